@@ -1,0 +1,76 @@
+#pragma once
+// The twin's typed command API. Commands are plain values: the GUI, the robot
+// link, sequence files and gaits queue them, and the physics thread applies
+// them at step boundaries. Units: SI, angles in radians.
+
+#include <array>
+#include <string>
+#include <variant>
+
+namespace sp {
+
+/// How a joint's actuator drives it.
+enum class JointMode {
+  Velocity,  ///< ODE motor holds a velocity with the actuator's torque limit
+  Position,  ///< PID on the angle gives the motor velocity (see actuator.h)
+  Torque,    ///< a commanded torque (force for sliders) is applied directly
+  Free,      ///< no drive: the joint turns freely (damping still applies)
+};
+const char* toString(JointMode mode);
+
+/// Joint velocity [rad/s or m/s]; switches the joint to Velocity mode.
+struct JointVelocityCmd {
+  std::string joint;
+  double velocity = 0;
+  friend bool operator==(const JointVelocityCmd&, const JointVelocityCmd&) = default;
+};
+/// Joint target [rad or m]; switches the joint to Position mode.
+struct JointTargetCmd {
+  std::string joint;
+  double position = 0;
+  friend bool operator==(const JointTargetCmd&, const JointTargetCmd&) = default;
+};
+/// Joint torque [N m or N]; switches the joint to Torque mode.
+struct JointTorqueCmd {
+  std::string joint;
+  double torque = 0;
+  friend bool operator==(const JointTorqueCmd&, const JointTorqueCmd&) = default;
+};
+/// Switches a joint's mode, keeping its current set-point for that mode.
+struct JointModeCmd {
+  std::string joint;
+  JointMode mode = JointMode::Free;
+  friend bool operator==(const JointModeCmd&, const JointModeCmd&) = default;
+};
+/// Wheel angular velocities [rad/s], front-left, front-right, rear-left, rear-right.
+struct WheelsCmd {
+  std::array<double, 4> omega{};
+  friend bool operator==(const WheelsCmd&, const WheelsCmd&) = default;
+};
+/// Drive at `speed` [m/s] (at the articulation hinge) with the articulation
+/// hinge at `articulation` [rad]; wheel speeds follow articulated-steering
+/// kinematics so that the tyres do not fight each other.
+struct DriveCmd {
+  double speed = 0;
+  double articulation = 0;
+  friend bool operator==(const DriveCmd&, const DriveCmd&) = default;
+};
+/// Every actuated joint to zero velocity (wheels) or to hold its angle.
+struct StopCmd {
+  friend bool operator==(const StopCmd&, const StopCmd&) = default;
+};
+
+using Command = std::variant<JointVelocityCmd, JointTargetCmd, JointTorqueCmd, JointModeCmd,
+                             WheelsCmd, DriveCmd, StopCmd>;
+
+/// A command with the sim time [s] at which it applies.
+struct TimedCommand {
+  double time = 0;
+  Command command;
+  int line = 0;  ///< source line in a sequence file, 0 if none
+};
+
+/// The command in sequence-file syntax (angles in degrees), e.g. `drive 0.5 10`.
+std::string toText(const Command& command);
+
+}  // namespace sp

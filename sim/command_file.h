@@ -1,0 +1,42 @@
+#pragma once
+// Command sequence files: one timestamped command per line, `#` comments.
+// Syntax and examples in docs/formats.md.
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sim/command.h"
+#include "sim/diagnostics.h"
+
+namespace sp {
+
+struct RobotModel;
+
+/// Parses one command (without its time) in file syntax, angles in degrees.
+/// On error returns nullopt and sets `error` to a message without location.
+std::optional<Command> parseCommand(std::string_view text, std::string& error);
+
+/// Parses a whole sequence held in `text`; `file` names it in diagnostics.
+/// All problems are reported; returns nullopt if there is any error.
+/// Times must be >= 0 and non-decreasing.
+std::optional<std::vector<TimedCommand>> parseCommandSequence(std::string_view text,
+                                                              std::string_view file,
+                                                              Diagnostics& diag);
+
+/// Reads and parses a sequence file.
+std::optional<std::vector<TimedCommand>> loadCommandSequence(const std::string& path,
+                                                             Diagnostics& diag);
+
+/// Checks commands against a robot: joints exist and are actuated, the
+/// actuator supports the mode, targets lie within joint limits, wheel and
+/// drive commands need the robot's <drive>. Returns false on any error;
+/// diagnostics carry `file` and each command's line.
+bool checkCommands(const std::vector<TimedCommand>& commands, const RobotModel& robot,
+                   std::string_view file, Diagnostics& diag);
+
+/// Checks one command against a robot; returns an empty string when valid.
+std::string checkCommand(const Command& command, const RobotModel& robot);
+
+}  // namespace sp

@@ -1,0 +1,1 @@
+#include "sim/height_grid.h"

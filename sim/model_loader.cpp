@@ -1,0 +1,1 @@
+#include "sim/model_loader.h"

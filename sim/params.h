@@ -1,0 +1,69 @@
+#pragma once
+// Simulation parameters: a human-readable `key = value` properties file with
+// `#` comments. config/defaults.params documents every key.
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sim/diagnostics.h"
+
+namespace sp {
+
+enum class Solver { Quick, Exact };
+
+/// Every tunable of the twin, with its default. Plain value type.
+struct SimParams {
+  // Physics
+  double step = 0.001;            ///< fixed step [s]
+  Solver solver = Solver::Quick;  ///< quick = dWorldQuickStep, exact = dWorldStep
+  int iterations = 50;            ///< quick solver iterations
+  double erp = 0.2;               ///< error reduction parameter
+  double cfm = 1e-6;              ///< constraint force mixing
+  double surfaceLayer = 0.001;    ///< contact surface layer [m]
+  double maxCorrectingVel = 10;   ///< contact max correcting velocity [m/s]
+  int maxContacts = 8;            ///< contact points per geom pair
+  uint64_t seed = 1;              ///< seed of the world's random engine
+  // Pacing
+  double realTimeFactor = 1.0;    ///< sim seconds per wall second
+  // Rates [Hz]
+  double telemetryRate = 50;
+  double laserRate = 20;
+  double logRate = 100;
+  double csvRate = 100;           ///< rows per sim second in `run --csv`
+  // Ports
+  int robotPort = 47800;          ///< TCP port of the robot link
+  // Health limits (checked every step)
+  double maxLinearSpeed = 50;     ///< [m/s]
+  double maxAngularSpeed = 200;   ///< [rad/s]
+  double maxJointError = 0.05;    ///< joint pulled apart [m]
+  double maxPenetration = 0.05;   ///< body below the ground [m]
+};
+
+/// Sets one key from its text value. `where`/`line` name the origin for
+/// diagnostics (a file and line, or "<command line>" and 0). Returns false and
+/// leaves `params` unchanged on an unknown key or a bad value.
+bool setParam(SimParams& params, std::string_view key, std::string_view value,
+              std::string_view where, int line, Diagnostics& diag);
+
+/// Reads a properties file over `params`. All problems are reported; on any
+/// error `params` is left exactly as it was (no half-applied file).
+bool loadParams(const std::string& path, SimParams& params, Diagnostics& diag);
+
+/// Applies a `key=value` override from the command line.
+bool applyOverride(SimParams& params, std::string_view assignment, Diagnostics& diag);
+
+/// Every key with its default value text and a one-line description, in the
+/// order of config/defaults.params.
+struct ParamInfo {
+  std::string key;
+  std::string defaultValue;
+  std::string description;
+};
+std::vector<ParamInfo> paramTable();
+
+/// The value of `key` in `params` as text (for logs and `--help`).
+std::string paramValue(const SimParams& params, std::string_view key);
+
+}  // namespace sp

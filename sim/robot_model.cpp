@@ -1,0 +1,1 @@
+#include "sim/robot_model.h"

@@ -1,0 +1,1 @@
+#include "sim/terrain_loader.h"
