@@ -1,1 +1,73 @@
 #include "sim/robot_model.h"
+
+#include <algorithm>
+
+namespace sp {
+
+const char* toString(GeomType type) {
+  switch (type) {
+    case GeomType::Box: return "box";
+    case GeomType::Cylinder: return "cylinder";
+    case GeomType::Sphere: return "sphere";
+    case GeomType::Capsule: return "capsule";
+  }
+  return "?";
+}
+
+const char* toString(JointType type) {
+  switch (type) {
+    case JointType::Hinge: return "hinge";
+    case JointType::Slider: return "slider";
+    case JointType::Universal: return "universal";
+    case JointType::Ball: return "ball";
+    case JointType::Fixed: return "fixed";
+  }
+  return "?";
+}
+
+const char* toString(SensorType type) {
+  switch (type) {
+    case SensorType::Pose: return "pose";
+    case SensorType::Laser: return "laser";
+    case SensorType::Encoder: return "encoder";
+    case SensorType::WheelForce: return "wheel_force";
+    case SensorType::JointForce: return "joint_force";
+    case SensorType::Imu: return "imu";
+  }
+  return "?";
+}
+
+namespace {
+template <typename T>
+int findByName(const std::vector<T>& items, std::string_view name) {
+  const auto it = std::find_if(items.begin(), items.end(),
+                               [&](const T& item) { return item.name == name; });
+  return it == items.end() ? -1 : static_cast<int>(it - items.begin());
+}
+}  // namespace
+
+int RobotModel::findLink(std::string_view n) const { return findByName(links, n); }
+int RobotModel::findJoint(std::string_view n) const { return findByName(joints, n); }
+int RobotModel::findSensor(std::string_view n) const { return findByName(sensors, n); }
+
+int RobotModel::findActuator(std::string_view jointName) const {
+  const int joint = findJoint(jointName);
+  if (joint < 0) return -1;
+  for (size_t i = 0; i < actuators.size(); ++i)
+    if (actuators[i].joint == joint) return static_cast<int>(i);
+  return -1;
+}
+
+double RobotModel::totalMass() const {
+  double sum = 0;
+  for (const LinkSpec& link : links) sum += link.mass;
+  return sum;
+}
+
+const ContactSpec& WorldModel::contactFor(std::string_view a, std::string_view b) const {
+  for (const ContactSpec& c : contacts)
+    if ((c.a == a && c.b == b) || (c.a == b && c.b == a)) return c;
+  return defaultContact;
+}
+
+}  // namespace sp
