@@ -3,6 +3,7 @@
 // rectangle centred on the terrain origin, linearly interpolated over the two
 // triangles of each cell exactly as ODE's heightfield is.
 
+#include <cstddef>
 #include <vector>
 
 namespace sp {
@@ -19,8 +20,8 @@ struct HeightGrid {
   double depth = 0;   ///< extent along y [m], > 0
   std::vector<double> heights;  ///< rows*columns values [m], index j*columns + i
 
-  double& at(int i, int j) { return heights[static_cast<size_t>(j) * columns + i]; }
-  double at(int i, int j) const { return heights[static_cast<size_t>(j) * columns + i]; }
+  double& at(int i, int j) { return heights[static_cast<std::size_t>(j) * columns + i]; }
+  double at(int i, int j) const { return heights[static_cast<std::size_t>(j) * columns + i]; }
   double spacingX() const { return width / (columns - 1); }
   double spacingY() const { return depth / (rows - 1); }
   double minHeight() const;
