@@ -408,12 +408,14 @@ bool World::build(Diagnostics& diag) {
       const Vec3 a = transformPoint(inst.pose, j.anchor);
       const Vec3 ax = rotate(inst.pose.q, j.axis);
       const Vec3 ax2 = rotate(inst.pose.q, j.axis2);
+      // ODE measures a joint as body 1 relative to body 2, so the child goes
+      // first: angles, rates and motors then read child relative to parent.
       dBodyID parent = j.parent >= 0 ? rt.bodies[j.parent] : nullptr;
       dBodyID child = rt.bodies[j.child];
       switch (j.type) {
         case JointType::Hinge:
           joint = dJointCreateHinge(m.world, nullptr);
-          dJointAttach(joint, parent, child);
+          dJointAttach(joint, child, parent);
           dJointSetHingeAnchor(joint, a.x, a.y, a.z);
           dJointSetHingeAxis(joint, ax.x, ax.y, ax.z);
           if (j.limited) {
@@ -423,7 +425,7 @@ bool World::build(Diagnostics& diag) {
           break;
         case JointType::Slider:
           joint = dJointCreateSlider(m.world, nullptr);
-          dJointAttach(joint, parent, child);
+          dJointAttach(joint, child, parent);
           dJointSetSliderAxis(joint, ax.x, ax.y, ax.z);
           if (j.limited) {
             dJointSetSliderParam(joint, dParamHiStop, j.upper);
@@ -432,7 +434,7 @@ bool World::build(Diagnostics& diag) {
           break;
         case JointType::Universal:
           joint = dJointCreateUniversal(m.world, nullptr);
-          dJointAttach(joint, parent, child);
+          dJointAttach(joint, child, parent);
           dJointSetUniversalAnchor(joint, a.x, a.y, a.z);
           dJointSetUniversalAxis1(joint, ax.x, ax.y, ax.z);
           dJointSetUniversalAxis2(joint, ax2.x, ax2.y, ax2.z);
@@ -443,12 +445,12 @@ bool World::build(Diagnostics& diag) {
           break;
         case JointType::Ball:
           joint = dJointCreateBall(m.world, nullptr);
-          dJointAttach(joint, parent, child);
+          dJointAttach(joint, child, parent);
           dJointSetBallAnchor(joint, a.x, a.y, a.z);
           break;
         case JointType::Fixed:
           joint = dJointCreateFixed(m.world, nullptr);
-          dJointAttach(joint, parent, child);
+          dJointAttach(joint, child, parent);
           dJointSetFixed(joint);
           break;
       }

@@ -1,0 +1,180 @@
+#include "app/headless_runner.h"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <ostream>
+
+#include "sim/command_file.h"
+#include "sim/model_loader.h"
+#include "sim/pacer.h"
+
+namespace sp {
+namespace {
+
+/// Writes one row per sample of the first robot: link poses, joint states.
+class CsvWriter {
+ public:
+  CsvWriter(std::ostream& out, const World& world) : out_(out) {
+    const RobotModel& robot = world.robotModel(0);
+    out_ << "time_s";
+    for (const LinkSpec& l : robot.links)
+      for (const char* c : {"x_m", "y_m", "z_m", "qw", "qx", "qy", "qz"}) out_ << ',' << l.name << '.' << c;
+    for (const JointSpec& j : robot.joints) {
+      const bool slider = j.type == JointType::Slider;
+      out_ << ',' << j.name << (slider ? ".pos_m" : ".pos_rad") << ',' << j.name
+           << (slider ? ".vel_m_s" : ".vel_rad_s");
+    }
+    out_ << '\n' << std::setprecision(9);
+  }
+
+  void sample(const World& world) {
+    const RobotModel& robot = world.robotModel(0);
+    out_ << world.time();
+    for (size_t l = 0; l < robot.links.size(); ++l) {
+      const Pose p = world.linkPose(0, static_cast<int>(l));
+      out_ << ',' << p.p.x << ',' << p.p.y << ',' << p.p.z << ',' << p.q.w << ',' << p.q.x << ',' << p.q.y
+           << ',' << p.q.z;
+    }
+    for (size_t j = 0; j < robot.joints.size(); ++j)
+      out_ << ',' << world.jointPosition(0, static_cast<int>(j)) << ','
+           << world.jointRate(0, static_cast<int>(j));
+    out_ << '\n';
+  }
+
+ private:
+  std::ostream& out_;
+};
+
+}  // namespace
+
+std::optional<SimParams> loadRunParams(const std::string& paramsFile, const std::vector<std::string>& overrides,
+                                       Diagnostics& diag) {
+  SimParams params;
+  bool ok = paramsFile.empty() || loadParams(paramsFile, params, diag);
+  for (const std::string& o : overrides) ok = applyOverride(params, o, diag) && ok;
+  if (!ok) return std::nullopt;
+  return params;
+}
+
+std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& out, std::ostream& err,
+                                     const ClockFn& clock, const SleepUntilFn& sleepUntil,
+                                     const std::atomic<bool>* stop) {
+  Diagnostics diag;
+  std::optional<SimParams> params = loadRunParams(options.paramsFile, options.overrides, diag);
+  std::optional<WorldModel> model = loadWorld(options.worldFile, diag);
+  std::vector<TimedCommand> commands;
+  if (model && model->robots.empty())
+    diag.error(options.worldFile, 0, "the world has no <robot> to run");
+  if (!options.commandsFile.empty() && model && !model->robots.empty()) {
+    const RobotModel& robot = model->robots[0].model;
+    if (auto seq = loadCommandSequence(options.commandsFile, diag)) {
+      if (checkCommands(*seq, robot, options.commandsFile, diag)) commands = std::move(*seq);
+    }
+  }
+  if (options.realTimeFactor && params) params->realTimeFactor = *options.realTimeFactor;
+  if (!(options.duration > 0)) diag.error("<command line>", 0, "--duration must be > 0");
+  err << diag.format();
+  if (diag.hasErrors() || !params || !model) return std::nullopt;
+
+  std::unique_ptr<World> world = World::create(*model, *params, diag);
+  if (!world) {
+    err << diag.format();
+    return std::nullopt;
+  }
+
+  const RobotInstance& robot = model->robots[0];
+  out << "SimPartner headless twin\n"
+      << "  world  '" << model->name << "' (" << options.worldFile << "), terrain "
+      << (model->terrain.kind == TerrainSpec::Kind::Plane ? "plane" : "heightfield " + model->terrain.file)
+      << "\n  robot  '" << robot.name << "' from " << robot.model.file << ": " << robot.model.links.size()
+      << " links, " << robot.model.joints.size() << " joints, " << robot.model.actuators.size()
+      << " actuators, " << std::fixed << std::setprecision(1) << robot.model.totalMass() << " kg\n"
+      << "  physics step " << params->step * 1000 << " ms, "
+      << (params->solver == Solver::Quick ? "quick solver, " + std::to_string(params->iterations) + " iterations"
+                                          : std::string("exact solver"))
+      << "\n  running " << options.duration << " s of sim time "
+      << (params->realTimeFactor > 0 ? "at " + std::to_string(params->realTimeFactor).substr(0, 5) + "x real time"
+                                     : std::string("as fast as possible"))
+      << (commands.empty() ? std::string(", no commands")
+                           : ", " + std::to_string(commands.size()) + " commands from " + options.commandsFile)
+      << "\n";
+
+  std::ofstream csvFile;
+  std::unique_ptr<CsvWriter> csv;
+  if (!options.csvFile.empty()) {
+    csvFile.open(options.csvFile);
+    if (!csvFile) {
+      err << options.csvFile << ": error: cannot write CSV file\n";
+      return std::nullopt;
+    }
+    csv = std::make_unique<CsvWriter>(csvFile, *world);
+    out << "  writing CSV at " << params->csvRate << " Hz to " << options.csvFile << "\n";
+  }
+  const int64_t csvEvery = std::max<int64_t>(1, std::llround(1.0 / (params->csvRate * params->step)));
+  const int64_t totalSteps = std::llround(options.duration / params->step);
+
+  Pacer pacer({params->step, params->realTimeFactor, 0.1, 100});
+  RunReport report;
+  report.requestedFactor = params->realTimeFactor;
+  size_t nextCommand = 0;
+  const double wallStart = clock();
+  double nextProgress = wallStart + options.progressInterval;
+  pacer.start(wallStart);
+  if (csv) csv->sample(*world);
+  while (world->stepCount() < totalSteps) {
+    if (stop && stop->load()) {
+      report.interrupted = true;
+      break;
+    }
+    const int64_t due = std::min(pacer.stepsDue(clock()), totalSteps - world->stepCount());
+    for (int64_t i = 0; i < due; ++i) {
+      // A command applies at the first step boundary at or after its time.
+      while (nextCommand < commands.size() && commands[nextCommand].time <= world->time() + 1e-9) {
+        const TimedCommand& c = commands[nextCommand++];
+        const std::string why = world->submit(c.command, 0);
+        if (!why.empty()) err << options.commandsFile << ":" << c.line << ": error: " << why << "\n";
+        else ++report.commandsApplied;
+      }
+      world->step();
+      if (csv && world->stepCount() % csvEvery == 0) csv->sample(*world);
+    }
+    pacer.stepped(due);
+    const double now = clock();
+    if (pacer.paced()) report.maxLag = std::max(report.maxLag, -pacer.lead(now));
+    if (options.progressInterval > 0 && now >= nextProgress) {
+      nextProgress += options.progressInterval;
+      const Pose base = world->linkPose(0, 0);
+      out << "  t=" << std::setprecision(1) << world->time() << " s  base at (" << std::setprecision(2)
+          << base.p.x << ", " << base.p.y << ", " << base.p.z << ") m  " << std::setprecision(2)
+          << pacer.achievedFactor(now) << "x real time\n";
+    }
+    if (due == 0 && pacer.paced()) sleepUntil(pacer.nextDeadline());
+  }
+  const double wallEnd = clock();
+  report.simTime = world->time();
+  report.wallTime = wallEnd - wallStart;
+  report.achievedFactor = pacer.achievedFactor(wallEnd);
+  report.finalError = pacer.paced() ? pacer.lead(wallEnd) : 0;
+  report.resyncs = pacer.resyncCount();
+  report.slipped = pacer.slippedTime();
+  report.steps = world->stepCount();
+
+  const Pose base = world->linkPose(0, 0);
+  out << std::setprecision(3) << (report.interrupted ? "interrupted" : "done") << ": " << report.simTime
+      << " s simulated in " << report.wallTime << " s wall, " << std::setprecision(2) << report.achievedFactor
+      << "x real time";
+  if (pacer.paced())
+    out << " (requested " << report.requestedFactor << "x; sim time - wall x factor at the end "
+        << std::setprecision(3) << report.finalError * 1000 << " ms, worst lag " << report.maxLag * 1000
+        << " ms, " << report.resyncs << " resyncs)";
+  out << "\n  " << report.commandsApplied << " commands applied; base ended at (" << base.p.x << ", "
+      << base.p.y << ", " << base.p.z << ") m\n";
+  if (pacer.paced() && report.resyncs > 0)
+    out << "warning: this machine cannot keep up with " << report.requestedFactor << "x real time: achieved "
+        << std::setprecision(2) << report.achievedFactor << "x, " << std::setprecision(3) << report.slipped
+        << " s of sim time ran late\n";
+  return report;
+}
+
+}  // namespace sp
