@@ -1,1 +1,73 @@
 #include "sim/command.h"
+
+#include <charconv>
+#include <system_error>
+
+#include "sim/math.h"
+
+namespace sp {
+namespace {
+
+std::string formatShortest(double value) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value);
+  return ec == std::errc() ? std::string(buf, end) : std::string("?");
+}
+
+// An angle [rad] as degrees, with the fewest significant digits that read
+// back (through degToRad) to exactly `rad`: degToRad(10) prints as "10", not
+// as "10.000000000000002". If no decimal does, the closest one is printed.
+std::string formatDegrees(double rad) {
+  const double deg = radToDeg(rad);
+  char buf[40];
+  for (int digits = 1; digits < 17; ++digits) {
+    const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, deg, std::chars_format::scientific, digits - 1);
+    double rounded = 0;
+    if (ec != std::errc() || std::from_chars(buf, end, rounded).ec != std::errc()) break;
+    if (degToRad(rounded) == rad) return formatShortest(rounded);
+  }
+  return formatShortest(deg);
+}
+
+}  // namespace
+
+const char* toString(JointMode mode) {
+  switch (mode) {
+    case JointMode::Velocity: return "velocity";
+    case JointMode::Position: return "position";
+    case JointMode::Torque: return "torque";
+    case JointMode::Free: return "free";
+  }
+  return "?";
+}
+
+// Joint values are written as for hinges (degrees, deg/s); sequence files do
+// not command sliders in this version (see command_file.h).
+std::string toText(const Command& command) {
+  struct Writer {
+    std::string operator()(const JointVelocityCmd& c) const {
+      return "velocity " + c.joint + " " + formatDegrees(c.velocity);
+    }
+    std::string operator()(const JointTargetCmd& c) const {
+      return "target " + c.joint + " " + formatDegrees(c.position);
+    }
+    std::string operator()(const JointTorqueCmd& c) const {
+      return "torque " + c.joint + " " + formatShortest(c.torque);
+    }
+    std::string operator()(const JointModeCmd& c) const {
+      return "mode " + c.joint + " " + toString(c.mode);
+    }
+    std::string operator()(const WheelsCmd& c) const {
+      std::string out = "wheels";
+      for (double omega : c.omega) out += " " + formatShortest(omega);
+      return out;
+    }
+    std::string operator()(const DriveCmd& c) const {
+      return "drive " + formatShortest(c.speed) + " " + formatDegrees(c.articulation);
+    }
+    std::string operator()(const StopCmd&) const { return "stop"; }
+  };
+  return std::visit(Writer{}, command);
+}
+
+}  // namespace sp

@@ -1,1 +1,365 @@
 #include "sim/command_file.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <system_error>
+
+#include "sim/math.h"
+#include "sim/robot_model.h"
+
+// Units in sequence files: angles in degrees (target, velocity in deg/s,
+// drive articulation), wheel speeds in rad/s (as customary for wheels), drive
+// speed in m/s, torques in N m. Limitation of this version: parseCommand does
+// not know joint types, so `target` and `velocity` values are always read as
+// degrees and converted to radians; sequence files therefore command hinge
+// joints only, and checkCommands() reports `target`/`velocity` on a slider as
+// an error. `torque` and `mode` are unit-free of this problem and work on both.
+
+namespace sp {
+namespace {
+
+constexpr std::string_view kSpace = " \t\r\n\v\f";
+
+std::string_view trim(std::string_view text) {
+  const size_t first = text.find_first_not_of(kSpace);
+  if (first == std::string_view::npos) return {};
+  const size_t last = text.find_last_not_of(kSpace);
+  return text.substr(first, last - first + 1);
+}
+
+std::vector<std::string_view> splitWords(std::string_view text) {
+  std::vector<std::string_view> words;
+  size_t pos = 0;
+  while ((pos = text.find_first_not_of(kSpace, pos)) != std::string_view::npos) {
+    const size_t end = std::min(text.find_first_of(kSpace, pos), text.size());
+    words.push_back(text.substr(pos, end - pos));
+    pos = end;
+  }
+  return words;
+}
+
+/// A finite decimal number with nothing after it, independent of the locale;
+/// a leading '+' is accepted.
+std::optional<double> parseReal(std::string_view text) {
+  if (text.size() > 1 && text.front() == '+' && text[1] != '-' && text[1] != '+') text.remove_prefix(1);
+  double value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
+    return std::nullopt;
+  return value;
+}
+
+/// A number for messages: 6 significant digits, as the model loader prints.
+std::string show(double value) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value, std::chars_format::general, 6);
+  return ec == std::errc() ? std::string(buf, end) : std::string("?");
+}
+
+/// The shortest text that reads back to exactly `value`.
+std::string shortest(double value) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value);
+  return ec == std::errc() ? std::string(buf, end) : std::string("?");
+}
+
+/// Arguments of one command; number() records the first bad one.
+struct ArgReader {
+  std::string_view command;
+  std::vector<std::string_view> args;
+  std::string error;
+
+  double number(size_t i) {
+    const std::optional<double> v = parseReal(args[i]);
+    if (!v && error.empty()) error = std::string(command) + ": bad number '" + std::string(args[i]) + "'";
+    return v.value_or(0);
+  }
+  std::string word(size_t i) const { return std::string(args[i]); }
+  JointMode mode(size_t i) {
+    for (JointMode m : {JointMode::Velocity, JointMode::Position, JointMode::Torque, JointMode::Free})
+      if (args[i] == toString(m)) return m;
+    if (error.empty())
+      error = std::string(command) + ": unknown mode '" + std::string(args[i]) +
+              "' (expected velocity, position, torque or free)";
+    return JointMode::Free;
+  }
+};
+
+/// One command of the file syntax: its name, arguments and how to build it.
+struct Syntax {
+  std::string_view name;
+  size_t arity;
+  std::string_view help;  // the arguments, for the arity message
+  Command (*build)(ArgReader& a);
+};
+
+// Braced initializers evaluate left to right, so the first bad argument is
+// the one reported.
+const Syntax kSyntax[] = {
+    {"drive", 2, "speed m/s, articulation deg",
+     [](ArgReader& a) -> Command { return DriveCmd{a.number(0), degToRad(a.number(1))}; }},
+    {"wheels", 4, "front-left, front-right, rear-left, rear-right rad/s",
+     [](ArgReader& a) -> Command { return WheelsCmd{{a.number(0), a.number(1), a.number(2), a.number(3)}}; }},
+    {"target", 2, "joint, angle deg",
+     [](ArgReader& a) -> Command { return JointTargetCmd{a.word(0), degToRad(a.number(1))}; }},
+    {"velocity", 2, "joint, velocity deg/s",
+     [](ArgReader& a) -> Command { return JointVelocityCmd{a.word(0), degToRad(a.number(1))}; }},
+    {"torque", 2, "joint, torque N m",
+     [](ArgReader& a) -> Command { return JointTorqueCmd{a.word(0), a.number(1)}; }},
+    {"mode", 2, "joint, velocity|position|torque|free",
+     [](ArgReader& a) -> Command { return JointModeCmd{a.word(0), a.mode(1)}; }},
+    {"stop", 0, "", [](ArgReader&) -> Command { return StopCmd{}; }},
+};
+
+constexpr const char* kWheelNames[4] = {"front-left", "front-right", "rear-left", "rear-right"};
+
+/// The joint `name` and its actuator, or an error message.
+struct Actuated {
+  const JointSpec* joint = nullptr;
+  const ActuatorSpec* actuator = nullptr;
+  std::string error;
+};
+
+Actuated findActuated(const RobotModel& robot, const std::string& name) {
+  Actuated out;
+  const int j = robot.findJoint(name);
+  if (j < 0) {
+    out.error = "unknown joint '" + name + "'";
+    return out;
+  }
+  const int a = robot.findActuator(name);
+  if (a < 0) {
+    out.error = "joint '" + name + "' has no actuator";
+    return out;
+  }
+  out.joint = &robot.joints[j];
+  out.actuator = &robot.actuators[a];
+  return out;
+}
+
+std::string needsPid(const std::string& joint) {
+  return "joint '" + joint + "': position mode needs PID gains on its actuator";
+}
+
+bool angular(const JointSpec& joint) { return joint.type != JointType::Slider; }
+
+/// Value [rad or m] in the file's unit (degrees or metres) for messages.
+std::string showInFileUnit(const JointSpec& joint, double value) {
+  return show(angular(joint) ? radToDeg(value) : value);
+}
+
+/// Checks of one command against the robot; "" when valid.
+struct Checker {
+  const RobotModel& robot;
+
+  std::string operator()(const JointTargetCmd& c) const {
+    const Actuated a = findActuated(robot, c.joint);
+    if (!a.error.empty()) return a.error;
+    if (!a.actuator->hasPid) return needsPid(c.joint);
+    const JointSpec& j = *a.joint;
+    if (j.limited && (c.position < j.lower || c.position > j.upper)) {
+      const std::string unit = angular(j) ? " deg" : " m";
+      return "target " + showInFileUnit(j, c.position) + unit + " is outside joint '" + j.name + "' limits [" +
+             showInFileUnit(j, j.lower) + ", " + showInFileUnit(j, j.upper) + "]" + unit;
+    }
+    return {};
+  }
+
+  std::string operator()(const JointVelocityCmd& c) const {
+    const Actuated a = findActuated(robot, c.joint);
+    if (!a.error.empty()) return a.error;
+    if (std::abs(c.velocity) > a.actuator->maxVelocity) {
+      const std::string unit = angular(*a.joint) ? " deg/s" : " m/s";
+      return "velocity " + showInFileUnit(*a.joint, c.velocity) + unit + " exceeds joint '" + c.joint +
+             "' max_velocity " + showInFileUnit(*a.joint, a.actuator->maxVelocity) + unit;
+    }
+    return {};
+  }
+
+  std::string operator()(const JointTorqueCmd& c) const {
+    const Actuated a = findActuated(robot, c.joint);
+    if (!a.error.empty()) return a.error;
+    if (std::abs(c.torque) > a.actuator->maxTorque) {
+      const std::string unit = angular(*a.joint) ? " N m" : " N";
+      return "torque " + show(c.torque) + unit + " exceeds joint '" + c.joint + "' max_torque " +
+             show(a.actuator->maxTorque) + unit;
+    }
+    return {};
+  }
+
+  std::string operator()(const JointModeCmd& c) const {
+    const Actuated a = findActuated(robot, c.joint);
+    if (!a.error.empty()) return a.error;
+    if (c.mode == JointMode::Position && !a.actuator->hasPid) return needsPid(c.joint);
+    return {};
+  }
+
+  std::string operator()(const WheelsCmd& c) const {
+    if (std::string e = needDrive(); !e.empty()) return e;
+    for (size_t i = 0; i < 4; ++i) {
+      const JointSpec& joint = robot.joints[robot.drive->wheels[i]];
+      const int a = robot.findActuator(joint.name);
+      if (a < 0) return "wheel joint '" + joint.name + "' has no actuator";
+      const double max = robot.actuators[a].maxVelocity;
+      if (std::abs(c.omega[i]) > max)
+        return std::string(kWheelNames[i]) + " wheel speed " + show(c.omega[i]) + " rad/s exceeds joint '" +
+               joint.name + "' max_velocity " + show(max) + " rad/s (" + show(radToDeg(max)) + " deg/s)";
+    }
+    return {};
+  }
+
+  std::string operator()(const DriveCmd& c) const {
+    if (std::string e = needDrive(); !e.empty()) return e;
+    const JointSpec& j = robot.joints[robot.drive->articulation];
+    if (j.limited && (c.articulation < j.lower || c.articulation > j.upper))
+      return "articulation " + show(radToDeg(c.articulation)) + " deg is outside joint '" + j.name +
+             "' limits [" + show(radToDeg(j.lower)) + ", " + show(radToDeg(j.upper)) + "] deg";
+    return {};
+  }
+
+  std::string operator()(const StopCmd&) const { return {}; }
+
+  // The robot's <drive>, with joint indices checked so that the checks above
+  // cannot index out of range on a hand-built model.
+  std::string needDrive() const {
+    if (!robot.drive) return "robot '" + robot.name + "' has no <drive>";
+    const auto valid = [&](int j) { return j >= 0 && static_cast<size_t>(j) < robot.joints.size(); };
+    bool ok = valid(robot.drive->articulation);
+    for (int w : robot.drive->wheels) ok = ok && valid(w);
+    return ok ? std::string() : "robot '" + robot.name + "' has a <drive> with unknown joints";
+  }
+};
+
+/// Sequence files read target/velocity values as degrees (see the top).
+std::string checkFileUnits(const Command& command, const RobotModel& robot) {
+  const std::string* joint = nullptr;
+  if (const auto* t = std::get_if<JointTargetCmd>(&command)) joint = &t->joint;
+  if (const auto* v = std::get_if<JointVelocityCmd>(&command)) joint = &v->joint;
+  if (!joint) return {};
+  const int j = robot.findJoint(*joint);
+  if (j >= 0 && robot.joints[j].type == JointType::Slider)
+    return "joint '" + *joint + "' is a slider; sequence files command hinge joints only (values are degrees)";
+  return {};
+}
+
+}  // namespace
+
+std::optional<Command> parseCommand(std::string_view text, std::string& error) {
+  const std::vector<std::string_view> words = splitWords(text);
+  if (words.empty()) {
+    error = "empty command";
+    return std::nullopt;
+  }
+  for (const Syntax& s : kSyntax) {
+    if (words[0] != s.name) continue;
+    ArgReader reader{s.name, {words.begin() + 1, words.end()}, {}};
+    if (reader.args.size() != s.arity) {
+      const std::string got = ", got " + std::to_string(reader.args.size());
+      error = std::string(s.name) +
+              (s.arity == 0 ? ": expected no arguments" + got
+                            : ": expected " + std::to_string(s.arity) + " arguments (" + std::string(s.help) +
+                                  ")" + got);
+      return std::nullopt;
+    }
+    Command command = s.build(reader);
+    if (!reader.error.empty()) {
+      error = reader.error;
+      return std::nullopt;
+    }
+    return command;
+  }
+  error = "unknown command '" + std::string(words[0]) + "'";
+  return std::nullopt;
+}
+
+std::optional<std::vector<TimedCommand>> parseCommandSequence(std::string_view text, std::string_view file,
+                                                              Diagnostics& diag) {
+  std::vector<TimedCommand> commands;
+  bool ok = true;
+  std::optional<double> previousTime;
+  int line = 0;
+  for (size_t pos = 0; pos <= text.size();) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view content = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++line;
+    content = trim(content.substr(0, content.find('#')));
+    if (content.empty()) continue;
+
+    const size_t split = std::min(content.find_first_of(kSpace), content.size());
+    const std::string_view timeText = content.substr(0, split);
+    const std::string_view rest = trim(content.substr(split));
+    const std::optional<double> time = parseReal(timeText);
+    if (!time) {
+      diag.error(file, line, "bad time '" + std::string(timeText) + "'");
+      ok = false;
+      continue;
+    }
+    if (*time < 0) {
+      diag.error(file, line, "time must be >= 0");
+      ok = false;
+      continue;
+    }
+    if (previousTime && *time < *previousTime) {
+      diag.error(file, line, "time " + shortest(*time) + " is before the previous command's time " +
+                                 shortest(*previousTime));
+      ok = false;
+      continue;
+    }
+    previousTime = time;
+    if (rest.empty()) {
+      diag.error(file, line, "expected a command after the time");
+      ok = false;
+      continue;
+    }
+    std::string error;
+    std::optional<Command> command = parseCommand(rest, error);
+    if (!command) {
+      diag.error(file, line, error);
+      ok = false;
+      continue;
+    }
+    commands.push_back({*time, std::move(*command), line});
+  }
+  if (!ok) return std::nullopt;
+  return commands;
+}
+
+std::optional<std::vector<TimedCommand>> loadCommandSequence(const std::string& path, Diagnostics& diag) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    diag.error(path, 0, "cannot open command sequence file");
+    return std::nullopt;
+  }
+  std::string text;
+  char chunk[4096];
+  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) text.append(chunk, static_cast<size_t>(in.gcount()));
+  if (in.bad()) {  // a directory, say
+    diag.error(path, 0, "cannot read command sequence file");
+    return std::nullopt;
+  }
+  return parseCommandSequence(text, path, diag);
+}
+
+bool checkCommands(const std::vector<TimedCommand>& commands, const RobotModel& robot, std::string_view file,
+                   Diagnostics& diag) {
+  bool ok = true;
+  for (const TimedCommand& c : commands) {
+    std::string error = checkFileUnits(c.command, robot);
+    if (error.empty()) error = checkCommand(c.command, robot);
+    if (!error.empty()) {
+      diag.error(file, c.line, std::move(error));
+      ok = false;
+    }
+  }
+  return ok;
+}
+
+std::string checkCommand(const Command& command, const RobotModel& robot) {
+  return std::visit(Checker{robot}, command);
+}
+
+}  // namespace sp

@@ -1,1 +1,304 @@
 #include "sim/params.h"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <map>
+#include <optional>
+#include <system_error>
+
+namespace sp {
+namespace {
+
+std::string_view trim(std::string_view text) {
+  constexpr std::string_view kSpace = " \t\r\n\v\f";
+  const size_t first = text.find_first_not_of(kSpace);
+  if (first == std::string_view::npos) return {};
+  const size_t last = text.find_last_not_of(kSpace);
+  return text.substr(first, last - first + 1);
+}
+
+// Shortest text that reads back to exactly `value` (so defaults and
+// paramValue() round-trip through setParam() bit for bit).
+std::string formatNumber(double value) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value);
+  return ec == std::errc() ? std::string(buf, end) : std::string("?");
+}
+
+// A leading '+' is accepted as well ("+5"); std::from_chars rejects it.
+std::string_view dropPlus(std::string_view text) {
+  if (text.size() > 1 && text.front() == '+' && text[1] != '-' && text[1] != '+')
+    text.remove_prefix(1);
+  return text;
+}
+
+/// A finite decimal number with nothing after it, independent of the locale.
+std::optional<double> parseReal(std::string_view text) {
+  text = dropPlus(text);
+  double value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
+    return std::nullopt;
+  return value;
+}
+
+/// Result of reading an integer: the value, or why not.
+template <typename Int>
+struct IntRead {
+  std::optional<Int> value;
+  bool tooLarge = false;  // a well-formed integer beyond the type's range
+  bool tooSmall = false;
+};
+
+template <typename Int>
+IntRead<Int> parseInt(std::string_view text) {
+  text = dropPlus(text);
+  Int value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  IntRead<Int> out;
+  if (text.empty() || end != text.data() + text.size()) return out;
+  if (ec == std::errc::result_out_of_range) {
+    (text.front() == '-' ? out.tooSmall : out.tooLarge) = true;
+    return out;
+  }
+  if (ec == std::errc()) out.value = value;
+  return out;
+}
+
+/// Bounds of a numeric key; a bound may be open (strict) or absent.
+struct Range {
+  std::optional<double> lo, hi;
+  bool loOpen = false, hiOpen = false;
+};
+Range atLeast(double lo) { return {lo, std::nullopt, false, false}; }
+Range above(double lo) { return {lo, std::nullopt, true, false}; }
+Range closed(double lo, double hi) { return {lo, hi, false, false}; }
+Range openClosed(double lo, double hi) { return {lo, hi, true, false}; }
+Range closedOpen(double lo, double hi) { return {lo, hi, false, true}; }
+
+/// The violated bound as "must be > 0", or "" when `value` is in range.
+std::string rangeError(const Range& range, double value) {
+  if (range.lo && (range.loOpen ? !(value > *range.lo) : !(value >= *range.lo)))
+    return std::string("must be ") + (range.loOpen ? "> " : ">= ") + formatNumber(*range.lo);
+  if (range.hi && (range.hiOpen ? !(value < *range.hi) : !(value <= *range.hi)))
+    return std::string("must be ") + (range.hiOpen ? "< " : "<= ") + formatNumber(*range.hi);
+  return {};
+}
+
+/// Parses `text` into `params` and returns "", or leaves `params` alone and
+/// returns the problem (without the key, which the caller prefixes).
+using Setter = std::function<std::string(SimParams& params, std::string_view text)>;
+using Getter = std::function<std::string(const SimParams& params)>;
+
+struct Entry {
+  const char* key;
+  const char* description;
+  Setter set;
+  Getter get;
+};
+
+struct Accessors {
+  Setter set;
+  Getter get;
+};
+
+Accessors real(double SimParams::*field, Range range) {
+  return {[field, range](SimParams& p, std::string_view text) -> std::string {
+            const std::optional<double> v = parseReal(text);
+            if (!v) return "expected a number, got '" + std::string(text) + "'";
+            if (std::string e = rangeError(range, *v); !e.empty()) return e + ", got " + std::string(text);
+            p.*field = *v;
+            return {};
+          },
+          [field](const SimParams& p) { return formatNumber(p.*field); }};
+}
+
+Accessors integer(int SimParams::*field, int lo, int hi) {
+  return {[field, lo, hi](SimParams& p, std::string_view text) -> std::string {
+            const IntRead<int64_t> v = parseInt<int64_t>(text);
+            const std::string got = ", got " + std::string(text);
+            if (v.tooSmall || (v.value && *v.value < lo)) return "must be >= " + std::to_string(lo) + got;
+            if (v.tooLarge || (v.value && *v.value > hi)) return "must be <= " + std::to_string(hi) + got;
+            if (!v.value) return "expected an integer, got '" + std::string(text) + "'";
+            p.*field = static_cast<int>(*v.value);
+            return {};
+          },
+          [field](const SimParams& p) { return std::to_string(p.*field); }};
+}
+
+Accessors unsigned64(uint64_t SimParams::*field) {
+  return {[field](SimParams& p, std::string_view text) -> std::string {
+            const IntRead<uint64_t> v = parseInt<uint64_t>(text);
+            if (v.tooLarge)
+              return "must be <= " + std::to_string(std::numeric_limits<uint64_t>::max()) + ", got " +
+                     std::string(text);
+            if (!v.value) return "expected a non-negative integer, got '" + std::string(text) + "'";
+            p.*field = *v.value;
+            return {};
+          },
+          [field](const SimParams& p) { return std::to_string(p.*field); }};
+}
+
+Accessors solver() {
+  return {[](SimParams& p, std::string_view text) -> std::string {
+            if (text == "quick") p.solver = Solver::Quick;
+            else if (text == "exact") p.solver = Solver::Exact;
+            else return "expected 'quick' or 'exact', got '" + std::string(text) + "'";
+            return {};
+          },
+          [](const SimParams& p) -> std::string { return p.solver == Solver::Exact ? "exact" : "quick"; }};
+}
+
+// A factor > 0, or `max` (stored as 0): run as fast as possible.
+Accessors realTimeFactor() {
+  return {[](SimParams& p, std::string_view text) -> std::string {
+            if (text == "max") {
+              p.realTimeFactor = 0;
+              return {};
+            }
+            const std::optional<double> v = parseReal(text);
+            if (!v) return "expected a number or 'max', got '" + std::string(text) + "'";
+            if (!(*v > 0)) return "must be > 0, got " + std::string(text);
+            p.realTimeFactor = *v;
+            return {};
+          },
+          [](const SimParams& p) { return p.realTimeFactor > 0 ? formatNumber(p.realTimeFactor) : "max"; }};
+}
+
+Entry entry(const char* key, const char* description, Accessors a) {
+  return {key, description, std::move(a.set), std::move(a.get)};
+}
+
+// The one list of keys, in the order of config/defaults.params. Defaults are
+// not repeated here: they are SimParams' in-class initializers.
+const std::vector<Entry>& table() {
+  constexpr double kMaxRate = 10000;
+  static const std::vector<Entry> entries = {
+      entry("physics.step", "fixed integration step [s], (0, 0.1]",
+            real(&SimParams::step, openClosed(0, 0.1))),
+      entry("physics.solver", "quick (dWorldQuickStep, iterative) or exact (dWorldStep)", solver()),
+      entry("physics.iterations", "quick solver iterations per step, 1..1000",
+            integer(&SimParams::iterations, 1, 1000)),
+      entry("physics.erp", "error reduction parameter, [0, 1]", real(&SimParams::erp, closed(0, 1))),
+      entry("physics.cfm", "constraint force mixing, [0, 1)", real(&SimParams::cfm, closedOpen(0, 1))),
+      entry("contact.surface_layer", "contact depth allowed before correction [m], >= 0",
+            real(&SimParams::surfaceLayer, atLeast(0))),
+      entry("contact.max_correcting_velocity", "max speed of penetration correction [m/s], >= 0",
+            real(&SimParams::maxCorrectingVel, atLeast(0))),
+      entry("contact.max_per_pair", "contact points per colliding geom pair, 1..64",
+            integer(&SimParams::maxContacts, 1, 64)),
+      entry("random.seed", "seed of the world's random engine (sensor noise), 0..2^64-1",
+            unsigned64(&SimParams::seed)),
+      entry("realtime.factor", "sim seconds per wall second, > 0, or max (unpaced)", realTimeFactor()),
+      entry("rate.telemetry", "telemetry messages to the console [Hz], (0, 10000]",
+            real(&SimParams::telemetryRate, openClosed(0, kMaxRate))),
+      entry("rate.laser", "laser scans published [Hz], (0, 10000]",
+            real(&SimParams::laserRate, openClosed(0, kMaxRate))),
+      entry("rate.log", "state rows recorded in the session log [Hz], (0, 10000]",
+            real(&SimParams::logRate, openClosed(0, kMaxRate))),
+      entry("rate.csv", "rows per sim second written by run --csv [Hz], (0, 10000]",
+            real(&SimParams::csvRate, openClosed(0, kMaxRate))),
+      entry("port.robot", "TCP port of the robot link, 1..65535", integer(&SimParams::robotPort, 1, 65535)),
+      entry("health.max_linear_speed", "any body faster than this diverged [m/s], > 0",
+            real(&SimParams::maxLinearSpeed, above(0))),
+      entry("health.max_angular_speed", "any body spinning faster than this diverged [rad/s], > 0",
+            real(&SimParams::maxAngularSpeed, above(0))),
+      entry("health.max_joint_error", "joint anchors pulled apart by more than this [m], > 0",
+            real(&SimParams::maxJointError, above(0))),
+      entry("health.max_penetration", "body below the ground by more than this [m], > 0",
+            real(&SimParams::maxPenetration, above(0))),
+  };
+  return entries;
+}
+
+const Entry* findEntry(std::string_view key) {
+  for (const Entry& e : table())
+    if (key == e.key) return &e;
+  return nullptr;
+}
+
+constexpr const char* kCommandLine = "<command line>";
+
+}  // namespace
+
+bool setParam(SimParams& params, std::string_view key, std::string_view value, std::string_view where,
+              int line, Diagnostics& diag) {
+  const Entry* e = findEntry(key);
+  if (!e) {
+    diag.error(where, line, "unknown key '" + std::string(key) + "'");
+    return false;
+  }
+  if (std::string problem = e->set(params, value); !problem.empty()) {
+    diag.error(where, line, std::string(key) + ": " + problem);
+    return false;
+  }
+  return true;
+}
+
+bool loadParams(const std::string& path, SimParams& params, Diagnostics& diag) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    diag.error(path, 0, "cannot open parameters file");
+    return false;
+  }
+  // Applied to a copy, committed only if the whole file is valid.
+  SimParams staged = params;
+  std::map<std::string, int, std::less<>> firstLine;
+  bool ok = true;
+  std::string raw;
+  for (int line = 1; std::getline(in, raw); ++line) {
+    std::string_view text = raw;
+    text = trim(text.substr(0, text.find('#')));
+    if (text.empty()) continue;
+    const size_t eq = text.find('=');
+    const std::string_view key = eq == std::string_view::npos ? std::string_view() : trim(text.substr(0, eq));
+    const std::string_view value = eq == std::string_view::npos ? std::string_view() : trim(text.substr(eq + 1));
+    if (key.empty() || value.empty()) {
+      diag.error(path, line, "expected 'key = value'");
+      ok = false;
+      continue;
+    }
+    if (const auto it = firstLine.find(key); it != firstLine.end()) {
+      diag.error(path, line, "duplicate key '" + std::string(key) + "' (first set on line " +
+                                 std::to_string(it->second) + ")");
+      ok = false;
+      continue;
+    }
+    if (findEntry(key)) firstLine.emplace(std::string(key), line);
+    if (!setParam(staged, key, value, path, line, diag)) ok = false;
+  }
+  if (in.bad()) {  // a directory, say
+    diag.error(path, 0, "cannot read parameters file");
+    return false;
+  }
+  if (ok) params = staged;
+  return ok;
+}
+
+bool applyOverride(SimParams& params, std::string_view assignment, Diagnostics& diag) {
+  const size_t eq = assignment.find('=');
+  const std::string_view key = eq == std::string_view::npos ? std::string_view() : trim(assignment.substr(0, eq));
+  if (key.empty()) {
+    diag.error(kCommandLine, 0, "expected key=value, got '" + std::string(assignment) + "'");
+    return false;
+  }
+  return setParam(params, key, trim(assignment.substr(eq + 1)), kCommandLine, 0, diag);
+}
+
+std::vector<ParamInfo> paramTable() {
+  const SimParams defaults;
+  std::vector<ParamInfo> out;
+  out.reserve(table().size());
+  for (const Entry& e : table()) out.push_back({e.key, e.get(defaults), e.description});
+  return out;
+}
+
+std::string paramValue(const SimParams& params, std::string_view key) {
+  const Entry* e = findEntry(key);
+  return e ? e->get(params) : std::string();
+}
+
+}  // namespace sp
