@@ -41,9 +41,8 @@ std::vector<std::string_view> splitWords(std::string_view text) {
 }
 
 /// A finite decimal number with nothing after it, independent of the locale;
-/// a leading '+' is accepted.
+/// as in robot and world files, no '+', no inf/nan, no units.
 std::optional<double> parseReal(std::string_view text) {
-  if (text.size() > 1 && text.front() == '+' && text[1] != '-' && text[1] != '+') text.remove_prefix(1);
   double value = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value))

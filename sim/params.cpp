@@ -28,16 +28,9 @@ std::string formatNumber(double value) {
   return ec == std::errc() ? std::string(buf, end) : std::string("?");
 }
 
-// A leading '+' is accepted as well ("+5"); std::from_chars rejects it.
-std::string_view dropPlus(std::string_view text) {
-  if (text.size() > 1 && text.front() == '+' && text[1] != '-' && text[1] != '+')
-    text.remove_prefix(1);
-  return text;
-}
-
-/// A finite decimal number with nothing after it, independent of the locale.
+/// A finite decimal number with nothing after it, independent of the locale;
+/// as in robot and world files, no '+', no inf/nan, no units.
 std::optional<double> parseReal(std::string_view text) {
-  text = dropPlus(text);
   double value = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
@@ -55,7 +48,6 @@ struct IntRead {
 
 template <typename Int>
 IntRead<Int> parseInt(std::string_view text) {
-  text = dropPlus(text);
   Int value = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   IntRead<Int> out;

@@ -126,7 +126,7 @@ void TestCommandFile::parseCommand_data() {
   QTest::addColumn<Command>("expected");
   QTest::addColumn<QString>("canonical");  // toText() of the result
   QTest::newRow("drive") << "drive 0.5 10" << Command(DriveCmd{0.5, degToRad(10)}) << "drive 0.5 10";
-  QTest::newRow("drive spacing") << "  drive\t+0.50   -10 " << Command(DriveCmd{0.5, degToRad(-10)})
+  QTest::newRow("drive spacing") << "  drive\t0.50   -10 " << Command(DriveCmd{0.5, degToRad(-10)})
                                  << "drive 0.5 -10";
   QTest::newRow("wheels in rad/s") << "wheels 1 2 -3 4.5" << Command(WheelsCmd{{1, 2, -3, 4.5}})
                                    << "wheels 1 2 -3 4.5";
@@ -174,6 +174,7 @@ void TestCommandFile::parseCommandErrors_data() {
                                 << "drive: expected 2 arguments (speed m/s, articulation deg), got 3";
   QTest::newRow("drive bad number") << "drive 1 x" << "drive: bad number 'x'";
   QTest::newRow("drive first bad number") << "drive y x" << "drive: bad number 'y'";
+  QTest::newRow("drive leading plus") << "drive +1 0" << "drive: bad number '+1'";
   QTest::newRow("drive unit suffix") << "drive 1m/s 0" << "drive: bad number '1m/s'";
   QTest::newRow("wheels 3 args") << "wheels 1 2 3"
                                  << "wheels: expected 4 arguments (front-left, front-right, rear-left, "

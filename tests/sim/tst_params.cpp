@@ -150,7 +150,6 @@ void TestParams::setParamAccepts_data() {
   QTest::newRow("step") << "physics.step" << "0.002" << "0.002";
   QTest::newRow("step upper bound") << "physics.step" << "0.1" << "0.1";
   QTest::newRow("step exponent") << "physics.step" << "5e-4" << "5e-04";
-  QTest::newRow("step leading plus") << "physics.step" << "+0.004" << "0.004";
   QTest::newRow("solver exact") << "physics.solver" << "exact" << "exact";
   QTest::newRow("solver quick") << "physics.solver" << "quick" << "quick";
   QTest::newRow("iterations min") << "physics.iterations" << "1" << "1";
@@ -221,6 +220,7 @@ void TestParams::setParamRejects_data() {
   QTest::newRow("not a number") << "physics.step" << "abc" << "physics.step: expected a number, got 'abc'";
   QTest::newRow("empty") << "physics.step" << "" << "physics.step: expected a number, got ''";
   QTest::newRow("trailing junk") << "physics.step" << "0.001s" << "physics.step: expected a number, got '0.001s'";
+  QTest::newRow("leading plus") << "physics.step" << "+0.004" << "physics.step: expected a number, got '+0.004'";
   QTest::newRow("decimal comma") << "physics.step" << "0,001" << "physics.step: expected a number, got '0,001'";
   QTest::newRow("nan") << "physics.step" << "nan" << "physics.step: expected a number, got 'nan'";
   QTest::newRow("inf") << "health.max_linear_speed" << "inf"
