@@ -17,8 +17,8 @@ enum class TerrainFormat { Auto, Asc, Pgm, Csv, Profile };
 struct TerrainSource {
   std::string path;  ///< resolved file path
   TerrainFormat format = TerrainFormat::Auto;  ///< Auto: by extension (.asc .pgm .csv)
-  double width = 0;      ///< x extent [m]; 0 = from the file (asc: ncols*cellsize; profile: distance span)
-  double depth = 0;      ///< y extent [m]; 0 = from the file (asc); required for csv/pgm; profile: lateral width
+  double width = 0;      ///< x extent [m]; 0 = from the file (asc: (ncols-1)*cellsize; profile: distance span)
+  double depth = 0;      ///< y extent [m]; 0 = from the file (asc: (nrows-1)*cellsize); required for csv/pgm; profile: lateral width
   double minHeight = 0;  ///< pgm only: height of grey value 0 [m]
   double maxHeight = 1;  ///< pgm only: height of the maximum grey value [m]
   double resolution = 0.05;  ///< profile only: sample spacing along both axes [m]
