@@ -22,7 +22,7 @@ struct SimParams {
   double erp = 0.2;               ///< error reduction parameter
   double cfm = 1e-6;              ///< constraint force mixing
   double surfaceLayer = 0.001;    ///< contact surface layer [m]
-  double maxCorrectingVel = 10;   ///< contact max correcting velocity [m/s]
+  double maxCorrectingVel = 0.5;  ///< contact max correcting velocity [m/s]
   int maxContacts = 8;            ///< contact points per geom pair
   uint64_t seed = 1;              ///< seed of the world's random engine
   // Pacing

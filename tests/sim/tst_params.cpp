@@ -159,7 +159,7 @@ void TestParams::setParamAccepts_data() {
   QTest::newRow("cfm 0") << "physics.cfm" << "0" << "0";
   QTest::newRow("cfm 0.999") << "physics.cfm" << "0.999" << "0.999";
   QTest::newRow("surface layer 0") << "contact.surface_layer" << "0" << "0";
-  QTest::newRow("correcting velocity") << "contact.max_correcting_velocity" << "0.5" << "0.5";
+  QTest::newRow("correcting velocity") << "contact.max_correcting_velocity" << "2.5" << "2.5";
   QTest::newRow("contacts 64") << "contact.max_per_pair" << "64" << "64";
   QTest::newRow("seed 0") << "random.seed" << "0" << "0";
   QTest::newRow("seed max") << "random.seed" << "18446744073709551615" << "18446744073709551615";
@@ -245,8 +245,8 @@ void TestParams::setParamRejects_data() {
   QTest::newRow("cfm negative") << "physics.cfm" << "-1e-9" << "physics.cfm: must be >= 0, got -1e-9";
   QTest::newRow("surface layer") << "contact.surface_layer" << "-0.001"
                                  << "contact.surface_layer: must be >= 0, got -0.001";
-  QTest::newRow("correcting velocity") << "contact.max_correcting_velocity" << "-1"
-                                       << "contact.max_correcting_velocity: must be >= 0, got -1";
+  QTest::newRow("correcting velocity") << "contact.max_correcting_velocity" << "0"
+                                       << "contact.max_correcting_velocity: must be > 0, got 0";
   QTest::newRow("contacts zero") << "contact.max_per_pair" << "0" << "contact.max_per_pair: must be >= 1, got 0";
   QTest::newRow("contacts 65") << "contact.max_per_pair" << "65" << "contact.max_per_pair: must be <= 64, got 65";
   QTest::newRow("seed negative") << "random.seed" << "-1"
