@@ -79,6 +79,7 @@ class ElementReader {
   /// A number; `scale` converts file units (degrees) to internal ones.
   /// Range checks apply to the file value.
   double number(const char* attr, double fallback, bool required = false, double scale = 1.0) {
+    lastValid_ = false;
     std::optional<std::string> t = text(attr, required);
     if (!t) return fallback;
     std::optional<double> v = parseDouble(*t);
@@ -87,18 +88,23 @@ class ElementReader {
       return fallback;
     }
     last_ = *v;
+    lastValid_ = true;
     return *v * scale;
   }
 
-  // Range checks on the last number read, in file units.
+  /// Whether the last number() or vec3() call found a valid value.
+  bool lastValid() const { return lastValid_; }
+
+  // Range checks on the last number read, in file units; skipped when it was
+  // absent or not a number (already reported).
   void positive(const char* attr) {
-    if (has(attr) && !(last_ > 0)) rangeError(attr, "> 0");
+    if (lastValid_ && has(attr) && !(last_ > 0)) rangeError(attr, "> 0");
   }
   void nonNegative(const char* attr) {
-    if (has(attr) && !(last_ >= 0)) rangeError(attr, ">= 0");
+    if (lastValid_ && has(attr) && !(last_ >= 0)) rangeError(attr, ">= 0");
   }
   void within(const char* attr, double lo, double hi) {
-    if (has(attr) && !(last_ >= lo && last_ <= hi))
+    if (lastValid_ && has(attr) && !(last_ >= lo && last_ <= hi))
       rangeError(attr, "in [" + formatNumber(lo) + ", " + formatNumber(hi) + "]");
   }
 
@@ -120,6 +126,7 @@ class ElementReader {
   }
 
   Vec3 vec3(const char* attr, Vec3 fallback, double scale = 1.0) {
+    lastValid_ = false;
     std::optional<std::string> t = text(attr, false);
     if (!t) return fallback;
     std::istringstream in(*t);
@@ -133,6 +140,7 @@ class ElementReader {
       error(attrLine(attr), std::string(attr) + ": expected 3 numbers, got '" + *t + "'");
       return fallback;
     }
+    lastValid_ = true;
     return {*v[0] * scale, *v[1] * scale, *v[2] * scale};
   }
 
@@ -221,6 +229,7 @@ class ElementReader {
   std::string context_;
   std::vector<std::string> used_;
   double last_ = 0;
+  bool lastValid_ = false;
 };
 
 /// Tracks names of one kind for duplicate detection.
@@ -247,6 +256,12 @@ void unknownElement(const XMLElement* child, const XMLElement* parent, std::stri
                     Diagnostics& diag) {
   diag.error(file, child->GetLineNum(),
              "unknown element <" + std::string(child->Name()) + "> in <" + parent->Name() + ">");
+}
+
+/// Reports every child of an element that takes none.
+void noChildren(const XMLElement* e, std::string_view file, Diagnostics& diag) {
+  for (const XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement())
+    unknownElement(c, e, file, diag);
 }
 
 /// Parses the document; reports a syntax error with its line.
@@ -293,11 +308,16 @@ std::optional<GeomSpec> readGeom(const XMLElement* e, std::string_view file, Dia
   const int errorsBefore = diag.errorCount();
   GeomSpec g;
   g.line = r.line();
-  g.type = static_cast<GeomType>(r.choice("type", {"box", "cylinder", "sphere", "capsule"}, 0, true));
-  if (g.type == GeomType::Box) {
+  const int type = r.choice("type", {"box", "cylinder", "sphere", "capsule"}, -1, true);
+  g.type = static_cast<GeomType>(std::max(type, 0));
+  if (type < 0) {
+    // Type missing or unknown (reported): which shape attributes it needs is
+    // unknown too, so do not report them as missing or unknown.
+    for (const char* attr : {"size", "radius", "length"}) (void)r.text(attr, false);
+  } else if (g.type == GeomType::Box) {
     if (!r.has("size")) r.error("missing required attribute 'size' (box)");
     g.size = r.vec3("size", {});
-    if (r.has("size") && !(g.size.x > 0 && g.size.y > 0 && g.size.z > 0))
+    if (r.has("size") && r.lastValid() && !(g.size.x > 0 && g.size.y > 0 && g.size.z > 0))
       r.error("size: every edge must be > 0");
   } else {
     g.radius = r.number("radius", 0, true);
@@ -312,6 +332,7 @@ std::optional<GeomSpec> readGeom(const XMLElement* e, std::string_view file, Dia
   if (std::optional<std::string> m = r.text("material", false)) g.material = *m;
   g.color = r.color();
   r.finish();
+  noChildren(e, file, diag);
   if (diag.errorCount() != errorsBefore) return std::nullopt;
   return g;
 }
@@ -389,9 +410,10 @@ void readJoint(const XMLElement* e, std::vector<PendingJoint>& joints, NameSet& 
     j.limited = true;
     j.lower = r.number("lower", 0, false, scale);
     const double lowerFile = j.lower / scale;
+    const bool lowerValid = r.lastValid();
     j.upper = r.number("upper", 0, false, scale);
     const double upperFile = j.upper / scale;
-    if (lowerFile > upperFile)
+    if (lowerValid && r.lastValid() && lowerFile > upperFile)
       r.error("lower limit " + formatNumber(lowerFile) + unit + " is above upper limit " +
               formatNumber(upperFile) + unit);
   } else {
@@ -401,8 +423,7 @@ void readJoint(const XMLElement* e, std::vector<PendingJoint>& joints, NameSet& 
   j.damping = r.number("damping", 0);
   r.nonNegative("damping");
   r.finish();
-  for (const XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement())
-    unknownElement(c, e, file, diag);
+  noChildren(e, file, diag);
   joints.push_back(std::move(p));
 }
 
@@ -446,8 +467,7 @@ void readActuator(const XMLElement* e, std::vector<PendingActuator>& out, NameSe
   if (a.mode == JointMode::Position && !(a.hasPid && a.kp > 0))
     r.error("mode position needs PID gains (kp > 0)");
   r.finish();
-  for (const XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement())
-    unknownElement(c, e, file, diag);
+  noChildren(e, file, diag);
   out.push_back(std::move(p));
 }
 
@@ -483,7 +503,7 @@ void readSensor(const XMLElement* e, std::vector<PendingSensor>& out, NameSet& n
   const bool laser = s.type == SensorType::Laser;
   for (const char* attr : {"fov", "beams", "min_range", "max_range", "exclude_self"})
     if (!laser && r.has(attr)) r.error(std::string(attr) + ": only laser sensors have it");
-  s.fov = r.number("fov", 180, false, degToRad(1));
+  s.fov = r.number("fov", degToRad(180), false, degToRad(1));  // fallback is not scaled
   if (r.has("fov")) r.within("fov", 1e-9, 360);
   s.beams = r.integer("beams", 181, 1, 100000);
   s.minRange = r.number("min_range", 0.05);
@@ -495,8 +515,7 @@ void readSensor(const XMLElement* e, std::vector<PendingSensor>& out, NameSet& n
             formatNumber(s.maxRange) + " m");
   s.excludeSelf = r.boolean("exclude_self", true);
   r.finish();
-  for (const XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement())
-    unknownElement(c, e, file, diag);
+  noChildren(e, file, diag);
   out.push_back(std::move(p));
 }
 
@@ -529,6 +548,7 @@ void readDrive(const XMLElement* e, RobotModel& robot, std::string_view file, Di
     const std::string joint = w.text("joint", true).value_or("");
     const int pos = w.choice("position", {"front_left", "front_right", "rear_left", "rear_right"}, -1, true);
     w.finish();
+    noChildren(c, file, diag);
     const int index = robot.findJoint(joint);
     if (!joint.empty() && index < 0) w.error("unknown joint '" + joint + "'");
     else if (index >= 0 && robot.joints[index].type != JointType::Hinge)
@@ -699,6 +719,7 @@ void readContact(const XMLElement* e, WorldModel& world, std::string_view file, 
   c.rollingResistance = r.number("rolling_resistance", 0);
   r.nonNegative("rolling_resistance");
   r.finish();
+  noChildren(e, file, diag);
   if (isDefault) {
     if (haveDefault) r.error("a second default contact");
     haveDefault = true;
@@ -731,8 +752,12 @@ void readTerrain(const XMLElement* e, WorldModel& world, std::string_view file, 
   if (kind == 0) {
     t.kind = TerrainSpec::Kind::Plane;
     for (const char* attr : {"file", "format", "width", "depth", "min_height", "max_height", "resolution"})
-      if (r.has(attr)) r.error(std::string(attr) + ": not used by a plane");
+      if (r.has(attr)) {
+        r.error(std::string(attr) + ": not used by a plane");
+        (void)r.text(attr, false);  // reported; not unknown as well
+      }
     r.finish();
+    noChildren(e, file, diag);
     return;
   }
   t.kind = TerrainSpec::Kind::Heightfield;
@@ -741,6 +766,7 @@ void readTerrain(const XMLElement* e, WorldModel& world, std::string_view file, 
   if (kind == 2) {
     src.format = TerrainFormat::Profile;
     if (r.has("format")) r.error("format: a profile is always distance,height CSV");
+    (void)r.text("format", false);  // reported; not unknown as well
     if (r.has("width")) r.error("width: a profile's length comes from its distances");
     if (!r.has("depth")) r.error("missing required attribute 'depth' (lateral width of the profile)");
   } else {
@@ -757,6 +783,7 @@ void readTerrain(const XMLElement* e, WorldModel& world, std::string_view file, 
   src.resolution = r.number("resolution", 0.05);
   r.positive("resolution");
   r.finish();
+  noChildren(e, file, diag);
   if (!f) return;
   t.file = resolvePath(baseDir, *f);
   src.path = t.file;
@@ -819,10 +846,12 @@ std::optional<WorldModel> parseWorld(std::string_view xml, std::string_view file
       haveGravity = true;
       world.gravity = r.vec3("xyz", world.gravity);
       r.finish();
+      noChildren(e, file, diag);
     } else if (tag == "material") {
       ElementReader r(e, file, diag);
       const std::string name = r.name();
       r.finish();
+      noChildren(e, file, diag);
       materials.add(name, r.line());
       world.materials.push_back(name);
     } else if (tag == "contact") {
@@ -846,6 +875,7 @@ std::optional<WorldModel> parseWorld(std::string_view xml, std::string_view file
       const std::optional<std::string> f = r.text("file", true);
       inst.pose = r.pose();
       r.finish();
+      noChildren(e, file, diag);
       if (f) {
         const std::string path = resolvePath(baseDir, *f);
         if (!fs::exists(path)) {
