@@ -68,7 +68,7 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
     diag.error(options.worldFile, 0, "the world has no <robot> to run");
   if (!options.commandsFile.empty() && model && !model->robots.empty()) {
     const RobotModel& robot = model->robots[0].model;
-    if (auto seq = loadCommandSequence(options.commandsFile, diag)) {
+    if (auto seq = loadCommandSequence(options.commandsFile, diag, &robot)) {
       if (checkCommands(*seq, robot, options.commandsFile, diag)) commands = std::move(*seq);
     }
   }

@@ -81,7 +81,7 @@ int check(const std::vector<std::string>& files) {
     }
   }
   for (const std::string& f : sequences) {
-    auto seq = sp::loadCommandSequence(f, diag);
+    auto seq = sp::loadCommandSequence(f, diag, robot ? &*robot : nullptr);
     if (seq && robot) sp::checkCommands(*seq, *robot, f, diag);
   }
   std::cerr << diag.format();

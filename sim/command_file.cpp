@@ -9,13 +9,11 @@
 #include "sim/math.h"
 #include "sim/robot_model.h"
 
-// Units in sequence files: angles in degrees (target, velocity in deg/s,
-// drive articulation), wheel speeds in rad/s (as customary for wheels), drive
-// speed in m/s, torques in N m. Limitation of this version: parseCommand does
-// not know joint types, so `target` and `velocity` values are always read as
-// degrees and converted to radians; sequence files therefore command hinge
-// joints only, and checkCommands() reports `target`/`velocity` on a slider as
-// an error. `torque` and `mode` are unit-free of this problem and work on both.
+// Units in sequence files: `target` and `velocity` take degrees and deg/s on
+// hinge joints and metres and m/s on slider joints, so parsing needs the
+// robot to know which is which (without one, every joint reads as a hinge);
+// drive articulation in degrees, drive speed in m/s, wheel speeds in rad/s
+// (as customary for wheels), torques in N m (forces in N on sliders).
 
 namespace sp {
 namespace {
@@ -69,6 +67,16 @@ struct ArgReader {
   std::string_view command;
   std::vector<std::string_view> args;
   std::string error;
+  const RobotModel* robot = nullptr;
+
+  /// Argument `v` as a value of the joint named by argument `j`: degrees
+  /// converted to radians, unless the robot says the joint is a slider.
+  double jointValue(size_t j, size_t v) {
+    const double x = number(v);
+    const int joint = robot ? robot->findJoint(args[j]) : -1;
+    if (joint >= 0 && robot->joints[joint].type == JointType::Slider) return x;
+    return degToRad(x);
+  }
 
   double number(size_t i) {
     const std::optional<double> v = parseReal(args[i]);
@@ -101,10 +109,10 @@ const Syntax kSyntax[] = {
      [](ArgReader& a) -> Command { return DriveCmd{a.number(0), degToRad(a.number(1))}; }},
     {"wheels", 4, "front-left, front-right, rear-left, rear-right rad/s",
      [](ArgReader& a) -> Command { return WheelsCmd{{a.number(0), a.number(1), a.number(2), a.number(3)}}; }},
-    {"target", 2, "joint, angle deg",
-     [](ArgReader& a) -> Command { return JointTargetCmd{a.word(0), degToRad(a.number(1))}; }},
-    {"velocity", 2, "joint, velocity deg/s",
-     [](ArgReader& a) -> Command { return JointVelocityCmd{a.word(0), degToRad(a.number(1))}; }},
+    {"target", 2, "joint, angle deg or position m",
+     [](ArgReader& a) -> Command { return JointTargetCmd{a.word(0), a.jointValue(0, 1)}; }},
+    {"velocity", 2, "joint, velocity deg/s or m/s",
+     [](ArgReader& a) -> Command { return JointVelocityCmd{a.word(0), a.jointValue(0, 1)}; }},
     {"torque", 2, "joint, torque N m",
      [](ArgReader& a) -> Command { return JointTorqueCmd{a.word(0), a.number(1)}; }},
     {"mode", 2, "joint, velocity|position|torque|free",
@@ -231,21 +239,9 @@ struct Checker {
   }
 };
 
-/// Sequence files read target/velocity values as degrees (see the top).
-std::string checkFileUnits(const Command& command, const RobotModel& robot) {
-  const std::string* joint = nullptr;
-  if (const auto* t = std::get_if<JointTargetCmd>(&command)) joint = &t->joint;
-  if (const auto* v = std::get_if<JointVelocityCmd>(&command)) joint = &v->joint;
-  if (!joint) return {};
-  const int j = robot.findJoint(*joint);
-  if (j >= 0 && robot.joints[j].type == JointType::Slider)
-    return "joint '" + *joint + "' is a slider; sequence files command hinge joints only (values are degrees)";
-  return {};
-}
-
 }  // namespace
 
-std::optional<Command> parseCommand(std::string_view text, std::string& error) {
+std::optional<Command> parseCommand(std::string_view text, std::string& error, const RobotModel* robot) {
   const std::vector<std::string_view> words = splitWords(text);
   if (words.empty()) {
     error = "empty command";
@@ -253,7 +249,7 @@ std::optional<Command> parseCommand(std::string_view text, std::string& error) {
   }
   for (const Syntax& s : kSyntax) {
     if (words[0] != s.name) continue;
-    ArgReader reader{s.name, {words.begin() + 1, words.end()}, {}};
+    ArgReader reader{s.name, {words.begin() + 1, words.end()}, {}, robot};
     if (reader.args.size() != s.arity) {
       const std::string got = ", got " + std::to_string(reader.args.size());
       error = std::string(s.name) +
@@ -274,7 +270,7 @@ std::optional<Command> parseCommand(std::string_view text, std::string& error) {
 }
 
 std::optional<std::vector<TimedCommand>> parseCommandSequence(std::string_view text, std::string_view file,
-                                                              Diagnostics& diag) {
+                                                              Diagnostics& diag, const RobotModel* robot) {
   std::vector<TimedCommand> commands;
   bool ok = true;
   std::optional<double> previousTime;
@@ -315,7 +311,7 @@ std::optional<std::vector<TimedCommand>> parseCommandSequence(std::string_view t
       continue;
     }
     std::string error;
-    std::optional<Command> command = parseCommand(rest, error);
+    std::optional<Command> command = parseCommand(rest, error, robot);
     if (!command) {
       diag.error(file, line, error);
       ok = false;
@@ -327,7 +323,8 @@ std::optional<std::vector<TimedCommand>> parseCommandSequence(std::string_view t
   return commands;
 }
 
-std::optional<std::vector<TimedCommand>> loadCommandSequence(const std::string& path, Diagnostics& diag) {
+std::optional<std::vector<TimedCommand>> loadCommandSequence(const std::string& path, Diagnostics& diag,
+                                                             const RobotModel* robot) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     diag.error(path, 0, "cannot open command sequence file");
@@ -340,15 +337,14 @@ std::optional<std::vector<TimedCommand>> loadCommandSequence(const std::string& 
     diag.error(path, 0, "cannot read command sequence file");
     return std::nullopt;
   }
-  return parseCommandSequence(text, path, diag);
+  return parseCommandSequence(text, path, diag, robot);
 }
 
 bool checkCommands(const std::vector<TimedCommand>& commands, const RobotModel& robot, std::string_view file,
                    Diagnostics& diag) {
   bool ok = true;
   for (const TimedCommand& c : commands) {
-    std::string error = checkFileUnits(c.command, robot);
-    if (error.empty()) error = checkCommand(c.command, robot);
+    std::string error = checkCommand(c.command, robot);
     if (!error.empty()) {
       diag.error(file, c.line, std::move(error));
       ok = false;

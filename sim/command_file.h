@@ -14,22 +14,28 @@ namespace sp {
 
 struct RobotModel;
 
-/// Parses one command (without its time) in file syntax, angles in degrees.
-/// On error returns nullopt and sets `error` to a message without location.
-std::optional<Command> parseCommand(std::string_view text, std::string& error);
+/// Parses one command (without its time) in file syntax. `target` and
+/// `velocity` values are degrees (deg/s) for hinge joints and metres (m/s)
+/// for slider joints of `robot`; without a robot every joint is taken for a
+/// hinge. On error returns nullopt and sets `error` to a message without
+/// location.
+std::optional<Command> parseCommand(std::string_view text, std::string& error,
+                                    const RobotModel* robot = nullptr);
 
 /// Parses a whole sequence held in `text`; `file` names it in diagnostics.
 /// All problems are reported; returns nullopt if there is any error.
 /// Times must be >= 0 and non-decreasing.
 std::optional<std::vector<TimedCommand>> parseCommandSequence(std::string_view text,
                                                               std::string_view file,
-                                                              Diagnostics& diag);
+                                                              Diagnostics& diag,
+                                                              const RobotModel* robot = nullptr);
 
 /// Reads and parses a sequence file.
 std::optional<std::vector<TimedCommand>> loadCommandSequence(const std::string& path,
-                                                             Diagnostics& diag);
+                                                             Diagnostics& diag,
+                                                             const RobotModel* robot = nullptr);
 
-/// Checks commands against a robot: joints exist and are actuated, the
+/// Checks commands (parsed with the same robot) against a robot: joints exist and are actuated, the
 /// actuator supports the mode, targets lie within joint limits, wheel and
 /// drive commands need the robot's <drive>. Returns false on any error;
 /// diagnostics carry `file` and each command's line.

@@ -356,6 +356,7 @@ void readLink(const XMLElement* e, RobotModel& robot, NameSet& names, std::strin
   link.line = r.line();
   link.name = r.name();
   names.add(link.name, link.line);
+  if (link.name == "world") r.error("name: 'world' is reserved for the ground in joint parents");
   link.mass = r.number("mass", 0, true);
   r.positive("mass");
   link.pose = r.pose();
@@ -490,10 +491,12 @@ void readSensor(const XMLElement* e, std::vector<PendingSensor>& out, NameSet& n
   const bool onJoint = s.type == SensorType::Encoder || s.type == SensorType::JointForce;
   if (onJoint) {
     p.joint = r.text("joint", true).value_or("");
-    if (r.has("link")) r.error(std::string("link: a ") + toString(s.type) + " sensor is on a joint");
+    if (r.has("link")) r.error(std::string("link: ") + toString(s.type) + " sensors are on a joint");
+    (void)r.text("link", false);  // reported above, not as unknown
   } else {
     p.link = r.text("link", true).value_or("");
-    if (r.has("joint")) r.error(std::string("joint: a ") + toString(s.type) + " sensor is on a link");
+    if (r.has("joint")) r.error(std::string("joint: ") + toString(s.type) + " sensors are on a link");
+    (void)r.text("joint", false);
   }
   s.rate = r.number("rate", 0);
   r.nonNegative("rate");
@@ -615,8 +618,8 @@ std::optional<RobotModel> parseRobot(std::string_view xml, std::string_view file
     }
     robot.joints.push_back(j);
   }
-  // Every link hangs off the tree: exactly one root (a link no joint moves),
-  // and following parents never loops.
+  // Following parents never loops. Several roots are allowed: a link that is
+  // no joint's child is a free body (docs/formats.md).
   for (size_t i = 0; i < robot.links.size(); ++i) {
     int at = static_cast<int>(i);
     for (size_t hops = 0; at >= 0 && parentOf[at] >= 0 && hops <= robot.links.size(); ++hops)

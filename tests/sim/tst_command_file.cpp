@@ -180,9 +180,9 @@ void TestCommandFile::parseCommandErrors_data() {
                                  << "wheels: expected 4 arguments (front-left, front-right, rear-left, "
                                     "rear-right rad/s), got 3";
   QTest::newRow("wheels nan") << "wheels 1 nan 3 4" << "wheels: bad number 'nan'";
-  QTest::newRow("target no value") << "target knee_fl" << "target: expected 2 arguments (joint, angle deg), got 1";
+  QTest::newRow("target no value") << "target knee_fl" << "target: expected 2 arguments (joint, angle deg or position m), got 1";
   QTest::newRow("target degree suffix") << "target knee_fl 10deg" << "target: bad number '10deg'";
-  QTest::newRow("velocity no args") << "velocity" << "velocity: expected 2 arguments (joint, velocity deg/s), got 0";
+  QTest::newRow("velocity no args") << "velocity" << "velocity: expected 2 arguments (joint, velocity deg/s or m/s), got 0";
   QTest::newRow("velocity inf") << "velocity knee_fl inf" << "velocity: bad number 'inf'";
   QTest::newRow("torque decimal comma") << "torque knee_fl 1,5" << "torque: bad number '1,5'";
   QTest::newRow("torque 3 args") << "torque knee_fl 1 2" << "torque: expected 2 arguments (joint, torque N m), got 3";
@@ -368,12 +368,12 @@ void TestCommandFile::checkCommands_data() {
   QTest::newRow("torque too strong") << "torque knee_fl 250"
                                      << "torque 250 N m exceeds joint 'knee_fl' max_torque 200 N m";
   QTest::newRow("force too strong") << "torque lift -1500" << "torque -1500 N exceeds joint 'lift' max_torque 1000 N";
-  QTest::newRow("slider target") << "target lift 10"
-                                 << "joint 'lift' is a slider; sequence files command hinge joints only "
-                                    "(values are degrees)";
-  QTest::newRow("slider velocity") << "velocity lift 0.1"
-                                   << "joint 'lift' is a slider; sequence files command hinge joints only "
-                                      "(values are degrees)";
+  QTest::newRow("slider target in metres") << "target lift 0.25" << "";
+  QTest::newRow("slider target beyond limit") << "target lift 10"
+                                              << "target 10 m is outside joint 'lift' limits [0, 0.3] m";
+  QTest::newRow("slider velocity in m/s") << "velocity lift 0.1" << "";
+  QTest::newRow("slider velocity too fast") << "velocity lift 0.5"
+                                            << "velocity 0.5 m/s exceeds joint 'lift' max_velocity 0.2 m/s";
   // Drive.
   QTest::newRow("wheel too fast") << "wheels 10 10 10 12"
                                   << "rear-right wheel speed 12 rad/s exceeds joint 'wheel_rr' max_velocity "
@@ -395,10 +395,11 @@ void TestCommandFile::checkCommands() {
   QFETCH(QString, command);
   QFETCH(QString, message);
   std::string error;
-  const std::optional<Command> parsed = sp::parseCommand(command.toStdString(), error);
+  const RobotModel robot = testRobot();
+  const std::optional<Command> parsed = sp::parseCommand(command.toStdString(), error, &robot);
   QVERIFY2(parsed, error.c_str());
   Diagnostics diag;
-  const bool ok = sp::checkCommands({TimedCommand{2.0, *parsed, 7}}, testRobot(), "moves.seq", diag);
+  const bool ok = sp::checkCommands({TimedCommand{2.0, *parsed, 7}}, robot, "moves.seq", diag);
   QCOMPARE(ok, message.isEmpty());
   QCOMPARE(q(diag.format()), message.isEmpty() ? QString() : "moves.seq:7: error: " + message + "\n");
 }

@@ -139,6 +139,14 @@ void TestModelLoader::testRobotErrors_data() {
   <link name="2nd" mass="1"><geom type="sphere" radius="0.1"/></link>
 </robot>)") << "r.xml:2: error: link '2nd': name: '2nd' is not a valid name "
                "(letters, digits, _ . -; not starting with a digit)\n";
+  QTest::newRow("link named world") << QByteArray(R"(<robot name="r">
+  <link name="world" mass="1"><geom type="sphere" radius="0.1"/></link>
+</robot>)") << "r.xml:2: error: link 'world': name: 'world' is reserved for the ground in joint parents\n";
+  QTest::newRow("encoder on a link") << QByteArray(R"(<robot name="r">
+  <link name="a" mass="1"><geom type="sphere" radius="0.1"/></link>
+  <joint name="j" type="hinge" parent="world" child="a"/>
+  <sensor name="s" type="encoder" joint="j" link="a"/>
+</robot>)") << "r.xml:4: error: sensor 's': link: encoder sensors are on a joint\n";
   QTest::newRow("bad version") << QByteArray(R"(<robot name="r" version="2">
   <link name="a" mass="1"><geom type="sphere" radius="0.1"/></link>
 </robot>)") << "r.xml:1: error: robot 'r': version must be in [1, 1], got 2\n";
