@@ -8,6 +8,7 @@
 
 #include "sim/math.h"
 #include "sim/robot_model.h"
+#include "sim/text.h"
 
 // Units in sequence files: `target` and `velocity` take degrees and deg/s on
 // hinge joints and metres and m/s on slider joints, so parsing needs the
@@ -18,47 +19,10 @@
 namespace sp {
 namespace {
 
-constexpr std::string_view kSpace = " \t\r\n\v\f";
-
-std::string_view trim(std::string_view text) {
-  const size_t first = text.find_first_not_of(kSpace);
-  if (first == std::string_view::npos) return {};
-  const size_t last = text.find_last_not_of(kSpace);
-  return text.substr(first, last - first + 1);
-}
-
-std::vector<std::string_view> splitWords(std::string_view text) {
-  std::vector<std::string_view> words;
-  size_t pos = 0;
-  while ((pos = text.find_first_not_of(kSpace, pos)) != std::string_view::npos) {
-    const size_t end = std::min(text.find_first_of(kSpace, pos), text.size());
-    words.push_back(text.substr(pos, end - pos));
-    pos = end;
-  }
-  return words;
-}
-
-/// A finite decimal number with nothing after it, independent of the locale;
-/// as in robot and world files, no '+', no inf/nan, no units.
-std::optional<double> parseReal(std::string_view text) {
-  double value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
-    return std::nullopt;
-  return value;
-}
-
 /// A number for messages: 6 significant digits, as the model loader prints.
 std::string show(double value) {
   char buf[32];
   const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value, std::chars_format::general, 6);
-  return ec == std::errc() ? std::string(buf, end) : std::string("?");
-}
-
-/// The shortest text that reads back to exactly `value`.
-std::string shortest(double value) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value);
   return ec == std::errc() ? std::string(buf, end) : std::string("?");
 }
 
@@ -284,7 +248,7 @@ std::optional<std::vector<TimedCommand>> parseCommandSequence(std::string_view t
     content = trim(content.substr(0, content.find('#')));
     if (content.empty()) continue;
 
-    const size_t split = std::min(content.find_first_of(kSpace), content.size());
+    const size_t split = std::min(content.find_first_of(" \t\r\v\f"), content.size());
     const std::string_view timeText = content.substr(0, split);
     const std::string_view rest = trim(content.substr(split));
     const std::optional<double> time = parseReal(timeText);
@@ -299,8 +263,8 @@ std::optional<std::vector<TimedCommand>> parseCommandSequence(std::string_view t
       continue;
     }
     if (previousTime && *time < *previousTime) {
-      diag.error(file, line, "time " + shortest(*time) + " is before the previous command's time " +
-                                 shortest(*previousTime));
+      diag.error(file, line, "time " + shortestText(*time) + " is before the previous command's time " +
+                                 shortestText(*previousTime));
       ok = false;
       continue;
     }

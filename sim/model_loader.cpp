@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "sim/terrain_loader.h"
+#include "sim/text.h"
 
 namespace sp {
 namespace {
@@ -21,15 +22,7 @@ using tinyxml2::XMLAttribute;
 using tinyxml2::XMLDocument;
 using tinyxml2::XMLElement;
 
-std::optional<double> parseDouble(std::string_view text) {
-  while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
-  while (!text.empty() && (text.back() == ' ' || text.back() == '\t')) text.remove_suffix(1);
-  double value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
-    return std::nullopt;
-  return value;
-}
+std::optional<double> parseDouble(std::string_view text) { return parseReal(trim(text)); }
 
 std::string formatNumber(double v) {
   std::ostringstream out;

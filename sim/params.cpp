@@ -9,34 +9,10 @@
 #include <optional>
 #include <system_error>
 
+#include "sim/text.h"
+
 namespace sp {
 namespace {
-
-std::string_view trim(std::string_view text) {
-  constexpr std::string_view kSpace = " \t\r\n\v\f";
-  const size_t first = text.find_first_not_of(kSpace);
-  if (first == std::string_view::npos) return {};
-  const size_t last = text.find_last_not_of(kSpace);
-  return text.substr(first, last - first + 1);
-}
-
-// Shortest text that reads back to exactly `value` (so defaults and
-// paramValue() round-trip through setParam() bit for bit).
-std::string formatNumber(double value) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value);
-  return ec == std::errc() ? std::string(buf, end) : std::string("?");
-}
-
-/// A finite decimal number with nothing after it, independent of the locale;
-/// as in robot and world files, no '+', no inf/nan, no units.
-std::optional<double> parseReal(std::string_view text) {
-  double value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
-    return std::nullopt;
-  return value;
-}
 
 /// Result of reading an integer: the value, or why not.
 template <typename Int>
@@ -74,9 +50,9 @@ Range closedOpen(double lo, double hi) { return {lo, hi, false, true}; }
 /// The violated bound as "must be > 0", or "" when `value` is in range.
 std::string rangeError(const Range& range, double value) {
   if (range.lo && (range.loOpen ? !(value > *range.lo) : !(value >= *range.lo)))
-    return std::string("must be ") + (range.loOpen ? "> " : ">= ") + formatNumber(*range.lo);
+    return std::string("must be ") + (range.loOpen ? "> " : ">= ") + shortestText(*range.lo);
   if (range.hi && (range.hiOpen ? !(value < *range.hi) : !(value <= *range.hi)))
-    return std::string("must be ") + (range.hiOpen ? "< " : "<= ") + formatNumber(*range.hi);
+    return std::string("must be ") + (range.hiOpen ? "< " : "<= ") + shortestText(*range.hi);
   return {};
 }
 
@@ -105,7 +81,7 @@ Accessors real(double SimParams::*field, Range range) {
             p.*field = *v;
             return {};
           },
-          [field](const SimParams& p) { return formatNumber(p.*field); }};
+          [field](const SimParams& p) { return shortestText(p.*field); }};
 }
 
 Accessors integer(int SimParams::*field, int lo, int hi) {
@@ -157,7 +133,7 @@ Accessors realTimeFactor() {
             p.realTimeFactor = *v;
             return {};
           },
-          [](const SimParams& p) { return p.realTimeFactor > 0 ? formatNumber(p.realTimeFactor) : "max"; }};
+          [](const SimParams& p) { return p.realTimeFactor > 0 ? shortestText(p.realTimeFactor) : "max"; }};
 }
 
 Entry entry(const char* key, const char* description, Accessors a) {

@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "sim/text.h"
+
 namespace sp {
 namespace {
 
@@ -64,24 +66,6 @@ std::vector<Line> splitLines(std::string_view content) {
 
 bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; }
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && isSpace(s.front())) s.remove_prefix(1);
-  while (!s.empty() && isSpace(s.back())) s.remove_suffix(1);
-  return s;
-}
-
-std::vector<std::string_view> splitWhitespace(std::string_view s) {
-  std::vector<std::string_view> tokens;
-  size_t i = 0;
-  while (i < s.size()) {
-    while (i < s.size() && isSpace(s[i])) ++i;
-    const size_t start = i;
-    while (i < s.size() && !isSpace(s[i])) ++i;
-    if (i > start) tokens.push_back(s.substr(start, i - start));
-  }
-  return tokens;
-}
-
 // Splits on commas and trims spaces around each field; "" gives one empty field.
 std::vector<std::string_view> splitCommas(std::string_view s) {
   std::vector<std::string_view> fields;
@@ -111,13 +95,6 @@ std::optional<long> parseInteger(std::string_view s) {
   const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
   if (ec != std::errc() || ptr != s.data() + s.size()) return std::nullopt;
   return value;
-}
-
-// Shortest text that reads back as the same double.
-std::string formatNumber(double value) {
-  std::array<char, 32> buffer{};
-  const auto [ptr, ec] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return ec == std::errc() ? std::string(buffer.data(), ptr) : std::string("?");
 }
 
 std::string quote(std::string_view s) { return "'" + std::string(s) + "'"; }
@@ -186,7 +163,7 @@ std::optional<HeightGrid> loadAsc(const TerrainSource& source, std::string_view 
   size_t dataStart = 0;
   for (; dataStart < lines.size(); ++dataStart) {
     const Line& line = lines[dataStart];
-    const std::vector<std::string_view> tokens = splitWhitespace(line.text);
+    const std::vector<std::string_view> tokens = splitWords(line.text);
     if (tokens.empty()) continue;
     const char first = tokens[0][0];
     if (!((first >= 'a' && first <= 'z') || (first >= 'A' && first <= 'Z'))) break;
@@ -278,7 +255,7 @@ std::optional<HeightGrid> loadAsc(const TerrainSource& source, std::string_view 
   std::vector<DataLine> dataLines;
   long total = 0;
   for (size_t k = dataStart; k < lines.size(); ++k) {
-    const long count = static_cast<long>(splitWhitespace(lines[k].text).size());
+    const long count = static_cast<long>(splitWords(lines[k].text).size());
     if (count == 0) continue;
     dataLines.push_back({k, count});
     total += count;
@@ -310,7 +287,7 @@ std::optional<HeightGrid> loadAsc(const TerrainSource& source, std::string_view 
   long index = 0;  // running value index, for the wrapped layout
   for (size_t k = 0; k < dataLines.size() && !r.full(); ++k) {
     const Line& line = lines[dataLines[k].index];
-    const std::vector<std::string_view> tokens = splitWhitespace(line.text);
+    const std::vector<std::string_view> tokens = splitWords(line.text);
     for (size_t t = 0; t < tokens.size() && !r.full(); ++t, ++index) {
       const long row = rowPerLine ? static_cast<long>(k) + 1 : index / ncols + 1;
       const long column = rowPerLine ? static_cast<long>(t) + 1 : index % ncols + 1;
@@ -527,7 +504,7 @@ std::optional<HeightGrid> loadCsvGrid(const TerrainSource& source, std::string_v
 std::optional<HeightGrid> loadProfile(const TerrainSource& source, std::string_view content, Reporter& r) {
   if (!(source.depth > 0)) r.error(0, "depth (lateral width) must be given (> 0) for a profile terrain");
   if (!(source.resolution > 0))
-    r.error(0, "resolution must be > 0 for a profile terrain, got " + formatNumber(source.resolution));
+    r.error(0, "resolution must be > 0 for a profile terrain, got " + shortestText(source.resolution));
 
   std::vector<double> distance;
   std::vector<double> height;
@@ -574,8 +551,8 @@ std::optional<HeightGrid> loadProfile(const TerrainSource& source, std::string_v
   const auto samples = [&](double extent, std::string_view what) -> int {
     const double n = std::round(extent / source.resolution) + 1;
     if (n > kMaxSamples) {
-      r.error(0, "profile " + std::string(what) + " of " + formatNumber(extent) + " m at resolution " +
-                     formatNumber(source.resolution) + " m needs " + formatNumber(n) +
+      r.error(0, "profile " + std::string(what) + " of " + shortestText(extent) + " m at resolution " +
+                     shortestText(source.resolution) + " m needs " + shortestText(n) +
                      " samples; the limit is " + std::to_string(kMaxSamples));
       return 0;
     }
@@ -635,9 +612,9 @@ std::optional<HeightGrid> loadHeightGrid(const TerrainSource& source, Diagnostic
 
   // Extents from the world file: 0 means "from the terrain file".
   if (!std::isfinite(source.width) || source.width < 0)
-    r.error(0, "width must be >= 0 (0 = from the file), got " + formatNumber(source.width));
+    r.error(0, "width must be >= 0 (0 = from the file), got " + shortestText(source.width));
   if (!std::isfinite(source.depth) || source.depth < 0)
-    r.error(0, "depth must be >= 0 (0 = from the file), got " + formatNumber(source.depth));
+    r.error(0, "depth must be >= 0 (0 = from the file), got " + shortestText(source.depth));
 
   TerrainFormat format = source.format;
   if (format == TerrainFormat::Auto) {
