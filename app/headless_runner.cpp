@@ -1,6 +1,7 @@
 #include "app/headless_runner.h"
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <ostream>
@@ -136,10 +137,11 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
         if (!why.empty()) err << options.commandsFile << ":" << c.line << ": error: " << why << "\n";
         else ++report.commandsApplied;
       }
-      world->step();
+      if (!world->step()) break;
       if (csv && world->stepCount() % csvEvery == 0) csv->sample(*world);
     }
     pacer.stepped(due);
+    if (!world->health().healthy()) break;
     const double now = clock();
     if (pacer.paced()) report.maxLag = std::max(report.maxLag, -pacer.lead(now));
     if (options.progressInterval > 0 && now >= nextProgress) {
@@ -159,17 +161,24 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
   report.resyncs = pacer.resyncCount();
   report.slipped = pacer.slippedTime();
   report.steps = world->stepCount();
+  report.stateHash = world->stateHash();
+  report.health = world->health();
 
   const Pose base = world->linkPose(0, 0);
-  out << std::setprecision(3) << (report.interrupted ? "interrupted" : "done") << ": " << report.simTime
+  if (!report.health.healthy()) err << "error: the twin diverged: " << report.health.message() << "\n";
+  out << std::setprecision(3)
+      << (report.interrupted ? "interrupted" : report.health.healthy() ? "done" : "stopped") << ": "
+      << report.simTime
       << " s simulated in " << report.wallTime << " s wall, " << std::setprecision(2) << report.achievedFactor
       << "x real time";
   if (pacer.paced())
     out << " (requested " << report.requestedFactor << "x; sim time - wall x factor at the end "
         << std::setprecision(3) << report.finalError * 1000 << " ms, worst lag " << report.maxLag * 1000
         << " ms, " << report.resyncs << " resyncs)";
+  char hash[32];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(report.stateHash));
   out << "\n  " << report.commandsApplied << " commands applied; base ended at (" << base.p.x << ", "
-      << base.p.y << ", " << base.p.z << ") m\n";
+      << base.p.y << ", " << base.p.z << ") m; state hash " << hash << "\n";
   if (pacer.paced() && report.resyncs > 0)
     out << "warning: this machine cannot keep up with " << report.requestedFactor << "x real time: achieved "
         << std::setprecision(2) << report.achievedFactor << "x, " << std::setprecision(3) << report.slipped

@@ -46,6 +46,8 @@ struct RunReport {
   int64_t steps = 0;
   int commandsApplied = 0;
   bool interrupted = false;
+  uint64_t stateHash = 0;    ///< World::stateHash() at the end
+  HealthReport health;       ///< why the run stopped early, if it diverged
 };
 
 /// Loads files and runs. Writes the narrative to `out` and diagnostics to

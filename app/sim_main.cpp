@@ -32,6 +32,8 @@ constexpr const char* kUsage = R"(usage:
       --rtf X|max       real-time factor (default: realtime.factor)
       --csv FILE        write link poses and joint states (rate.csv Hz)
       --quiet           no progress lines
+      Exits 0 when the run completed, 1 on bad input, 3 if the twin diverged
+      (the report names what, where and when).
   simpartner-sim params
       Prints every parameter key with its default and meaning.
 )";
@@ -146,7 +148,8 @@ int run(const std::vector<std::string>& args) {
   std::signal(SIGINT, [](int) { gStop = true; });
   std::signal(SIGTERM, [](int) { gStop = true; });
   const auto report = sp::runHeadless(o, std::cout, std::cerr, monotonicSeconds, sleepUntilSeconds, &gStop);
-  return report ? 0 : 1;
+  if (!report) return 1;
+  return report->health.healthy() ? 0 : 3;
 }
 
 }  // namespace

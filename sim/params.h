@@ -37,8 +37,10 @@ struct SimParams {
   // Health limits (checked every step)
   double maxLinearSpeed = 50;     ///< [m/s]
   double maxAngularSpeed = 200;   ///< [rad/s]
+  double maxLinearAcceleration = 5000;     ///< [m/s^2]
+  double maxAngularAcceleration = 100000;  ///< [rad/s^2]
   double maxJointError = 0.05;    ///< joint pulled apart [m]
-  double maxPenetration = 0.05;   ///< body below the ground [m]
+  double maxPenetration = 0.05;   ///< contact depth, or a body below the ground [m]
 };
 
 /// Sets one key from its text value. `where`/`line` name the origin for

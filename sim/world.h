@@ -19,8 +19,82 @@
 #include "sim/diagnostics.h"
 #include "sim/params.h"
 #include "sim/robot_model.h"
+#include "sim/sensors.h"
 
 namespace sp {
+
+/// The state of one rigid body, exactly as ODE holds it.
+struct BodyState {
+  std::array<double, 3> position{};
+  /// w, x, y, z. In a Snapshot: the quaternion that, given to ODE (which
+  /// normalises it), yields the body's orientation bit for bit; it may
+  /// differ from that orientation in the last bit.
+  std::array<double, 4> quaternion{};
+  std::array<double, 3> linearVelocity{};
+  std::array<double, 3> angularVelocity{};
+  friend bool operator==(const BodyState&, const BodyState&) = default;
+};
+
+/// Controller state of one robot: actuators and the drive mode.
+struct RobotControlState {
+  std::vector<ActuatorState> actuators;
+  bool driveActive = false;
+  double driveSpeed = 0;
+  double driveArticulation = 0;
+  friend bool operator==(const RobotControlState&, const RobotControlState&) = default;
+};
+
+/// Sampling state of one sensor.
+struct SensorState {
+  int64_t nextStep = 0;  ///< step count at which it samples next
+  Vec3 lastVelocity;     ///< imu: velocity at the last sample (for acceleration)
+  // wheel_force: sums over the steps since the last sample (the reading is
+  // their mean, as a force sensor's low-pass output would be).
+  Vec3 forceSum;         ///< contact force on the wheel [N s/step]
+  Vec3 normalSum;        ///< normal force times contact normal
+  int contactSum = 0;
+  int stepsSummed = 0;
+  SensorSample latest;
+};
+
+/// The whole dynamic state of a World at a step boundary: a plain value.
+/// Restoring it into the same World, or into a fresh one built from the same
+/// files and parameters, continues bit for bit as the original would.
+struct Snapshot {
+  uint64_t modelKey = 0;  ///< identifies the model layout it fits
+  int64_t step = 0;
+  double stepSize = 0;    ///< [s] of the world it was taken from
+  std::vector<BodyState> bodies;  ///< robot links in order, then dynamic objects
+  std::vector<RobotControlState> robots;
+  std::vector<std::vector<SensorState>> sensors;  ///< per robot, per sensor
+  unsigned long odeRandom = 0;        ///< the quick stepper's random state
+  std::array<uint64_t, 4> random{};   ///< the noise engine's state
+  std::shared_ptr<const HeightGrid> terrain;  ///< heightfield heights (shared, immutable)
+  std::vector<std::pair<int, Command>> pending;  ///< commands queued for the next step
+};
+
+/// What went wrong when the twin diverged, where and when.
+struct HealthReport {
+  enum class Kind { Healthy, NotFinite, Speed, AngularSpeed, Acceleration, AngularAcceleration,
+                    JointSeparation, Penetration, EngineFailure };
+  Kind kind = Kind::Healthy;
+  std::string where;  ///< "link 'wheel_fl'", "joint 'knee_fl'", ...; for EngineFailure ODE's message
+  int64_t step = 0;   ///< the step that produced it
+  double time = 0;    ///< [s], after that step
+  double value = 0;   ///< the offending value
+  double limit = 0;   ///< the limit it broke (its parameter names it in message())
+  bool healthy() const { return kind == Kind::Healthy; }
+  /// One line, e.g. "step 1204 (t = 1.204 s): body 'wheel_fl' angular speed
+  /// 512 rad/s exceeds health.max_angular_speed = 200".
+  std::string message() const;
+};
+
+/// What a World computes besides the physics (the benchmark turns both off
+/// to measure the bare ODE world).
+struct WorldOptions {
+  bool sensors = true;      ///< sample the robot's sensors
+  bool controllers = true;  ///< run actuators, drive kinematics and damping
+};
 
 /// The articulated-steering geometry of a robot with a <drive>, measured
 /// from its current pose (legs move, so it changes).
@@ -42,7 +116,7 @@ class World {
   /// Builds the ODE world. Returns nullptr with diagnostics if the model
   /// cannot be built (it was checked by the loader, so this is rare).
   static std::unique_ptr<World> create(const WorldModel& model, const SimParams& params,
-                                       Diagnostics& diag);
+                                       Diagnostics& diag, WorldOptions options = {});
   ~World();
   World(const World&) = delete;
   World& operator=(const World&) = delete;
@@ -53,8 +127,37 @@ class World {
   std::string submit(const Command& command, int robot = 0);
 
   /// Advances one fixed step: applies queued commands, runs the actuators,
-  /// collides, steps ODE.
-  void step();
+  /// collides, steps ODE, checks health, samples the sensors that are due.
+  /// Returns false, and does nothing, once the twin has diverged (health()).
+  bool step();
+
+  /// Healthy until a step breaks a limit; then stepping stops until a
+  /// snapshot is restored.
+  const HealthReport& health() const { return health_; }
+  /// Messages ODE printed during the last step (solver trouble, say).
+  const std::vector<std::string>& odeMessages() const { return odeMessages_; }
+
+  /// The dynamic state now. Cheap: bodies, controllers, sensor phases.
+  Snapshot snapshot() const;
+  /// Restores a snapshot of this world or of one built from the same files.
+  /// Returns "" on success, else why not (nothing is changed then): another
+  /// model, a non-finite state, a time off this world's step grid, or a world
+  /// whose physics engine failed (EngineFailure: build a new one).
+  std::string restore(const Snapshot& snapshot);
+  /// A 64-bit hash of the dynamic state (bodies bit for bit, controllers,
+  /// random states, step), to compare runs.
+  uint64_t stateHash() const;
+
+  /// Latest sample of each sensor of a robot (step -1 until first sampled).
+  const SensorSample& sensorSample(int robot, int sensor) const;
+  /// (robot, sensor) pairs sampled by the last step.
+  const std::vector<std::pair<int, int>>& sampledLastStep() const { return sampledLastStep_; }
+  /// Casts one ray through the world (terrain, objects, robots) [m];
+  /// +infinity if nothing is hit within maxRange, 0 from inside the ground.
+  /// With `excludeRobot` >= 0 the ray passes through that robot's link
+  /// `excludeLink`, or through all its links when excludeLink < 0.
+  double castRay(Vec3 origin, Vec3 direction, double maxRange, int excludeRobot = -1,
+                 int excludeLink = -1) const;
 
   double time() const { return static_cast<double>(steps_) * params_.step; }
   int64_t stepCount() const { return steps_; }
@@ -90,16 +193,25 @@ class World {
 
  private:
   struct Impl;
-  World(const WorldModel& model, const SimParams& params);
+  World(const WorldModel& model, const SimParams& params, WorldOptions options);
   bool build(Diagnostics& diag);
   void applyCommand(const Command& command, int robot);
   void runActuators();
   void collide();
+  void canonicalizeQuaternions();
+  void checkHealth();
+  void accumulateWheelForces();
+  void sampleSensors();
+  uint64_t modelKey() const;
 
   WorldModel model_;
   SimParams params_;
+  WorldOptions options_;
   int64_t steps_ = 0;
   int lastContactCount_ = 0;
+  HealthReport health_;
+  std::vector<std::string> odeMessages_;
+  std::vector<std::pair<int, int>> sampledLastStep_;
   std::unique_ptr<Impl> impl_;
 };
 

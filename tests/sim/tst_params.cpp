@@ -134,7 +134,7 @@ void TestParams::tableDefaultsAreSimParamsDefaults() {
   std::set<std::string> seen;
   const QRegularExpression keyPattern("^[a-z]+\\.[a-z_]+$");
   const std::vector<ParamInfo> table = paramTable();
-  QCOMPARE(table.size(), size_t(19));
+  QCOMPARE(table.size(), size_t(21));
   for (const ParamInfo& info : table) {
     QVERIFY2(seen.insert(info.key).second, info.key.c_str());
     QVERIFY2(keyPattern.match(q(info.key)).hasMatch(), info.key.c_str());
@@ -173,6 +173,8 @@ void TestParams::setParamAccepts_data() {
   QTest::newRow("port max") << "port.robot" << "65535" << "65535";
   QTest::newRow("linear speed") << "health.max_linear_speed" << "12.5" << "12.5";
   QTest::newRow("angular speed") << "health.max_angular_speed" << "1e3" << "1000";
+  QTest::newRow("acceleration") << "health.max_linear_acceleration" << "2500" << "2500";
+  QTest::newRow("angular acceleration") << "health.max_angular_acceleration" << "5e4" << "50000";
   QTest::newRow("joint error") << "health.max_joint_error" << "0.01" << "0.01";
   QTest::newRow("penetration") << "health.max_penetration" << "0.2" << "0.2";
 }
@@ -270,6 +272,8 @@ void TestParams::setParamRejects_data() {
                                 << "health.max_linear_speed: must be > 0, got 0";
   QTest::newRow("angular speed") << "health.max_angular_speed" << "-1"
                                  << "health.max_angular_speed: must be > 0, got -1";
+  QTest::newRow("acceleration") << "health.max_linear_acceleration" << "0"
+                                << "health.max_linear_acceleration: must be > 0, got 0";
   QTest::newRow("joint error") << "health.max_joint_error" << "0" << "health.max_joint_error: must be > 0, got 0";
   QTest::newRow("penetration") << "health.max_penetration" << "-0.5"
                                << "health.max_penetration: must be > 0, got -0.5";
