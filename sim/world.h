@@ -158,6 +158,11 @@ class World {
   /// `excludeLink`, or through all its links when excludeLink < 0.
   double castRay(Vec3 origin, Vec3 direction, double maxRange, int excludeRobot = -1,
                  int excludeLink = -1) const;
+  /// A fan of rays in the xy plane of `pose`, beam b at angleMin + b *
+  /// angleStep about its z axis; fills `ranges` (sized by the caller) as
+  /// castRay would, gathering the candidate geoms once for the whole fan.
+  void castFan(const Pose& pose, double angleMin, double angleStep, double maxRange, int excludeRobot,
+               int excludeLink, std::vector<double>& ranges) const;
 
   double time() const { return static_cast<double>(steps_) * params_.step; }
   int64_t stepCount() const { return steps_; }
@@ -202,6 +207,8 @@ class World {
   void checkHealth();
   void accumulateWheelForces();
   void sampleSensors();
+  void prepareRayTargets(int excludeRobot, int excludeLink) const;
+  double castPrepared(Vec3 origin, Vec3 direction, double maxRange) const;
   uint64_t modelKey() const;
 
   WorldModel model_;
