@@ -138,6 +138,24 @@ class TestDeterminism : public QObject {
     QCOMPARE(hb, expected);
   }
 
+  // The ghost: a world forked from the twin's snapshot runs ahead in another
+  // thread while the twin keeps stepping, and predicts the twin's state
+  // exactly (same commands, same step).
+  void forkedGhostPredictsExactly() {
+    const WorldModel model = loadModel();
+    auto twin = build(model);
+    run(*twin, 600);
+    const Snapshot fork = twin->snapshot();
+    uint64_t predicted = 0;
+    std::thread ghostThread([&] {
+      auto ghost = build(model);
+      if (ghost->restore(fork).empty()) predicted = run(*ghost, 1800).back();
+    });
+    const uint64_t actual = run(*twin, 1800).back();
+    ghostThread.join();
+    QCOMPARE(predicted, actual);
+  }
+
   // Two processes running the same files and commands print the same final
   // state hash, and it is the one this process computes.
   void acrossProcesses() {
