@@ -19,7 +19,7 @@ struct SimParams {
   double step = 0.001;            ///< fixed step [s]
   Solver solver = Solver::Quick;  ///< quick = dWorldQuickStep, exact = dWorldStep
   int iterations = 50;            ///< quick solver iterations
-  double erp = 0.2;               ///< error reduction parameter
+  double erp = 0.5;               ///< error reduction parameter
   double cfm = 1e-6;              ///< constraint force mixing
   double surfaceLayer = 0.001;    ///< contact surface layer [m]
   double maxCorrectingVel = 0.5;  ///< contact max correcting velocity [m/s]
