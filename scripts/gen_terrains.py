@@ -97,11 +97,14 @@ TRACK_LENGTH = 22.0  # m
 TRACK_STEP = 0.05  # m
 TRACK_FLAT = 1.0  # m of flat track at each end
 # (start [m], length [m], height [m]) cosine bumps on top of the undulation.
+# Each is pi * height / 0.2 long, so its steepest slope is 0.2 (11 deg): a
+# four-wheel-drive robot climbs that on packed snow (mu 0.3 > 0.2 plus the
+# undulation's 0.03).
 TRACK_BUMPS = [
-    (3.0, 1.0, 0.10),
-    (7.5, 1.2, 0.15),
-    (12.0, 1.3, 0.20),
-    (16.5, 1.5, 0.30),
+    (2.5, 1.6, 0.10),
+    (6.0, 2.4, 0.15),
+    (10.0, 3.2, 0.20),
+    (14.5, 4.8, 0.30),
 ]
 # (amplitude [m], period [m]): u(d) = sum amplitude * (1 - cos(2 pi (d - 1) / period)).
 # Both periods divide the 20 m between the flat ends, so the undulation

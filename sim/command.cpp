@@ -41,6 +41,15 @@ const char* toString(JointMode mode) {
   return "?";
 }
 
+const char* toString(Gait gait) {
+  switch (gait) {
+    case Gait::Off: return "off";
+    case Gait::Caterpillar: return "caterpillar";
+    case Gait::Rolking: return "rolking";
+  }
+  return "?";
+}
+
 // Joint values are written as for hinges (degrees, deg/s); sequence files do
 // not command sliders in this version (see command_file.h).
 std::string toText(const Command& command) {
@@ -66,6 +75,7 @@ std::string toText(const Command& command) {
       return "drive " + formatShortest(c.speed) + " " + formatDegrees(c.articulation);
     }
     std::string operator()(const StopCmd&) const { return "stop"; }
+    std::string operator()(const GaitCmd& c) const { return std::string("gait ") + toString(c.gait); }
   };
   return std::visit(Writer{}, command);
 }

@@ -55,13 +55,25 @@ struct DriveCmd {
   double articulation = 0;
   friend bool operator==(const DriveCmd&, const DriveCmd&) = default;
 };
+/// Leg gaits (sim/gait.h). Off returns the legs to the stance pose with the
+/// wheels braked.
+enum class Gait { Off, Caterpillar, Rolking };
+const char* toString(Gait gait);
+
+/// Starts a gait (or stops one with Gait::Off); a drive, wheels, stop or
+/// leg joint command ends it.
+struct GaitCmd {
+  Gait gait = Gait::Off;
+  friend bool operator==(const GaitCmd&, const GaitCmd&) = default;
+};
+
 /// Every actuated joint to zero velocity (wheels) or to hold its angle.
 struct StopCmd {
   friend bool operator==(const StopCmd&, const StopCmd&) = default;
 };
 
 using Command = std::variant<JointVelocityCmd, JointTargetCmd, JointTorqueCmd, JointModeCmd,
-                             WheelsCmd, DriveCmd, StopCmd>;
+                             WheelsCmd, DriveCmd, StopCmd, GaitCmd>;
 
 /// A command with the sim time [s] at which it applies.
 struct TimedCommand {

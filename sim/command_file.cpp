@@ -7,6 +7,7 @@
 #include <system_error>
 
 #include "sim/math.h"
+#include "sim/gait.h"
 #include "sim/robot_model.h"
 #include "sim/text.h"
 
@@ -48,6 +49,13 @@ struct ArgReader {
     return v.value_or(0);
   }
   std::string word(size_t i) const { return std::string(args[i]); }
+  Gait gait(size_t i) {
+    for (Gait g : {Gait::Off, Gait::Caterpillar, Gait::Rolking})
+      if (args[i] == toString(g)) return g;
+    if (error.empty())
+      error = std::string(command) + ": unknown gait '" + std::string(args[i]) + "' (expected off, caterpillar or rolking)";
+    return Gait::Off;
+  }
   JointMode mode(size_t i) {
     for (JointMode m : {JointMode::Velocity, JointMode::Position, JointMode::Torque, JointMode::Free})
       if (args[i] == toString(m)) return m;
@@ -82,6 +90,7 @@ const Syntax kSyntax[] = {
     {"mode", 2, "joint, velocity|position|torque|free",
      [](ArgReader& a) -> Command { return JointModeCmd{a.word(0), a.mode(1)}; }},
     {"stop", 0, "", [](ArgReader&) -> Command { return StopCmd{}; }},
+    {"gait", 1, "off|caterpillar|rolking", [](ArgReader& a) -> Command { return GaitCmd{a.gait(0)}; }},
 };
 
 constexpr const char* kWheelNames[4] = {"front-left", "front-right", "rear-left", "rear-right"};
@@ -191,6 +200,18 @@ struct Checker {
   }
 
   std::string operator()(const StopCmd&) const { return {}; }
+
+  std::string operator()(const GaitCmd&) const {
+    if (std::string e = needDrive(); !e.empty()) return e;
+    const auto legs = findLegs(robot);
+    if (!legs) return "robot '" + robot.name + "' has no hip-knee-wheel legs for gaits";
+    for (const LegJoints& leg : *legs)
+      for (int j : {leg.hip, leg.knee}) {
+        const int a = robot.findActuator(robot.joints[j].name);
+        if (a < 0 || !robot.actuators[a].hasPid) return needsPid(robot.joints[j].name);
+      }
+    return {};
+  }
 
   // The robot's <drive>, with joint indices checked so that the checks above
   // cannot index out of range on a hand-built model.

@@ -34,6 +34,12 @@ struct SimParams {
   double csvRate = 100;           ///< rows per sim second in `run --csv`
   // Ports
   int robotPort = 47800;          ///< TCP port of the robot link
+  // Gaits (sim/gait.h); swings in degrees about the stance pose
+  double caterpillarHipSwing = 12;   ///< [deg]
+  double caterpillarPhaseTime = 1.0; ///< [s] per half cycle
+  double rolkingHipSwing = 12;       ///< [deg]
+  double rolkingLegTime = 0.8;       ///< [s] per leg reach
+  double rolkingBodyTime = 1.2;      ///< [s] to bring the body forward
   // Health limits (checked every step)
   double maxLinearSpeed = 50;     ///< [m/s]
   double maxAngularSpeed = 200;   ///< [rad/s]

@@ -168,6 +168,8 @@ struct World::Impl {
     std::vector<SensorState> sensors;
     std::vector<int64_t> sensorPeriod;          // steps between samples
     std::vector<dJointFeedback> jointFeedback;  // per joint (joint_force sensors read it)
+    std::optional<std::array<LegJoints, 4>> legs;  // for gaits
+    double legLength = 0;  // hip to wheel centre [m], for gaits
   };
   // A contact joint whose force a wheel_force sensor sums.
   struct WheelContact {
@@ -565,6 +567,11 @@ bool World::build(Diagnostics& diag) {
       rt.joints.push_back(joint);
     }
     for (const ActuatorSpec& a : robot.actuators) rt.control.actuators.push_back(initialActuatorState(a));
+    rt.legs = findLegs(robot);
+    if (rt.legs) {
+      const LegJoints& leg = (*rt.legs)[0];
+      rt.legLength = norm(robot.joints[leg.wheel].anchor - robot.joints[leg.hip].anchor);
+    }
     // Joint feedback for every joint: cheap, and joint_force sensors and
     // health reports read it.
     rt.jointFeedback.resize(robot.joints.size());
@@ -608,6 +615,11 @@ void World::applyCommand(const Command& command, int robot) {
   const RobotModel& model = robotModel(robot);
   auto actuatorOf = [&](const std::string& joint) { return model.findActuator(joint); };
   auto cancelDriveIfDriveJoint = [&](int actuator) {
+    if (rt.legs)
+      for (const LegJoints& leg : *rt.legs)
+        if (model.actuators[actuator].joint == leg.hip || model.actuators[actuator].joint == leg.knee ||
+            model.actuators[actuator].joint == leg.wheel)
+          rt.control.gaitActive = false;
     if (!model.drive) return;
     const int joint = model.actuators[actuator].joint;
     const DriveSpec& d = *model.drive;
@@ -642,19 +654,26 @@ void World::applyCommand(const Command& command, int robot) {
           setMode(rt.control.actuators[a], c.mode);
         } else if constexpr (std::is_same_v<T, WheelsCmd>) {
           rt.control.driveActive = false;
+          rt.control.gaitActive = false;
           for (int w = 0; w < 4; ++w) {
             const int a = actuatorOf(model.joints[model.drive->wheels[w]].name);
             setMode(rt.control.actuators[a], JointMode::Velocity);
             rt.control.actuators[a].velocity = c.omega[w];
           }
         } else if constexpr (std::is_same_v<T, DriveCmd>) {
+          rt.control.gaitActive = false;
           rt.control.driveActive = true;
           rt.control.driveSpeed = c.speed;
           rt.control.driveArticulation = c.articulation;
+        } else if constexpr (std::is_same_v<T, GaitCmd>) {
+          rt.control.driveActive = false;
+          rt.control.gaitActive = true;
+          rt.control.gait = GaitState{c.gait, 0, steps_};
         } else if constexpr (std::is_same_v<T, StopCmd>) {
           // Wheels and speed-driven joints brake; joints with a position
           // controller hold where they are now; free joints stay free.
           rt.control.driveActive = false;
+          rt.control.gaitActive = false;
           for (size_t a = 0; a < model.actuators.size(); ++a) {
             ActuatorState& s = rt.control.actuators[a];
             const ActuatorSpec& spec = model.actuators[a];
@@ -717,6 +736,35 @@ void World::runActuators() {
       if (art.mode != JointMode::Position) art.integral = 0;
       art.mode = JointMode::Position;
       art.target = rt.control.driveArticulation;
+    }
+    if (rt.control.gaitActive && rt.legs) {
+      const std::array<LegCommand, 4> legs =
+          gaitStep(params_, rt.control.gait, steps_, params_.step, rt.legLength, model.drive->wheelRadius);
+      auto actuatorOf = [&](int joint) -> ActuatorState& {
+        return rt.control.actuators[model.findActuator(model.joints[joint].name)];
+      };
+      auto hold = [](ActuatorState& s, double target) {
+        if (s.mode != JointMode::Position) s.integral = 0;
+        s.mode = JointMode::Position;
+        s.target = target;
+      };
+      for (int i = 0; i < 4; ++i) {
+        const LegJoints& leg = (*rt.legs)[i];
+        hold(actuatorOf(leg.hip), legs[i].hip);
+        hold(actuatorOf(leg.knee), 0);
+        ActuatorState& wheel = actuatorOf(leg.wheel);
+        switch (legs[i].wheel) {
+          case LegCommand::Wheel::Free: wheel.mode = JointMode::Free; break;
+          case LegCommand::Wheel::Brake:
+            wheel.mode = JointMode::Velocity;
+            wheel.velocity = 0;
+            break;
+          case LegCommand::Wheel::Drive:
+            wheel.mode = JointMode::Velocity;
+            wheel.velocity = legs[i].wheelSpeed;
+            break;
+        }
+      }
     }
     // Actuated joints: motor set-points and explicit torques.
     std::vector<bool> actuated(model.joints.size(), false);
@@ -1244,6 +1292,8 @@ uint64_t World::stateHash() const {
     hashValue(h, rt.control.driveActive);
     hashValue(h, rt.control.driveSpeed);
     hashValue(h, rt.control.driveArticulation);
+    hashValue(h, rt.control.gaitActive);
+    hashValue(h, rt.control.gait);
     for (const SensorState& st : rt.sensors) {
       hashValue(h, st.nextStep);
       hashValue(h, st.forceSum);

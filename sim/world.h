@@ -17,6 +17,7 @@
 #include "sim/actuator.h"
 #include "sim/command.h"
 #include "sim/diagnostics.h"
+#include "sim/gait.h"
 #include "sim/params.h"
 #include "sim/robot_model.h"
 #include "sim/sensors.h"
@@ -41,6 +42,8 @@ struct RobotControlState {
   bool driveActive = false;
   double driveSpeed = 0;
   double driveArticulation = 0;
+  bool gaitActive = false;
+  GaitState gait;
   friend bool operator==(const RobotControlState&, const RobotControlState&) = default;
 };
 
