@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <fstream>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -11,6 +12,8 @@
 #include <vector>
 
 #include "app/headless_runner.h"
+#include "app/validation.h"
+#include "ui/plot_renderer.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/params.h"
@@ -34,6 +37,11 @@ constexpr const char* kUsage = R"(usage:
       --quiet           no progress lines
       Exits 0 when the run completed, 1 on bad input, 3 if the twin diverged
       (the report names what, where and when).
+  simpartner-sim validate [--out DIR] [--quick] [--params FILE] [--set KEY=VALUE]...
+      Runs the founding paper's five validation experiments headless and
+      writes DIR/report.md (default DIR: validation), a PNG plot and the CSV
+      data behind each. --quick runs short versions. Exits 0 when every
+      experiment passes its target, 4 when some fail.
   simpartner-sim params
       Prints every parameter key with its default and meaning.
 )";
@@ -91,6 +99,62 @@ int check(const std::vector<std::string>& files) {
   const int warnings = static_cast<int>(diag.items().size()) - errors;
   std::cout << files.size() << " file(s) checked: " << errors << " error(s), " << warnings << " warning(s)\n";
   return errors == 0 ? 0 : 1;
+}
+
+int validate(const std::vector<std::string>& args, const char* argv0) {
+  sp::ValidationOptions o;
+  std::string out = "validation", paramsFile;
+  std::vector<std::string> overrides;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--quick") {
+      o.quick = true;
+    } else if ((a == "--out" || a == "--params" || a == "--set") && i + 1 < args.size()) {
+      (a == "--out" ? out : a == "--params" ? paramsFile : overrides.emplace_back()) = args[++i];
+    } else {
+      std::cerr << "<command line>: error: unknown or incomplete option '" << a << "'\n" << kUsage;
+      return 2;
+    }
+  }
+  sp::Diagnostics diag;
+  auto params = sp::loadRunParams(paramsFile, overrides, diag);
+  std::cerr << diag.format();
+  if (!params) return 2;
+  o.params = *params;
+  // The shipped robots/ and terrains/: next to the working directory, or
+  // two levels above the executable (build/app/).
+  namespace fs = std::filesystem;
+  o.sourceDir = fs::exists("terrains/flat.world.xml")
+                    ? "."
+                    : fs::absolute(fs::path(argv0)).parent_path().parent_path().parent_path().string();
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) {
+    std::cerr << out << ": error: cannot create the output folder: " << ec.message() << "\n";
+    return 1;
+  }
+  std::cout << "SimPartner validation" << (o.quick ? " (quick)" : "") << ": the founding paper's five experiments\n";
+  std::vector<sp::ExperimentResult> results;
+  try {
+    results = sp::runValidation(o, std::cout);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  for (const sp::ExperimentResult& r : results)
+    for (const sp::ExperimentPlot& p : r.plots) {
+      std::ofstream(out + "/" + p.file + ".csv") << sp::toCsv(p.spec);
+      std::string error;
+      if (!sp::renderPlotPng(p.spec, out + "/" + p.file + ".png", error)) {
+        std::cerr << "error: " << error << "\n";
+        return 1;
+      }
+    }
+  std::ofstream(out + "/report.md") << sp::validationReport(results, o);
+  int passed = 0;
+  for (const sp::ExperimentResult& r : results) passed += r.pass();
+  std::cout << passed << " of " << results.size() << " experiments pass; report: " << out << "/report.md\n";
+  return passed == static_cast<int>(results.size()) ? 0 : 4;
 }
 
 int printParams() {
@@ -171,6 +235,7 @@ int main(int argc, char** argv) {
   }
   if (cmd == "run") return run(args);
   if (cmd == "params") return printParams();
+  if (cmd == "validate") return validate(args, argv[0]);
   std::cerr << "<command line>: error: unknown command '" << cmd << "'\n" << kUsage;
   return 2;
 }
