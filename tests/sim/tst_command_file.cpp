@@ -7,11 +7,13 @@
 
 #include <fstream>
 
+#include "tests/test_files.h"
 #include "sim/command_file.h"
 #include "sim/math.h"
 #include "sim/robot_model.h"
 
 using namespace sp;
+using sp::test::writeFile;
 
 Q_DECLARE_METATYPE(sp::Command)
 
@@ -78,13 +80,6 @@ RobotModel testRobot() {
   return robot;
 }
 
-/// Writes `content` to `name` in `dir` and returns its path.
-std::string writeFile(const QTemporaryDir& dir, const char* name, const QByteArray& content) {
-  const std::string path = dir.filePath(name).toStdString();
-  std::ofstream out(path, std::ios::binary);
-  out.write(content.constData(), content.size());
-  return path;
-}
 
 }  // namespace
 

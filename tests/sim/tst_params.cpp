@@ -11,9 +11,11 @@
 #include <string>
 #include <vector>
 
+#include "tests/test_files.h"
 #include "sim/params.h"
 
 using namespace sp;
+using sp::test::writeFile;
 
 namespace {
 
@@ -72,13 +74,6 @@ std::vector<std::string> keysInFile(const std::string& path) {
   return keys;
 }
 
-/// Writes `content` to `name` in `dir` and returns its path.
-std::string writeFile(const QTemporaryDir& dir, const char* name, const QByteArray& content) {
-  const std::string path = dir.filePath(name).toStdString();
-  std::ofstream out(path, std::ios::binary);
-  out.write(content.constData(), content.size());
-  return path;
-}
 
 }  // namespace
 
