@@ -127,9 +127,9 @@ void TestParams::defaultsFileListsEveryKeyInTableOrder() {
 void TestParams::tableDefaultsAreSimParamsDefaults() {
   const SimParams defaults;
   std::set<std::string> seen;
-  const QRegularExpression keyPattern("^[a-z]+\\.[a-z_]+$");
+  const QRegularExpression keyPattern("^[a-z]+(\\.[a-z_]+)+$");
   const std::vector<ParamInfo> table = paramTable();
-  QCOMPARE(table.size(), size_t(21));
+  QCOMPARE(table.size(), size_t(26));
   for (const ParamInfo& info : table) {
     QVERIFY2(seen.insert(info.key).second, info.key.c_str());
     QVERIFY2(keyPattern.match(q(info.key)).hasMatch(), info.key.c_str());
@@ -169,6 +169,8 @@ void TestParams::setParamAccepts_data() {
   QTest::newRow("linear speed") << "health.max_linear_speed" << "12.5" << "12.5";
   QTest::newRow("angular speed") << "health.max_angular_speed" << "1e3" << "1000";
   QTest::newRow("acceleration") << "health.max_linear_acceleration" << "2500" << "2500";
+  QTest::newRow("caterpillar swing") << "gait.caterpillar.hip_swing" << "20" << "20";
+  QTest::newRow("rolking body time") << "gait.rolking.body_time" << "2.5" << "2.5";
   QTest::newRow("angular acceleration") << "health.max_angular_acceleration" << "5e4" << "50000";
   QTest::newRow("joint error") << "health.max_joint_error" << "0.01" << "0.01";
   QTest::newRow("penetration") << "health.max_penetration" << "0.2" << "0.2";
@@ -267,6 +269,8 @@ void TestParams::setParamRejects_data() {
                                 << "health.max_linear_speed: must be > 0, got 0";
   QTest::newRow("angular speed") << "health.max_angular_speed" << "-1"
                                  << "health.max_angular_speed: must be > 0, got -1";
+  QTest::newRow("swing too wide") << "gait.rolking.hip_swing" << "50"
+                                  << "gait.rolking.hip_swing: must be <= 45, got 50";
   QTest::newRow("acceleration") << "health.max_linear_acceleration" << "0"
                                 << "health.max_linear_acceleration: must be > 0, got 0";
   QTest::newRow("joint error") << "health.max_joint_error" << "0" << "health.max_joint_error: must be > 0, got 0";
