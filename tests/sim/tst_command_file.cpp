@@ -121,6 +121,8 @@ void TestCommandFile::parseCommand_data() {
   QTest::addColumn<Command>("expected");
   QTest::addColumn<QString>("canonical");  // toText() of the result
   QTest::newRow("drive") << "drive 0.5 10" << Command(DriveCmd{0.5, degToRad(10)}) << "drive 0.5 10";
+  QTest::newRow("gait") << "gait caterpillar" << Command(GaitCmd{Gait::Caterpillar}) << "gait caterpillar";
+  QTest::newRow("gait off") << "gait off" << Command(GaitCmd{Gait::Off}) << "gait off";
   QTest::newRow("drive spacing") << "  drive\t0.50   -10 " << Command(DriveCmd{0.5, degToRad(-10)})
                                  << "drive 0.5 -10";
   QTest::newRow("wheels in rad/s") << "wheels 1 2 -3 4.5" << Command(WheelsCmd{{1, 2, -3, 4.5}})
@@ -254,6 +256,8 @@ void TestCommandFile::parseSequenceErrors_data() {
   QTest::addColumn<QString>("text");
   QTest::addColumn<QString>("expected");
   QTest::newRow("unknown command") << "1.0 drvie 1 2" << "walk.seq:1: error: unknown command 'drvie'\n";
+  QTest::newRow("unknown gait") << "1.0 gait trot"
+                                << "walk.seq:1: error: gait: unknown gait 'trot' (expected off, caterpillar or rolking)\n";
   QTest::newRow("bad time") << "x drive 1 2" << "walk.seq:1: error: bad time 'x'\n";
   QTest::newRow("time with unit") << "1s stop" << "walk.seq:1: error: bad time '1s'\n";
   QTest::newRow("negative time") << "-1 stop" << "walk.seq:1: error: time must be >= 0\n";
