@@ -682,8 +682,12 @@ void World::applyCommand(const Command& command, int robot) {
             if (model.drive)
               for (int w : model.drive->wheels) isWheel = isWheel || w == spec.joint;
             if (spec.hasPid && spec.kp > 0 && !isWheel) {
+              // A position-controlled joint that is moving stops where it is;
+              // one that is still (a gripper squeezing a pole, a leg carrying
+              // load) keeps its target and so its force.
+              const bool moving = std::abs(jointRate(robot, spec.joint)) > 1e-3;
+              if (s.mode != JointMode::Position || moving) s.target = jointPosition(robot, spec.joint);
               setMode(s, JointMode::Position);
-              s.target = jointPosition(robot, spec.joint);
             } else {
               setMode(s, JointMode::Velocity);
               s.velocity = 0;

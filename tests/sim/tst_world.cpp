@@ -292,6 +292,33 @@ class TestWorld : public QObject {
     QVERIFY(std::abs(world->jointPosition(0, 1)) < degToRad(0.5));
   }
 
+  // Stop halts a moving position-controlled joint where it is, but a still
+  // one keeps its target: an arm pressing on a block (like a gripper
+  // squeezing) keeps pressing.
+  void stopKeepsSqueezing() {
+    WorldFixture f;
+    auto world = f.build(worldWith(R"(<robot name="arm" file="robot.xml"/>
+                                      <object name="block"><geom type="box" size="0.4 0.4 0.2" xyz="0.8 0 1.8"/></object>)",
+                                   "0 0 0"),
+                         armRobot(R"(lower="-60" upper="60")", R"(<actuator name="shoulder" joint="shoulder"
+                           mode="position" kp="10" max_torque="500" max_velocity="90"/>)"));
+    QVERIFY(world);
+    QCOMPARE(world->submit(JointTargetCmd{"shoulder", degToRad(30)}), std::string());
+    stepFor(*world, 2.0);  // resting on the block, pressing down
+    QVERIFY(world->jointPosition(0, 1) < degToRad(10));
+    QCOMPARE(world->submit(StopCmd{}), std::string());
+    world->step();
+    QCOMPARE(world->actuatorState(0, 0).target, degToRad(30));
+    QCOMPARE(world->submit(JointTargetCmd{"shoulder", degToRad(-10)}), std::string());
+    stepFor(*world, 0.1);  // swinging back
+    QCOMPARE(world->submit(StopCmd{}), std::string());
+    world->step();
+    const double held = world->actuatorState(0, 0).target;
+    QVERIFY(held > degToRad(-9) && held < degToRad(10));
+    stepFor(*world, 1.0);
+    QVERIFY(std::abs(world->jointPosition(0, 1) - held) < degToRad(0.5));
+  }
+
   // Commands are checked when submitted and applied at the next step.
   void commandsApplyAtStepBoundary() {
     WorldFixture f;
