@@ -536,6 +536,12 @@ std::vector<ExperimentResult> runValidation(const ValidationOptions& o, std::ost
 }
 
 std::string validationReport(const std::vector<ExperimentResult>& results, const ValidationOptions& o) {
+  // Table cells: a '|' would end the cell.
+  auto cell = [](const std::string& text) {
+    std::string out;
+    for (char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
+    return out;
+  };
   std::ostringstream md;
   int passed = 0;
   for (const ExperimentResult& r : results) passed += r.pass();
@@ -549,8 +555,8 @@ std::string validationReport(const std::vector<ExperimentResult>& results, const
      << "|---|---|---|---|---|---|---|---|\n";
   for (const ExperimentResult& r : results)
     for (const Metric& m : r.metrics)
-      md << "| " << r.number << " | " << r.title << " | " << m.quantity << " | " << m.paper << " | "
-         << num(m.ours, std::abs(m.ours) < 0.1 ? 4 : 2) << " | " << m.unit << " | " << m.target << " | "
+      md << "| " << r.number << " | " << r.title << " | " << cell(m.quantity) << " | " << cell(m.paper) << " | "
+         << num(m.ours, std::abs(m.ours) < 0.1 ? 4 : 2) << " | " << cell(m.unit) << " | " << cell(m.target) << " | "
          << (m.pass ? "pass" : "**fail**") << " |\n";
   for (const ExperimentResult& r : results) {
     md << "\n## " << r.number << ". " << r.title << " — " << (r.pass() ? "pass" : "fail") << "\n\n"
