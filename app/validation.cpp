@@ -545,12 +545,22 @@ std::string validationReport(const std::vector<ExperimentResult>& results, const
   std::ostringstream md;
   int passed = 0;
   for (const ExperimentResult& r : results) passed += r.pass();
+  // Model version: a hash of the robot file's bytes, so a report names the
+  // exact model it was made with.
+  std::ifstream robotFile(o.sourceDir + "/robots/workpartner.xml", std::ios::binary);
+  std::ostringstream robotText;
+  robotText << robotFile.rdbuf();
+  uint64_t hash = 0xcbf29ce484222325ULL;
+  for (unsigned char c : robotText.str()) hash = (hash ^ c) * 0x100000001b3ULL;
+  char version[24];
+  std::snprintf(version, sizeof version, "%016llx", static_cast<unsigned long long>(hash));
   md << "# SimPartner validation report\n\n"
      << "The founding paper's five validation experiments, run on the twin by `simpartner-sim validate"
      << (o.quick ? " --quick" : "") << "`. Every number below was computed by that run; the paper's figures are "
      << "quoted from ../shared/MISSION.md.\n\n"
      << "**" << passed << " of " << results.size() << " experiments pass.** Conditions common to all: WorkPartner "
-     << "model robots/workpartner.xml, " << solverText(o.params) << ".\n\n"
+     << "model robots/workpartner.xml (FNV-1a 64 of its contents: " << version << "), " << solverText(o.params)
+     << ".\n\n"
      << "| # | experiment | quantity | paper | ours | unit | target | result |\n"
      << "|---|---|---|---|---|---|---|---|\n";
   for (const ExperimentResult& r : results)

@@ -76,6 +76,9 @@ std::string toText(const Command& command) {
     }
     std::string operator()(const StopCmd&) const { return "stop"; }
     std::string operator()(const GaitCmd& c) const { return std::string("gait ") + toString(c.gait); }
+    std::string operator()(const TurnCmd& c) const {
+      return "turn " + formatShortest(c.speed) + " " + formatDegrees(c.yawRate);
+    }
   };
   return std::visit(Writer{}, command);
 }

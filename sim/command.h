@@ -67,13 +67,22 @@ struct GaitCmd {
   friend bool operator==(const GaitCmd&, const GaitCmd&) = default;
 };
 
+/// Drive at `speed` [m/s] turning at `yawRate` [rad/s] (> 0 turns left):
+/// the articulation angle that gives this turn with the current leg
+/// geometry is recomputed every step; wheel speeds as for DriveCmd.
+struct TurnCmd {
+  double speed = 0;
+  double yawRate = 0;
+  friend bool operator==(const TurnCmd&, const TurnCmd&) = default;
+};
+
 /// Every actuated joint to zero velocity (wheels) or to hold its angle.
 struct StopCmd {
   friend bool operator==(const StopCmd&, const StopCmd&) = default;
 };
 
 using Command = std::variant<JointVelocityCmd, JointTargetCmd, JointTorqueCmd, JointModeCmd,
-                             WheelsCmd, DriveCmd, StopCmd, GaitCmd>;
+                             WheelsCmd, DriveCmd, StopCmd, GaitCmd, TurnCmd>;
 
 /// A command with the sim time [s] at which it applies.
 struct TimedCommand {

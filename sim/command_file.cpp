@@ -90,6 +90,8 @@ const Syntax kSyntax[] = {
     {"mode", 2, "joint, velocity|position|torque|free",
      [](ArgReader& a) -> Command { return JointModeCmd{a.word(0), a.mode(1)}; }},
     {"stop", 0, "", [](ArgReader&) -> Command { return StopCmd{}; }},
+    {"turn", 2, "speed m/s, yaw rate deg/s",
+     [](ArgReader& a) -> Command { return TurnCmd{a.number(0), degToRad(a.number(1))}; }},
     {"gait", 1, "off|caterpillar|rolking", [](ArgReader& a) -> Command { return GaitCmd{a.gait(0)}; }},
 };
 
@@ -200,6 +202,8 @@ struct Checker {
   }
 
   std::string operator()(const StopCmd&) const { return {}; }
+
+  std::string operator()(const TurnCmd&) const { return needDrive(); }
 
   std::string operator()(const GaitCmd&) const {
     if (std::string e = needDrive(); !e.empty()) return e;

@@ -359,6 +359,24 @@ std::array<double, 4> articulatedWheelSpeeds(const DriveGeometry& g, double spee
           yawRate * (rRear + g.rearTrack / 2) / wheelRadius};
 }
 
+double articulationForTurn(const DriveGeometry& g, double speed, double yawRate, double maxAngle) {
+  if (yawRate == 0 || speed == 0) return 0;
+  // The hinge radius R_H = |speed / yawRate| grows monotonically smaller as
+  // gamma grows on (0, pi): bisect for it.
+  const double wanted = std::abs(speed / yawRate);
+  auto radius = [&](double gamma) {
+    const double rRear = (g.frontLength + g.rearLength * std::cos(gamma)) / std::sin(gamma);
+    return std::hypot(g.rearLength, rRear);
+  };
+  double lo = 1e-6, hi = std::min(maxAngle, kPi - 1e-3);
+  if (radius(hi) > wanted) return std::copysign(hi, yawRate * speed);  // tighter than the hinge allows
+  for (int i = 0; i < 60; ++i) {
+    const double mid = (lo + hi) / 2;
+    (radius(mid) > wanted ? lo : hi) = mid;
+  }
+  return std::copysign((lo + hi) / 2, yawRate * speed);
+}
+
 World::World(const WorldModel& model, const SimParams& params, WorldOptions options)
     : model_(model), params_(params), options_(options), impl_(std::make_unique<Impl>()) {}
 
@@ -660,8 +678,15 @@ void World::applyCommand(const Command& command, int robot) {
             setMode(rt.control.actuators[a], JointMode::Velocity);
             rt.control.actuators[a].velocity = c.omega[w];
           }
+        } else if constexpr (std::is_same_v<T, TurnCmd>) {
+          rt.control.gaitActive = false;
+          rt.control.driveActive = true;
+          rt.control.driveByYawRate = true;
+          rt.control.driveSpeed = c.speed;
+          rt.control.driveYawRate = c.yawRate;
         } else if constexpr (std::is_same_v<T, DriveCmd>) {
           rt.control.gaitActive = false;
+          rt.control.driveByYawRate = false;
           rt.control.driveActive = true;
           rt.control.driveSpeed = c.speed;
           rt.control.driveArticulation = c.articulation;
@@ -729,8 +754,14 @@ void World::runActuators() {
     const RobotModel& model = robotModel(static_cast<int>(r));
     if (rt.control.driveActive && model.drive) {
       const DriveSpec& d = *model.drive;
-      const std::array<double, 4> w =
-          articulatedWheelSpeeds(*driveGeometry(static_cast<int>(r)), rt.control.driveSpeed, d.wheelRadius);
+      const DriveGeometry geometry = *driveGeometry(static_cast<int>(r));
+      if (rt.control.driveByYawRate) {
+        const JointSpec& hinge = model.joints[d.articulation];
+        const double limit = hinge.limited ? std::min(std::abs(hinge.lower), std::abs(hinge.upper)) : kPi / 2;
+        rt.control.driveArticulation =
+            articulationForTurn(geometry, rt.control.driveSpeed, rt.control.driveYawRate, limit);
+      }
+      const std::array<double, 4> w = articulatedWheelSpeeds(geometry, rt.control.driveSpeed, d.wheelRadius);
       for (int i = 0; i < 4; ++i) {
         ActuatorState& s = rt.control.actuators[model.findActuator(model.joints[d.wheels[i]].name)];
         s.mode = JointMode::Velocity;
@@ -1296,6 +1327,8 @@ uint64_t World::stateHash() const {
     hashValue(h, rt.control.driveActive);
     hashValue(h, rt.control.driveSpeed);
     hashValue(h, rt.control.driveArticulation);
+    hashValue(h, rt.control.driveByYawRate);
+    hashValue(h, rt.control.driveYawRate);
     hashValue(h, rt.control.gaitActive);
     hashValue(h, rt.control.gait);
     for (const SensorState& st : rt.sensors) {

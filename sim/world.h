@@ -42,6 +42,8 @@ struct RobotControlState {
   bool driveActive = false;
   double driveSpeed = 0;
   double driveArticulation = 0;
+  bool driveByYawRate = false;  ///< TurnCmd: the articulation follows driveYawRate
+  double driveYawRate = 0;
   bool gaitActive = false;
   GaitState gait;
   friend bool operator==(const RobotControlState&, const RobotControlState&) = default;
@@ -113,6 +115,11 @@ struct DriveGeometry {
 /// roll without side slip around the turn centre of the articulated-steering
 /// kinematics (docs/architecture.md), with `speed` [m/s] at the hinge.
 std::array<double, 4> articulatedWheelSpeeds(const DriveGeometry& g, double speed, double wheelRadius);
+
+/// The articulation angle [rad] at which the hinge runs at `speed` [m/s]
+/// with yaw rate `yawRate` [rad/s] (the inverse of the kinematics above),
+/// limited to +-`maxAngle`; 0 for a zero yaw rate.
+double articulationForTurn(const DriveGeometry& g, double speed, double yawRate, double maxAngle);
 
 class World {
  public:

@@ -123,6 +123,7 @@ void TestCommandFile::parseCommand_data() {
   QTest::newRow("drive") << "drive 0.5 10" << Command(DriveCmd{0.5, degToRad(10)}) << "drive 0.5 10";
   QTest::newRow("gait") << "gait caterpillar" << Command(GaitCmd{Gait::Caterpillar}) << "gait caterpillar";
   QTest::newRow("gait off") << "gait off" << Command(GaitCmd{Gait::Off}) << "gait off";
+  QTest::newRow("turn by rate") << "turn 0.5 -12" << Command(TurnCmd{0.5, degToRad(-12)}) << "turn 0.5 -12";
   QTest::newRow("drive spacing") << "  drive\t0.50   -10 " << Command(DriveCmd{0.5, degToRad(-10)})
                                  << "drive 0.5 -10";
   QTest::newRow("wheels in rad/s") << "wheels 1 2 -3 4.5" << Command(WheelsCmd{{1, 2, -3, 4.5}})

@@ -122,6 +122,21 @@ class TestWorkPartner : public QObject {
              qPrintable(QString("radius %1, kinematics %2").arg(radius).arg(expected)));
     QVERIFY((wrapAngle(yaw1 - yaw0) > 0) == (articulation > 0));
   }
+
+  // Driving by turn rate: the hinge angle is solved from the kinematics
+  // each step, and the robot turns at the commanded yaw rate.
+  void turnsAtCommandedYawRate() {
+    auto world = load("terrains/flat.world.xml");
+    QVERIFY(world);
+    const double yawRate = degToRad(-8);
+    QCOMPARE(world->submit(TurnCmd{0.6, yawRate}), std::string());
+    stepFor(*world, 4.0);
+    const double yaw0 = rpyFromQuat(world->linkPose(0, 0).q).z;
+    stepFor(*world, 4.0);
+    const double measured = wrapAngle(rpyFromQuat(world->linkPose(0, 0).q).z - yaw0) / 4.0;
+    QVERIFY2(std::abs(measured - yawRate) / std::abs(yawRate) < 0.02,
+             qPrintable(QString("%1 deg/s").arg(radToDeg(measured))));
+  }
 };
 
 QTEST_GUILESS_MAIN(TestWorkPartner)
