@@ -1,0 +1,536 @@
+#include "net/message.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <iterator>
+#include <string_view>
+#include <system_error>
+#include <type_traits>
+
+#include "sim/command_file.h"
+
+namespace sp::net {
+namespace {
+
+constexpr size_t kQuoteMax = 40;  // bytes of a value quoted in an error
+
+// ---------------------------------------------------------------------------
+// Names of enum values, in enum order.
+
+constexpr const char* kTypeNames[] = {
+    "HELLO",     "WELCOME", "LEASE_ACQUIRE", "LEASE_KEEPALIVE", "LEASE_RELEASE",
+    "LEASE_STATE", "COMMAND", "REPLY",       "TELEMETRY",       "LASER",
+    "HEARTBEAT", "ESTOP",   "REARM",         "EVENT",           "ERROR"};
+constexpr const char* kRoleNames[] = {"control", "monitor"};
+constexpr const char* kStatusNames[] = {"ok",   "invalid", "out_of_limits", "not_owner",
+                                        "busy", "failed",  "expired",       "duplicate"};
+constexpr const char* kEventNames[] = {"failsafe", "divergence", "estop", "rearmed", "link"};
+static_assert(std::size(kTypeNames) == kLastMessageType);
+
+template <class E, size_t N>
+const char* enumName(E value, const char* const (&names)[N]) {
+  const auto i = static_cast<size_t>(value);
+  return i < N ? names[i] : "?";
+}
+
+// "a, b or c"
+template <size_t N>
+std::string alternatives(const char* const (&names)[N]) {
+  std::string out;
+  for (size_t i = 0; i < N; ++i) {
+    if (i > 0) out += i + 1 == N ? " or " : ", ";
+    out += names[i];
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------
+// Text helpers.
+
+// `'value'`, cut to kQuoteMax bytes at a character boundary, with control
+// characters as \xNN, so that an error message stays one short line.
+std::string quote(std::string_view value) {
+  std::string out = "'";
+  size_t n = value.size();
+  bool cut = false;
+  if (n > kQuoteMax) {
+    n = kQuoteMax;
+    while (n > 0 && (static_cast<unsigned char>(value[n]) & 0xC0u) == 0x80u) --n;
+    cut = true;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(value[i]);
+    if (c < 0x20 || c == 0x7F) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  out += cut ? "'..." : "'";
+  return out;
+}
+
+// Offset of the first byte that is not part of well-formed UTF-8 (no
+// overlong forms, no surrogates, nothing above U+10FFFF), or npos.
+size_t invalidUtf8(std::string_view s) {
+  size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    size_t len = 0;
+    unsigned char lo = 0x80, hi = 0xBF;  // range of the second byte
+    if (c >= 0xC2 && c <= 0xDF) {
+      len = 2;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      len = 3;
+      if (c == 0xE0) lo = 0xA0;
+      if (c == 0xED) hi = 0x9F;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      len = 4;
+      if (c == 0xF0) lo = 0x90;
+      if (c == 0xF4) hi = 0x8F;
+    } else {
+      return i;
+    }
+    if (i + len > s.size()) return i;
+    const auto c1 = static_cast<unsigned char>(s[i + 1]);
+    if (c1 < lo || c1 > hi) return i;
+    for (size_t k = 2; k < len; ++k)
+      if ((static_cast<unsigned char>(s[i + k]) & 0xC0u) != 0x80u) return i;
+    i += len;
+  }
+  return std::string_view::npos;
+}
+
+std::vector<std::string_view> splitSpaces(std::string_view s) {
+  std::vector<std::string_view> items;
+  size_t i = 0;
+  while (i < s.size()) {
+    if (s[i] == ' ') {
+      ++i;
+      continue;
+    }
+    const size_t end = std::min(s.find(' ', i), s.size());
+    items.push_back(s.substr(i, end - i));
+    i = end;
+  }
+  return items;
+}
+
+void appendNumber(std::string& out, double v) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, ec == std::errc() ? end : buf);
+}
+
+void appendNumber(std::string& out, uint64_t v) {
+  char buf[24];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, ec == std::errc() ? end : buf);
+}
+
+template <class T>
+bool parseWhole(std::string_view s, T& value) {
+  if (s.empty()) return false;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+  return ec == std::errc() && end == s.data() + s.size();
+}
+
+// ---------------------------------------------------------------------------
+// Fields. forEachField(message, f) calls f(key, member, need) for every key of
+// a message in the order they are written; encoder and decoder share it, so
+// a key's name, type and whether it is required are stated once.
+
+enum class Need { Required, Optional };
+
+template <class M, class F>
+void forEachField(M& m, F& f) {
+  using T = std::remove_const_t<M>;
+  constexpr Need R = Need::Required;
+  if constexpr (std::is_same_v<T, HelloMsg>) {
+    f("name", m.name, R);
+    f("token", m.token, R);
+    f("role", m.role, R);
+  } else if constexpr (std::is_same_v<T, WelcomeMsg>) {
+    f("robot", m.robot, R);
+    f("session", m.session, R);
+    f("telemetry_rate", m.telemetryRate, R);
+  } else if constexpr (std::is_same_v<T, LeaseStateMsg>) {
+    f("holder", m.holder, R);
+    f("yours", m.yours, R);
+  } else if constexpr (std::is_same_v<T, CommandMsg>) {
+    f("seq", m.seq, R);
+    f("expires_ms", m.expiresMs, R);
+    f("command", m.command, R);
+  } else if constexpr (std::is_same_v<T, ReplyMsg>) {
+    f("seq", m.seq, R);
+    f("status", m.status, R);
+    f("reason", m.reason, Need::Optional);
+  } else if constexpr (std::is_same_v<T, TelemetryMsg>) {
+    f("seq", m.seq, R);
+    f("time", m.time, R);
+    f("pose", m.pose, R);
+    f("joint_names", m.jointNames, R);
+    f("joint_positions", m.jointPositions, R);
+    f("joint_velocities", m.jointVelocities, R);
+    f("wheel_normal", m.wheelNormal, R);
+    f("wheel_tangential", m.wheelTangential, R);
+    f("roll", m.roll, R);
+    f("pitch", m.pitch, R);
+    f("rtt_ms", m.rttMs, R);
+    f("lost", m.lost, R);
+    f("failsafe", m.failsafe, R);
+    f("estop", m.estop, R);
+    f("health", m.health, Need::Optional);
+  } else if constexpr (std::is_same_v<T, LaserMsg>) {
+    f("seq", m.seq, R);
+    f("time", m.time, R);
+    f("angle_min", m.angleMin, R);
+    f("angle_step", m.angleStep, R);
+    f("ranges", m.ranges, R);
+  } else if constexpr (std::is_same_v<T, HeartbeatMsg>) {
+    f("seq", m.seq, R);
+    f("time", m.time, R);
+  } else if constexpr (std::is_same_v<T, EstopMsg>) {
+    f("reason", m.reason, Need::Optional);
+  } else if constexpr (std::is_same_v<T, EventMsg>) {
+    f("kind", m.kind, R);
+    f("text", m.text, Need::Optional);
+  } else if constexpr (std::is_same_v<T, ErrorMsg>) {
+    f("reason", m.reason, R);
+  } else {
+    // LEASE_ACQUIRE, LEASE_KEEPALIVE, LEASE_RELEASE, REARM: no keys.
+    static_assert(std::is_empty_v<T>);
+  }
+}
+
+// Rules beyond syntax, shared by encoder and decoder; "" when valid, else
+// "key 'k': problem".
+struct Validator {
+  std::string operator()(const HelloMsg& m) const {
+    if (m.name.empty()) return "key 'name': must not be empty";
+    const auto hex = [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F'); };
+    if (!std::all_of(m.token.begin(), m.token.end(), hex)) return "key 'token': expected hex digits only";
+    if (m.token.size() < 32)
+      return "key 'token': expected at least 32 hex digits (128 bits), got " + std::to_string(m.token.size());
+    return {};
+  }
+  std::string operator()(const WelcomeMsg& m) const {
+    if (!(std::isfinite(m.telemetryRate) && m.telemetryRate > 0)) {
+      std::string s = "key 'telemetry_rate': must be finite and > 0, got ";
+      appendNumber(s, m.telemetryRate);
+      return s;
+    }
+    return {};
+  }
+  std::string operator()(const CommandMsg& m) const {
+    if (m.expiresMs == 0) return "key 'expires_ms': must be > 0";
+    if (m.command.empty()) return "key 'command': must not be empty";
+    return {};
+  }
+  std::string operator()(const TelemetryMsg& m) const {
+    for (size_t i = 0; i < m.jointNames.size(); ++i) {
+      const std::string& name = m.jointNames[i];
+      if (name.empty() || name.find(' ') != std::string::npos)
+        return "key 'joint_names': name " + std::to_string(i + 1) + " is empty or contains a space";
+    }
+    const auto count = [&](const char* key, size_t n) -> std::string {
+      if (n == m.jointNames.size()) return {};
+      return std::string("key '") + key + "': expected " + std::to_string(m.jointNames.size()) +
+             " numbers (one per joint name), got " + std::to_string(n);
+    };
+    if (std::string e = count("joint_positions", m.jointPositions.size()); !e.empty()) return e;
+    return count("joint_velocities", m.jointVelocities.size());
+  }
+  std::string operator()(const LaserMsg& m) const {
+    if (!std::isfinite(m.angleMin)) return "key 'angle_min': must be finite";
+    if (!std::isfinite(m.angleStep)) return "key 'angle_step': must be finite";
+    return {};
+  }
+  std::string operator()(const auto&) const { return {}; }
+};
+
+std::string validate(const Message& message) { return std::visit(Validator{}, message); }
+
+// ---------------------------------------------------------------------------
+// Encoding.
+
+struct Encoder {
+  std::string out;
+  std::string error;  // "key 'k': problem", first one only
+
+  void fail(const char* key, const std::string& problem) {
+    if (error.empty()) error = std::string("key '") + key + "': " + problem;
+  }
+  void text(const char* key, const std::string& value) {
+    if (value.find('\n') != std::string::npos) fail(key, "contains a line feed");
+    else if (invalidUtf8(value) != std::string::npos) fail(key, "is not valid UTF-8");
+    out += value;
+  }
+  template <size_t N>
+  void name(const char* key, size_t value, const char* const (&names)[N]) {
+    if (value >= N) fail(key, "bad enum value " + std::to_string(value));
+    else out += names[value];
+  }
+
+  void operator()(const char* key, const std::string& v, Need) { line(key, [&] { text(key, v); }); }
+  void operator()(const char* key, uint64_t v, Need) { line(key, [&] { appendNumber(out, v); }); }
+  void operator()(const char* key, double v, Need) { line(key, [&] { appendNumber(out, v); }); }
+  void operator()(const char* key, bool v, Need) { line(key, [&] { out += v ? '1' : '0'; }); }
+  void operator()(const char* key, Role v, Need) {
+    line(key, [&] { name(key, static_cast<size_t>(v), kRoleNames); });
+  }
+  void operator()(const char* key, ReplyStatus v, Need) {
+    line(key, [&] { name(key, static_cast<size_t>(v), kStatusNames); });
+  }
+  void operator()(const char* key, EventKind v, Need) {
+    line(key, [&] { name(key, static_cast<size_t>(v), kEventNames); });
+  }
+  void operator()(const char* key, const Pose& v, Need) {
+    const double xs[7] = {v.p.x, v.p.y, v.p.z, v.q.w, v.q.x, v.q.y, v.q.z};
+    line(key, [&] { numbers(xs, xs + 7); });
+  }
+  void operator()(const char* key, const std::array<double, 4>& v, Need) {
+    line(key, [&] { numbers(v.begin(), v.end()); });
+  }
+  void operator()(const char* key, const std::vector<double>& v, Need) {
+    line(key, [&] { numbers(v.begin(), v.end()); });
+  }
+  void operator()(const char* key, const std::vector<std::string>& v, Need) {
+    line(key, [&] {
+      for (size_t i = 0; i < v.size(); ++i) {
+        if (i > 0) out += ' ';
+        text(key, v[i]);
+      }
+    });
+  }
+
+  template <class It>
+  void numbers(It begin, It end) {
+    for (It it = begin; it != end; ++it) {
+      if (it != begin) out += ' ';
+      appendNumber(out, *it);
+    }
+  }
+  template <class W>
+  void line(const char* key, W write) {
+    out += key;
+    out += '=';
+    write();
+    out += '\n';
+  }
+};
+
+// ---------------------------------------------------------------------------
+// Decoding.
+
+struct Entry {
+  std::string_view key, value;
+  int line = 0;
+};
+
+struct Decoder {
+  const std::vector<Entry>& entries;  // sorted by key
+  std::string error;                  // "key 'k': problem" or "missing key 'k'", first one only
+
+  template <class T>
+  void operator()(const char* key, T& member, Need need) {
+    if (!error.empty()) return;
+    const auto it = std::lower_bound(entries.begin(), entries.end(), std::string_view(key),
+                                     [](const Entry& e, std::string_view k) { return e.key < k; });
+    if (it == entries.end() || it->key != key) {
+      if (need == Need::Required) error = std::string("missing key '") + key + "'";
+      return;
+    }
+    std::string problem = parse(it->value, member);
+    if (!problem.empty()) error = std::string("key '") + key + "': " + problem;
+  }
+
+  static std::string parse(std::string_view s, std::string& v) {
+    v.assign(s);
+    return {};
+  }
+  static std::string parse(std::string_view s, uint64_t& v) {
+    return parseWhole(s, v) ? std::string() : "expected an unsigned integer, got " + quote(s);
+  }
+  static std::string parse(std::string_view s, double& v) {
+    return parseWhole(s, v) ? std::string() : "expected a number, got " + quote(s);
+  }
+  static std::string parse(std::string_view s, bool& v) {
+    if (s != "0" && s != "1") return "expected 0 or 1, got " + quote(s);
+    v = s == "1";
+    return {};
+  }
+  template <class E, size_t N>
+  static std::string parseName(std::string_view s, E& v, const char* const (&names)[N]) {
+    for (size_t i = 0; i < N; ++i)
+      if (s == names[i]) {
+        v = static_cast<E>(i);
+        return {};
+      }
+    return "expected " + alternatives(names) + ", got " + quote(s);
+  }
+  static std::string parse(std::string_view s, Role& v) { return parseName(s, v, kRoleNames); }
+  static std::string parse(std::string_view s, ReplyStatus& v) { return parseName(s, v, kStatusNames); }
+  static std::string parse(std::string_view s, EventKind& v) { return parseName(s, v, kEventNames); }
+
+  static std::string parse(std::string_view s, std::vector<double>& v) {
+    const std::vector<std::string_view> items = splitSpaces(s);
+    v.assign(items.size(), 0.0);
+    for (size_t i = 0; i < items.size(); ++i)
+      if (!parseWhole(items[i], v[i]))
+        return "number " + std::to_string(i + 1) + ": expected a number, got " + quote(items[i]);
+    return {};
+  }
+  static std::string parseFixed(std::string_view s, double* out, size_t n, const char* what) {
+    std::vector<double> v;
+    if (std::string e = parse(s, v); !e.empty()) return e;
+    if (v.size() != n)
+      return "expected " + std::to_string(n) + " numbers (" + what + "), got " + std::to_string(v.size());
+    std::copy(v.begin(), v.end(), out);
+    return {};
+  }
+  static std::string parse(std::string_view s, Pose& v) {
+    double xs[7];
+    if (std::string e = parseFixed(s, xs, 7, "x y z qw qx qy qz"); !e.empty()) return e;
+    v.p = {xs[0], xs[1], xs[2]};
+    v.q = {xs[3], xs[4], xs[5], xs[6]};
+    return {};
+  }
+  static std::string parse(std::string_view s, std::array<double, 4>& v) {
+    return parseFixed(s, v.data(), 4, "FL FR RL RR");
+  }
+  static std::string parse(std::string_view s, std::vector<std::string>& v) {
+    v.clear();
+    for (std::string_view item : splitSpaces(s)) v.emplace_back(item);
+    return {};
+  }
+};
+
+bool isKey(std::string_view key) {
+  return !key.empty() && std::all_of(key.begin(), key.end(), [](char c) { return (c >= 'a' && c <= 'z') || c == '_'; });
+}
+
+// The alternative of Message with index i, default-constructed.
+template <size_t I = 0>
+Message messageOfIndex(size_t i) {
+  if constexpr (I + 1 < std::variant_size_v<Message>) {
+    if (i != I) return messageOfIndex<I + 1>(i);
+  }
+  return Message(std::in_place_index<I>);
+}
+
+}  // namespace
+
+static_assert(std::variant_size_v<Message> == kLastMessageType);
+
+const char* toString(MessageType type) { return messageTypeName(static_cast<uint8_t>(type)); }
+
+const char* messageTypeName(uint8_t type) {
+  return type >= kFirstMessageType && type <= kLastMessageType ? kTypeNames[type - kFirstMessageType] : "unknown";
+}
+
+const char* toString(Role role) { return enumName(role, kRoleNames); }
+const char* toString(ReplyStatus status) { return enumName(status, kStatusNames); }
+const char* toString(EventKind kind) { return enumName(kind, kEventNames); }
+
+MessageType typeOf(const Message& message) {
+  return static_cast<MessageType>(message.index() + kFirstMessageType);
+}
+
+std::optional<std::string> encodePayload(const Message& message, std::string& error) {
+  const char* type = toString(typeOf(message));
+  if (std::string problem = validate(message); !problem.empty()) {
+    error = std::string(type) + ": " + problem;
+    return std::nullopt;
+  }
+  Encoder encoder;
+  std::visit([&](const auto& m) { forEachField(m, encoder); }, message);
+  if (!encoder.error.empty()) {
+    error = std::string(type) + ": " + encoder.error;
+    return std::nullopt;
+  }
+  return std::move(encoder.out);
+}
+
+std::optional<std::string> encodeMessage(const Message& message, std::string& error) {
+  std::optional<std::string> payload = encodePayload(message, error);
+  if (!payload) return std::nullopt;
+  std::optional<std::string> frame = encodeFrame(static_cast<uint8_t>(typeOf(message)), *payload);
+  if (!frame)
+    error = std::string(toString(typeOf(message))) + ": payload of " + std::to_string(payload->size()) +
+            " bytes exceeds the maximum " + std::to_string(kMaxPayloadSize);
+  return frame;
+}
+
+std::optional<Message> decodeMessage(const Frame& frame, std::string& error) {
+  if (frame.type < kFirstMessageType || frame.type > kLastMessageType) {
+    error = "unknown message type " + std::to_string(frame.type);
+    return std::nullopt;
+  }
+  const std::string type = messageTypeName(frame.type);
+  const auto fail = [&](const std::string& problem) {
+    error = type + ": " + problem;
+    return std::nullopt;
+  };
+  if (frame.version != kProtocolVersion)
+    return fail("unsupported protocol version " + std::to_string(frame.version) + ", expected " +
+                std::to_string(kProtocolVersion));
+  const std::string_view payload = frame.payload;
+  if (const size_t bad = invalidUtf8(payload); bad != std::string_view::npos)
+    return fail("payload is not valid UTF-8 at byte " + std::to_string(bad));
+
+  // Lines to entries.
+  std::vector<Entry> entries;
+  int lineNo = 0;
+  for (size_t pos = 0; pos < payload.size();) {
+    const size_t end = std::min(payload.find('\n', pos), payload.size());
+    const std::string_view line = payload.substr(pos, end - pos);
+    pos = end + 1;
+    ++lineNo;
+    if (line.empty()) continue;
+    const size_t eq = line.find('=');
+    if (eq == std::string_view::npos)
+      return fail("line " + std::to_string(lineNo) + ": expected key=value, got " + quote(line));
+    const std::string_view key = line.substr(0, eq);
+    if (!isKey(key)) return fail("line " + std::to_string(lineNo) + ": bad key " + quote(key) + ", expected [a-z_]+");
+    entries.push_back({key, line.substr(eq + 1), lineNo});
+  }
+  std::stable_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.key < b.key; });
+  const Entry* repeat = nullptr;  // the repeat with the lowest line
+  for (size_t i = 1; i < entries.size(); ++i)
+    if (entries[i].key == entries[i - 1].key && (!repeat || entries[i].line < repeat->line)) repeat = &entries[i];
+  if (repeat) {
+    const auto first = std::lower_bound(entries.begin(), entries.end(), repeat->key,
+                                        [](const Entry& e, std::string_view k) { return e.key < k; });
+    return fail("line " + std::to_string(repeat->line) + ": key '" + std::string(repeat->key) + "' repeats line " +
+                std::to_string(first->line));
+  }
+
+  Message message = messageOfIndex(frame.type - kFirstMessageType);
+  Decoder decoder{entries, {}};
+  std::visit([&](auto& m) { forEachField(m, decoder); }, message);
+  if (!decoder.error.empty()) return fail(decoder.error);
+  if (std::string problem = validate(message); !problem.empty()) return fail(problem);
+  return message;
+}
+
+CommandMsg makeCommandMsg(uint64_t seq, uint64_t expiresMs, const Command& command) {
+  return CommandMsg{seq, expiresMs, toText(command)};
+}
+
+std::optional<Command> parseCommandMsg(const CommandMsg& message, const RobotModel* robot, std::string& error) {
+  std::string problem;
+  std::optional<Command> command = parseCommand(message.command, problem, robot);
+  if (!command) error = "COMMAND: key 'command': " + problem;
+  return command;
+}
+
+}  // namespace sp::net

@@ -1,0 +1,214 @@
+#pragma once
+// Typed messages of the robot link and their payload encoding
+// (docs/protocol.md is the reference; keep the two in step).
+//
+// A payload is UTF-8 text, one `key=value` per line, lines ended by '\n'.
+// Keys match [a-z_]+; a value is everything after the first '=' up to the
+// end of its line. Numbers are written in their shortest round-trip form
+// (std::to_chars): unsigned integers in decimal, floating-point values as
+// `0.5`, `1e-07`, `inf`, `-inf` or `nan`; a list is its items separated by
+// spaces; a flag is 0 or 1. Receivers ignore empty lines and keys they do not
+// know (so that later versions may add keys), and reject a message that
+// lacks a required key, repeats a key, or holds a value that does not parse
+// or breaks a rule below; the error names the message type and the key.
+//
+// Units are SI with angles in radians, except where a key says otherwise
+// (`*_ms` keys are milliseconds; the command text uses the sequence-file
+// syntax, angles in degrees, see docs/formats.md).
+//
+// Plain values and free functions: usable from any thread.
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "net/frame.h"
+#include "sim/command.h"
+#include "sim/math.h"
+
+namespace sp {
+struct RobotModel;
+}
+
+namespace sp::net {
+
+/// The message type byte of a frame. C = sent by clients, R = by the robot.
+enum class MessageType : uint8_t {
+  Hello = 1,           ///< C: first message: name, token, role
+  Welcome = 2,         ///< R: answer to a good HELLO
+  LeaseAcquire = 3,    ///< C: asks for the control lease
+  LeaseKeepalive = 4,  ///< C: keeps the lease (and the deadman) alive
+  LeaseRelease = 5,    ///< C: gives the lease up
+  LeaseState = 6,      ///< R: who holds the lease
+  Command = 7,         ///< C: one twin command with sequence number and expiry
+  Reply = 8,           ///< R: exactly one per COMMAND
+  Telemetry = 9,       ///< R: state at the telemetry rate
+  Laser = 10,          ///< R: a laser scan at the scanner's rate
+  Heartbeat = 11,      ///< C and R
+  Estop = 12,          ///< C: emergency stop, from any authenticated client
+  Rearm = 13,          ///< C: clears a latched failsafe or e-stop
+  Event = 14,          ///< R: failsafe, divergence, e-stop, re-armed, link
+  Error = 15,          ///< C and R: a message was refused
+};
+inline constexpr uint8_t kFirstMessageType = 1;
+inline constexpr uint8_t kLastMessageType = 15;
+
+/// "HELLO", "LEASE_ACQUIRE", ... as in docs/protocol.md.
+const char* toString(MessageType type);
+/// The name of a type byte, or "unknown" for a byte that is no MessageType.
+const char* messageTypeName(uint8_t type);
+
+/// HELLO role: a controlling client may take the lease; a monitor only reads.
+enum class Role { Control, Monitor };
+/// REPLY status.
+enum class ReplyStatus { Ok, Invalid, OutOfLimits, NotOwner, Busy, Failed, Expired, Duplicate };
+/// EVENT kind.
+enum class EventKind { Failsafe, Divergence, Estop, Rearmed, Link };
+const char* toString(Role role);                  ///< "control", "monitor"
+const char* toString(ReplyStatus status);         ///< "ok", "out_of_limits", ...
+const char* toString(EventKind kind);             ///< "failsafe", ...
+
+/// HELLO: keys `name`, `token`, `role`.
+struct HelloMsg {
+  std::string name;   ///< the client's name, not empty; shown to other clients
+  std::string token;  ///< shared secret, at least 32 hex digits (128 bits)
+  Role role = Role::Monitor;
+  friend bool operator==(const HelloMsg&, const HelloMsg&) = default;
+};
+/// WELCOME: keys `robot`, `session`, `telemetry_rate`.
+struct WelcomeMsg {
+  std::string robot;           ///< the robot's name
+  uint64_t session = 0;        ///< this connection's session id
+  double telemetryRate = 50;   ///< [Hz], finite and > 0
+  friend bool operator==(const WelcomeMsg&, const WelcomeMsg&) = default;
+};
+/// LEASE_ACQUIRE: no keys.
+struct LeaseAcquireMsg {
+  friend bool operator==(const LeaseAcquireMsg&, const LeaseAcquireMsg&) = default;
+};
+/// LEASE_KEEPALIVE: no keys.
+struct LeaseKeepaliveMsg {
+  friend bool operator==(const LeaseKeepaliveMsg&, const LeaseKeepaliveMsg&) = default;
+};
+/// LEASE_RELEASE: no keys.
+struct LeaseReleaseMsg {
+  friend bool operator==(const LeaseReleaseMsg&, const LeaseReleaseMsg&) = default;
+};
+/// LEASE_STATE: keys `holder`, `yours`.
+struct LeaseStateMsg {
+  std::string holder;  ///< name of the client holding the lease; empty if none
+  bool yours = false;  ///< whether the receiving connection holds it
+  friend bool operator==(const LeaseStateMsg&, const LeaseStateMsg&) = default;
+};
+/// COMMAND: keys `seq`, `expires_ms`, `command`.
+struct CommandMsg {
+  uint64_t seq = 0;        ///< increasing per connection
+  uint64_t expiresMs = 0;  ///< [ms] > 0: not to be executed later than this after sending
+  std::string command;     ///< sequence-file syntax without time, e.g. `drive 0.5 10`
+  friend bool operator==(const CommandMsg&, const CommandMsg&) = default;
+};
+/// REPLY: keys `seq`, `status`, `reason` (optional, default empty).
+struct ReplyMsg {
+  uint64_t seq = 0;  ///< the COMMAND's seq
+  ReplyStatus status = ReplyStatus::Ok;
+  std::string reason;  ///< why, when status is not ok
+  friend bool operator==(const ReplyMsg&, const ReplyMsg&) = default;
+};
+/// TELEMETRY: keys `seq`, `time`, `pose`, `joint_names`, `joint_positions`,
+/// `joint_velocities`, `wheel_normal`, `wheel_tangential`, `roll`, `pitch`,
+/// `rtt_ms`, `lost`, `failsafe`, `estop`, `health` (optional, default empty).
+/// The joint names come in every frame, so that any frame can be read alone.
+struct TelemetryMsg {
+  uint64_t seq = 0;    ///< increasing per connection; gaps are lost frames
+  double time = 0;     ///< [s] robot (twin) time of the state
+  Pose pose;           ///< main body in the world: [m], unit quaternion (`x y z qw qx qy qz`)
+  std::vector<std::string> jointNames;   ///< non-empty, without spaces
+  std::vector<double> jointPositions;    ///< [rad or m], one per name
+  std::vector<double> jointVelocities;   ///< [rad/s or m/s], one per name
+  std::array<double, 4> wheelNormal{};      ///< [N], FL FR RL RR
+  std::array<double, 4> wheelTangential{};  ///< [N], FL FR RL RR
+  double roll = 0, pitch = 0;  ///< [rad], body inclination
+  double rttMs = 0;            ///< [ms] round trip to this client, as the robot measures it
+  uint64_t lost = 0;           ///< telemetry frames the robot dropped for this client
+  bool failsafe = false;       ///< the deadman failsafe is latched
+  bool estop = false;          ///< an e-stop is latched
+  std::string health;          ///< empty when healthy, else why the twin stopped
+  friend bool operator==(const TelemetryMsg&, const TelemetryMsg&) = default;
+};
+/// LASER: keys `seq`, `time`, `angle_min`, `angle_step`, `ranges`.
+struct LaserMsg {
+  uint64_t seq = 0;
+  double time = 0;          ///< [s] robot time of the scan
+  double angleMin = 0;      ///< [rad] first beam, about the sensor's z; finite
+  double angleStep = 0;     ///< [rad] between beams; finite
+  std::vector<double> ranges;  ///< [m]; inf = no return, nan = invalid
+  friend bool operator==(const LaserMsg&, const LaserMsg&) = default;
+};
+/// HEARTBEAT: keys `seq`, `time`.
+struct HeartbeatMsg {
+  uint64_t seq = 0;  ///< the sender's heartbeat count
+  double time = 0;   ///< [s] the sender's monotonic clock when sent
+  friend bool operator==(const HeartbeatMsg&, const HeartbeatMsg&) = default;
+};
+/// ESTOP: key `reason` (optional).
+struct EstopMsg {
+  std::string reason;
+  friend bool operator==(const EstopMsg&, const EstopMsg&) = default;
+};
+/// REARM: no keys.
+struct RearmMsg {
+  friend bool operator==(const RearmMsg&, const RearmMsg&) = default;
+};
+/// EVENT: keys `kind`, `text` (optional).
+struct EventMsg {
+  EventKind kind = EventKind::Link;
+  std::string text;
+  friend bool operator==(const EventMsg&, const EventMsg&) = default;
+};
+/// ERROR: key `reason`.
+struct ErrorMsg {
+  std::string reason;
+  friend bool operator==(const ErrorMsg&, const ErrorMsg&) = default;
+};
+
+/// Any message. The alternatives are in type-code order: index() + 1 is the
+/// MessageType.
+using Message = std::variant<HelloMsg, WelcomeMsg, LeaseAcquireMsg, LeaseKeepaliveMsg, LeaseReleaseMsg,
+                             LeaseStateMsg, CommandMsg, ReplyMsg, TelemetryMsg, LaserMsg, HeartbeatMsg,
+                             EstopMsg, RearmMsg, EventMsg, ErrorMsg>;
+
+MessageType typeOf(const Message& message);
+
+/// The payload text of `message`. On error (a text value with a line feed
+/// or invalid UTF-8, a joint name that is empty or has a space, a value
+/// that breaks a rule above) returns nullopt and sets `error`, e.g.
+/// `HELLO: key 'name': must not be empty`.
+std::optional<std::string> encodePayload(const Message& message, std::string& error);
+
+/// The whole frame of `message`, ready to send; nullopt and `error` as for
+/// encodePayload, or when the payload exceeds kMaxPayloadSize (a laser scan
+/// of more than some 3400 full-precision ranges); never cut.
+std::optional<std::string> encodeMessage(const Message& message, std::string& error);
+
+/// The message in `frame`; on error nullopt and `error` names the type and,
+/// where there is one, the key or line, e.g. `COMMAND: missing key 'seq'`,
+/// `COMMAND: key 'seq': expected an unsigned integer, got '-1'`,
+/// `unknown message type 200`. Values are quoted at most 40 bytes long with
+/// control characters escaped; a bad token is never echoed.
+std::optional<Message> decodeMessage(const Frame& frame, std::string& error);
+
+/// A COMMAND carrying `command` as text (sp::toText: joint values are written
+/// as for hinges, in degrees; slider commands do not round-trip in this
+/// version, see sim/command.h).
+CommandMsg makeCommandMsg(uint64_t seq, uint64_t expiresMs, const Command& command);
+
+/// The twin command a COMMAND carries, parsed with sp::parseCommand against
+/// `robot` (may be null: every joint taken for a hinge). On error nullopt and
+/// `error` is `COMMAND: key 'command': ` plus the parser's message. Syntax
+/// only: limits are checked by sp::checkCommand.
+std::optional<Command> parseCommandMsg(const CommandMsg& message, const RobotModel* robot, std::string& error);
+
+}  // namespace sp::net

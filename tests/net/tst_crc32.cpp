@@ -1,0 +1,57 @@
+// Tests of the CRC-32 (net/crc32.h).
+
+#include <QtTest>
+
+#include <string>
+
+#include "net/crc32.h"
+
+using namespace sp::net;
+
+class TestCrc32 : public QObject {
+  Q_OBJECT
+
+ private slots:
+  void knownValues_data();
+  void knownValues();
+  void incrementalEqualsOneShot();
+};
+
+void TestCrc32::knownValues_data() {
+  QTest::addColumn<QByteArray>("bytes");
+  QTest::addColumn<uint>("crc");
+  QTest::newRow("check value") << QByteArray("123456789") << 0xCBF43926u;
+  QTest::newRow("empty") << QByteArray() << 0u;
+  QTest::newRow("a") << QByteArray("a") << 0xE8B7BE43u;
+  QTest::newRow("fox") << QByteArray("The quick brown fox jumps over the lazy dog") << 0x414FA339u;
+  QTest::newRow("zeros") << QByteArray(32, '\0') << 0x190A55ADu;
+}
+
+// The CRC is IEEE 802.3's (zlib's): the standard check value of "123456789"
+// and other published values.
+void TestCrc32::knownValues() {
+  QFETCH(QByteArray, bytes);
+  QFETCH(uint, crc);
+  QCOMPARE(crc32(std::string_view(bytes.constData(), static_cast<size_t>(bytes.size()))), crc);
+}
+
+// Feeding the bytes in two pieces, split anywhere, gives the one-shot value;
+// so does reset() and feeding again.
+void TestCrc32::incrementalEqualsOneShot() {
+  const std::string text = "The quick brown fox jumps over the lazy dog";
+  for (size_t split = 0; split <= text.size(); ++split) {
+    Crc32 crc;
+    crc.update(text.data(), split);
+    crc.update(std::string_view(text).substr(split));
+    QCOMPARE(crc.value(), 0x414FA339u);
+  }
+  Crc32 crc;
+  crc.update("junk", 4);
+  crc.reset();
+  crc.update(nullptr, 0);
+  crc.update("123456789", 9);
+  QCOMPARE(crc.value(), 0xCBF43926u);
+}
+
+QTEST_GUILESS_MAIN(TestCrc32)
+#include "tst_crc32.moc"
