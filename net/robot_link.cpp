@@ -1,0 +1,217 @@
+#include "net/robot_link.h"
+
+#include <algorithm>
+
+namespace sp::net {
+
+bool equalConstantTime(const std::string& a, const std::string& b) {
+  // Runs over the longer string whatever the contents, so the time taken
+  // tells nothing about where the first difference is.
+  const size_t n = std::max(a.size(), b.size());
+  unsigned char diff = a.size() == b.size() ? 0 : 1;
+  for (size_t i = 0; i < n; ++i) {
+    const unsigned char x = i < a.size() ? static_cast<unsigned char>(a[i]) : 0;
+    const unsigned char y = i < b.size() ? static_cast<unsigned char>(b[i]) : 0;
+    diff = static_cast<unsigned char>(diff | (x ^ y));
+  }
+  return diff == 0;
+}
+
+RobotLink::RobotLink(RobotLinkConfig config, const RobotModel* robot,
+                     std::function<std::string(const Command&)> check)
+    : config_(std::move(config)), robot_(robot), check_(std::move(check)) {}
+
+void RobotLink::connected(ClientId client, double) { clients_[client] = Client{}; }
+
+void RobotLink::disconnected(ClientId client, double) {
+  clients_.erase(client);
+  if (holder_ == client) {
+    // The lease goes with the connection; the deadman keeps counting from
+    // the holder's last packet and stops the robot (tick()).
+    holder_ = 0;
+    broadcastLease();
+  }
+}
+
+void RobotLink::send(ClientId client, Message message) { outgoing_.push_back({client, std::move(message)}); }
+
+void RobotLink::broadcast(const Message& message) {
+  for (const auto& [id, c] : clients_)
+    if (c.authenticated) send(id, message);
+}
+
+void RobotLink::broadcastLease() {
+  const std::string holderName = holder_ && clients_.count(holder_) ? clients_[holder_].name : std::string();
+  for (const auto& [id, c] : clients_)
+    if (c.authenticated) send(id, LeaseStateMsg{holderName, id == holder_});
+}
+
+void RobotLink::close(ClientId client, const std::string& reason) {
+  send(client, ErrorMsg{reason});
+  closing_.push_back(client);
+}
+
+void RobotLink::refuse(ClientId client, uint64_t seq, ReplyStatus status, std::string reason) {
+  ++refused_;
+  send(client, ReplyMsg{seq, status, std::move(reason)});
+}
+
+void RobotLink::stopEverything(EventKind why, const std::string& text, double now) {
+  commands_.emplace_back(std::in_place_type<StopCmd>);
+  if (why == EventKind::Failsafe) {
+    failsafe_ = true;
+    lastFailsafe_ = now;
+  } else {
+    estop_ = true;
+  }
+  broadcast(EventMsg{why, text});
+}
+
+void RobotLink::malformed(ClientId client, const std::string& error, double) {
+  close(client, "malformed frame: " + error);
+}
+
+void RobotLink::received(ClientId client, const Message& message, double now) {
+  auto it = clients_.find(client);
+  if (it == clients_.end()) return;
+  Client& c = it->second;
+
+  if (const auto* hello = std::get_if<HelloMsg>(&message)) {
+    if (c.authenticated) return send(client, ErrorMsg{"already authenticated"});
+    if (config_.token.empty() || !equalConstantTime(hello->token, config_.token))
+      return close(client, "authentication failed");
+    c.authenticated = true;
+    c.name = hello->name;
+    c.role = hello->role;
+    send(client, WelcomeMsg{config_.robotName, ++session_, config_.telemetryRate});
+    const std::string holderName = holder_ ? clients_[holder_].name : std::string();
+    send(client, LeaseStateMsg{holderName, false});
+    if (failsafe_) send(client, EventMsg{EventKind::Failsafe, "failsafe latched: re-arm to move"});
+    if (estop_) send(client, EventMsg{EventKind::Estop, "e-stop latched: re-arm to move"});
+    return;
+  }
+  // Nothing but HELLO before authentication: no telemetry, no control.
+  if (!c.authenticated) return close(client, "HELLO first");
+
+  std::visit(
+      [&](const auto& m) {
+        using T = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<T, LeaseAcquireMsg>) {
+          if (c.role != Role::Control) return send(client, ErrorMsg{"a monitor cannot take the control lease"});
+          if (holder_ && holder_ != client) return send(client, LeaseStateMsg{clients_[holder_].name, false});
+          holder_ = client;
+          lastFromHolder_ = now;
+          deadmanArmed_ = true;
+          broadcastLease();
+        } else if constexpr (std::is_same_v<T, LeaseKeepaliveMsg>) {
+          if (client == holder_) {
+            lastFromHolder_ = now;
+            deadmanArmed_ = true;
+          } else {
+            send(client, ErrorMsg{"LEASE_KEEPALIVE without the lease"});
+          }
+        } else if constexpr (std::is_same_v<T, LeaseReleaseMsg>) {
+          if (client == holder_) {
+            // A deliberate release stops the robot too, without latching:
+            // nobody is in control any more.
+            holder_ = 0;
+            deadmanArmed_ = false;
+            commands_.emplace_back(std::in_place_type<StopCmd>);
+            broadcastLease();
+          }
+        } else if constexpr (std::is_same_v<T, CommandMsg>) {
+          if (client != holder_) {
+            const std::string who = holder_ ? "'" + clients_[holder_].name + "' holds the lease" : "nobody holds the lease";
+            return refuse(client, m.seq, ReplyStatus::NotOwner, who);
+          }
+          if (c.anySeq && m.seq <= c.lastSeq)
+            return refuse(client, m.seq, ReplyStatus::Duplicate,
+                          m.seq == c.lastSeq ? "sequence number already used"
+                                             : "out of order: last sequence number was " + std::to_string(c.lastSeq));
+          c.anySeq = true;
+          c.lastSeq = m.seq;
+          // One-way delay estimated as half the measured round trip.
+          if (c.rttMs / 2 > static_cast<double>(m.expiresMs))
+            return refuse(client, m.seq, ReplyStatus::Expired,
+                          "arrived about " + std::to_string(static_cast<int>(c.rttMs / 2)) + " ms after sending, " +
+                              "expiry " + std::to_string(m.expiresMs) + " ms");
+          if (failsafe_ || estop_)
+            return refuse(client, m.seq, ReplyStatus::Failed,
+                          std::string(estop_ ? "e-stop" : "failsafe") + " latched: re-arm first");
+          std::string error;
+          const std::optional<Command> command = parseCommandMsg(m, robot_, error);
+          if (!command) return refuse(client, m.seq, ReplyStatus::Invalid, error);
+          if (std::string why = check_ ? check_(*command) : std::string(); !why.empty()) {
+            // Limits are refused, never clipped.
+            const bool limit = why.find("outside") != std::string::npos || why.find("exceeds") != std::string::npos;
+            return refuse(client, m.seq, limit ? ReplyStatus::OutOfLimits : ReplyStatus::Invalid, why);
+          }
+          lastFromHolder_ = now;
+          deadmanArmed_ = true;
+          commands_.push_back(*command);
+          ++accepted_;
+          send(client, ReplyMsg{m.seq, ReplyStatus::Ok, ""});
+        } else if constexpr (std::is_same_v<T, HeartbeatMsg>) {
+          // An echo of one of ours measures the round trip; the client's
+          // own heartbeats are echoed back for it to do the same.
+          if (m.seq >= (uint64_t{1} << 62)) c.rttMs = (now - m.time) * 1000;
+          else send(client, m);
+        } else if constexpr (std::is_same_v<T, EstopMsg>) {
+          stopEverything(EventKind::Estop, "e-stop from '" + c.name + "'" + (m.reason.empty() ? "" : ": " + m.reason),
+                         now);
+        } else if constexpr (std::is_same_v<T, RearmMsg>) {
+          if (c.role != Role::Control || (holder_ && holder_ != client))
+            return send(client, ErrorMsg{"only the lease holder re-arms"});
+          if (!failsafe_ && !estop_) return;
+          failsafe_ = estop_ = false;
+          lastFromHolder_ = now;
+          deadmanArmed_ = holder_ != 0;
+          broadcast(EventMsg{EventKind::Rearmed, "re-armed by '" + c.name + "'"});
+        } else {
+          send(client, ErrorMsg{std::string(toString(typeOf(message))) + " is not sent to the robot"});
+        }
+      },
+      message);
+}
+
+void RobotLink::tick(double now) {
+  // The deadman watches the holder, and keeps watching after a holder is
+  // lost until it fires: losing the operator stops the robot.
+  if (deadmanArmed_ && !failsafe_ && now - lastFromHolder_ > config_.deadman) {
+    stopEverything(EventKind::Failsafe,
+                   "no command or keep-alive from the controlling client for " +
+                       std::to_string(static_cast<int>(config_.deadman * 1000)) + " ms",
+                   now);
+    deadmanArmed_ = false;  // until a holder is heard again
+  }
+}
+
+void RobotLink::sendHeartbeats(double now) {
+  // Our sequence numbers live above 2^62, apart from the clients' own.
+  const uint64_t seq = (uint64_t{1} << 62) + ++heartbeatSeq_;
+  for (const auto& [id, c] : clients_)
+    if (c.authenticated) send(id, HeartbeatMsg{seq, now});
+}
+
+std::vector<RobotLink::Outgoing> RobotLink::takeOutgoing() { return std::exchange(outgoing_, {}); }
+std::vector<Command> RobotLink::takeCommands() { return std::exchange(commands_, {}); }
+std::vector<ClientId> RobotLink::takeClosing() { return std::exchange(closing_, {}); }
+
+bool RobotLink::authenticated(ClientId client) const {
+  auto it = clients_.find(client);
+  return it != clients_.end() && it->second.authenticated;
+}
+
+std::vector<ClientId> RobotLink::subscribers() const {
+  std::vector<ClientId> out;
+  for (const auto& [id, c] : clients_)
+    if (c.authenticated) out.push_back(id);
+  return out;
+}
+
+double RobotLink::rttMs(ClientId client) const {
+  auto it = clients_.find(client);
+  return it == clients_.end() ? 0 : it->second.rttMs;
+}
+
+}  // namespace sp::net

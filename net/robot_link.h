@@ -1,0 +1,121 @@
+#pragma once
+// The robot's side of the link, without sockets: sessions and token
+// authentication, the control lease, command checks (sequence, expiry,
+// limits), the safety chain (deadman failsafe, e-stop, re-arm, both latched)
+// and heartbeats. The stand-in robot and any real robot adapter feed it
+// decoded messages and the time, and carry out what it returns; tests drive
+// it with a fake clock. docs/protocol.md describes the behaviour.
+//
+// Thread: one thread at a time (the link's); no method is thread-safe.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "net/message.h"
+#include "sim/command.h"
+
+namespace sp {
+struct RobotModel;
+}
+
+namespace sp::net {
+
+using ClientId = uint64_t;
+
+struct RobotLinkConfig {
+  std::string robotName = "workpartner";
+  std::string token;            ///< shared secret, >= 32 hex digits; checked in constant time
+  double deadman = 0.2;         ///< [s] without a command or keep-alive from the holder => failsafe
+  double telemetryRate = 50;    ///< [Hz], announced in WELCOME
+};
+
+/// Constant-time comparison (no early exit), for tokens.
+bool equalConstantTime(const std::string& a, const std::string& b);
+
+class RobotLink {
+ public:
+  /// `robot` (may be null) parses command text; `check` validates a parsed
+  /// command against the robot's limits ("" = fine), e.g. World::submit's
+  /// checks via sp::checkCommand.
+  RobotLink(RobotLinkConfig config, const RobotModel* robot, std::function<std::string(const Command&)> check);
+
+  void connected(ClientId client, double now);
+  /// Drops the client; a lease holder's lease is released (the deadman
+  /// then fires, and the failsafe latches, as for any lost holder).
+  void disconnected(ClientId client, double now);
+  /// One decoded message from a client at time `now` [s, monotonic].
+  void received(ClientId client, const Message& message, double now);
+  /// A frame from the client could not be decoded: answers ERROR and asks
+  /// for the connection to close.
+  void malformed(ClientId client, const std::string& error, double now);
+  /// Checks the deadman; call often (every few ms).
+  void tick(double now);
+
+  struct Outgoing {
+    ClientId client;
+    Message message;
+  };
+  /// Messages to send since the last call, in order.
+  std::vector<Outgoing> takeOutgoing();
+  /// Twin commands to apply since the last call, in order (checked).
+  std::vector<Command> takeCommands();
+  /// Clients whose connection must be closed (after their last messages).
+  std::vector<ClientId> takeClosing();
+
+  bool failsafeLatched() const { return failsafe_; }
+  bool estopLatched() const { return estop_; }
+  /// The lease holder, 0 if none.
+  ClientId holder() const { return holder_; }
+  bool authenticated(ClientId client) const;
+  /// Clients that receive telemetry (every authenticated one).
+  std::vector<ClientId> subscribers() const;
+  /// Round-trip time to a client from its heartbeat echoes [ms], 0 unknown.
+  double rttMs(ClientId client) const;
+  /// Counters for logs and tests.
+  uint64_t commandsAccepted() const { return accepted_; }
+  uint64_t commandsRefused() const { return refused_; }
+  /// When the failsafe last fired [s], for deadman timing; -1 if never.
+  double lastFailsafeTime() const { return lastFailsafe_; }
+
+  /// A heartbeat to send to every client now (the robot's own, which
+  /// clients echo so that the robot can measure round trips).
+  void sendHeartbeats(double now);
+
+ private:
+  struct Client {
+    bool authenticated = false;
+    std::string name;
+    Role role = Role::Monitor;
+    uint64_t lastSeq = 0;
+    bool anySeq = false;
+    double rttMs = 0;
+  };
+  void send(ClientId client, Message message);
+  void broadcast(const Message& message);
+  void broadcastLease();
+  void refuse(ClientId client, uint64_t seq, ReplyStatus status, std::string reason);
+  void stopEverything(EventKind why, const std::string& text, double now);
+  void close(ClientId client, const std::string& reason);
+
+  RobotLinkConfig config_;
+  const RobotModel* robot_;
+  std::function<std::string(const Command&)> check_;
+  std::map<ClientId, Client> clients_;
+  ClientId holder_ = 0;
+  double lastFromHolder_ = 0;
+  bool deadmanArmed_ = false;
+  bool failsafe_ = false, estop_ = false;
+  double lastFailsafe_ = -1;
+  uint64_t session_ = 0;
+  uint64_t heartbeatSeq_ = 0;
+  uint64_t accepted_ = 0, refused_ = 0;
+  std::vector<Outgoing> outgoing_;
+  std::vector<Command> commands_;
+  std::vector<ClientId> closing_;
+};
+
+}  // namespace sp::net
