@@ -1,0 +1,267 @@
+#include "net/robot_server.h"
+
+#include <chrono>
+#include <random>
+
+namespace sp::net {
+
+std::string randomToken() {
+  std::random_device device;
+  std::string token;
+  static const char* hex = "0123456789abcdef";
+  for (int i = 0; i < 32; ++i) token += hex[device() & 15u];
+  return token;
+}
+
+/// One client connection: its socket, decoder and bounded write queue.
+class RobotServer::Session {
+ public:
+  Session(asio::ip::tcp::socket connected, ClientId clientId) : socket(std::move(connected)), id(clientId) {}
+
+  asio::ip::tcp::socket socket;
+  ClientId id;
+  FrameDecoder decoder;
+  std::array<char, 4096> readBuffer{};
+  struct Queued {
+    std::string bytes;
+    bool telemetry;  // telemetry and laser frames may be dropped
+  };
+  std::deque<Queued> queue;  // frames to write, front first
+  size_t queuedTelemetry = 0;
+  bool writing = false, reading = false;
+  bool closing = false;  // write what is queued, then close
+  bool closed = false;
+  uint64_t telemetrySeq = 0, laserSeq = 0, lost = 0;
+};
+
+RobotServer::RobotServer(asio::io_context& io, RobotServerConfig config, RobotPort& robot)
+    : io_(io),
+      config_(std::move(config)),
+      robot_(robot),
+      link_(config_.link, robot.model(), [&robot](const Command& c) { return robot.check(c); }),
+      acceptor_(io),
+      timer_(io) {}
+
+RobotServer::~RobotServer() { stop(); }
+
+double RobotServer::now() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string RobotServer::start() {
+  if (config_.link.token.size() < 32) return "the token must have at least 32 hex digits (128 bits)";
+  asio::error_code ec;
+  const asio::ip::address address = asio::ip::make_address(config_.address, ec);
+  if (ec) return "bad address '" + config_.address + "': " + ec.message();
+  const asio::ip::tcp::endpoint endpoint(address, config_.port);
+  acceptor_.open(endpoint.protocol(), ec);
+  if (!ec) acceptor_.set_option(asio::ip::tcp::acceptor::reuse_address(true), ec);
+  if (!ec) acceptor_.bind(endpoint, ec);
+  if (!ec) acceptor_.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec) return "cannot listen on " + config_.address + ":" + std::to_string(config_.port) + ": " + ec.message();
+  port_ = acceptor_.local_endpoint().port();
+  accept();
+  const double t = now();
+  nextTelemetry_ = t;
+  nextHeartbeat_ = t;
+  schedule();
+  return {};
+}
+
+void RobotServer::stop() {
+  if (stopped_) return;
+  stopped_ = true;
+  asio::error_code ec;
+  acceptor_.close(ec);
+  timer_.cancel();
+  for (auto& [id, s] : sessions_) s->socket.close(ec);
+}
+
+void RobotServer::accept() {
+  acceptor_.async_accept([this](asio::error_code ec, asio::ip::tcp::socket socket) {
+    if (ec || stopped_) return;
+    asio::error_code ignored;
+    socket.set_option(asio::ip::tcp::no_delay(true), ignored);
+    const ClientId id = nextId_++;
+    auto session = std::make_unique<Session>(std::move(socket), id);
+    Session& s = *session;
+    sessions_[id] = std::move(session);
+    ++stats_.clientsAccepted;
+    link_.connected(id, now());
+    (void)s;
+    startRead(id);
+    accept();
+  });
+}
+
+void RobotServer::startRead(ClientId id) {
+  auto it = sessions_.find(id);
+  if (it == sessions_.end() || it->second->closed) return;
+  Session& s = *it->second;
+  s.reading = true;
+  // Completions look the session up by id: a session closed meanwhile is
+  // only erased once no operation refers to its buffers.
+  s.socket.async_read_some(asio::buffer(s.readBuffer), [this, id](asio::error_code ec, size_t n) {
+    auto found = sessions_.find(id);
+    if (found == sessions_.end()) return;
+    Session& ses = *found->second;
+    ses.reading = false;
+    if (ec || ses.closed) return closeSession(id);
+    received(id, std::string(ses.readBuffer.data(), n));
+    startRead(id);
+  });
+}
+
+void RobotServer::enqueue(Session& s, const Message& message, bool telemetry) {
+  std::string error;
+  std::optional<std::string> frame = encodeMessage(message, error);
+  if (!frame) return;
+  if (telemetry && s.queuedTelemetry >= config_.maxQueuedFrames) {
+    // A slow reader loses telemetry; the control loop never waits for it.
+    ++s.lost;
+    ++stats_.telemetryDropped;
+    return;
+  }
+  if (!telemetry && s.queue.size() >= config_.maxQueuedControl) {
+    s.closing = true;  // a client that does not read its replies is dropped
+    return;
+  }
+  s.queuedTelemetry += telemetry;
+  s.queue.push_back({std::move(*frame), telemetry});
+}
+
+void RobotServer::received(ClientId id, const std::string& bytes) {
+  Session& s = *sessions_.at(id);
+  s.decoder.feed(bytes);
+  while (std::optional<Frame> frame = s.decoder.next()) {
+    ++stats_.framesIn;
+    std::string error;
+    const std::optional<Message> message = decodeMessage(*frame, error);
+    if (!message) {
+      // A well-framed message with bad content: refused, connection kept.
+      link_.received(id, ErrorMsg{"refused: " + error}, now());
+      continue;
+    }
+    link_.received(id, *message, now());
+  }
+  if (s.decoder.failed()) {
+    // A broken frame: the stream cannot be resynchronised; close it.
+    ++stats_.badFrames;
+    link_.malformed(id, s.decoder.errorMessage(), now());
+  }
+  flush();
+}
+
+void RobotServer::flush() {
+  const std::vector<Command> commands = link_.takeCommands();
+  if (!commands.empty()) robot_.apply(commands);
+  for (const RobotLink::Outgoing& o : link_.takeOutgoing()) {
+    auto it = sessions_.find(o.client);
+    if (it != sessions_.end() && !it->second->closed) enqueue(*it->second, o.message, false);
+  }
+  for (ClientId id : link_.takeClosing()) {
+    auto it = sessions_.find(id);
+    if (it != sessions_.end()) it->second->closing = true;
+  }
+  for (auto& [id, ptr] : sessions_) {
+    Session& s = *ptr;
+    if (s.writing || s.closed) continue;
+    if (s.queue.empty()) {
+      if (s.closing) closeSession(id);
+      continue;
+    }
+    s.writing = true;
+    const ClientId sid = id;
+    asio::async_write(s.socket, asio::buffer(s.queue.front().bytes), [this, sid](asio::error_code ec, size_t) {
+      auto it = sessions_.find(sid);
+      if (it == sessions_.end()) return;
+      Session& ses = *it->second;
+      ses.writing = false;
+      if (ec) return closeSession(sid);
+      ses.queuedTelemetry -= ses.queue.front().telemetry;
+      ses.queue.pop_front();
+      flush();
+    });
+    // Only one frame per write; flush() continues from the completion.
+  }
+}
+
+void RobotServer::closeSession(ClientId id) {
+  auto it = sessions_.find(id);
+  if (it == sessions_.end()) return;
+  Session& s = *it->second;
+  if (!s.closed) {
+    s.closed = true;
+    asio::error_code ec;
+    s.socket.shutdown(asio::ip::tcp::socket::shutdown_both, ec);
+    s.socket.close(ec);
+    link_.disconnected(id, now());
+  }
+  // Erase only when no operation still refers to the session's buffers.
+  if (!s.reading && !s.writing) sessions_.erase(it);
+  flush();
+}
+
+void RobotServer::schedule() {
+  if (stopped_) return;
+  // 2 ms: the deadman's resolution (it must stop within 300 ms, fires at 200).
+  timer_.expires_after(std::chrono::milliseconds(2));
+  timer_.async_wait([this](asio::error_code ec) {
+    if (ec || stopped_) return;
+    onTimer();
+    schedule();
+  });
+}
+
+void RobotServer::onTimer() {
+  const double t = now();
+  link_.tick(t);
+  if (t >= nextHeartbeat_) {
+    nextHeartbeat_ = t + 0.5;
+    link_.sendHeartbeats(t);
+  }
+  std::vector<std::pair<ClientId, Message>> frames;
+  if (t >= nextTelemetry_) {
+    nextTelemetry_ += 1.0 / config_.link.telemetryRate;
+    if (nextTelemetry_ < t) nextTelemetry_ = t;  // no burst after a stall
+    const RobotState st = robot_.state();
+    for (ClientId id : link_.subscribers()) {
+      auto it = sessions_.find(id);
+      if (it == sessions_.end()) continue;
+      Session& s = *it->second;
+      TelemetryMsg m;
+      m.seq = ++s.telemetrySeq;
+      m.time = st.time;
+      m.pose = st.pose;
+      m.jointNames = st.jointNames;
+      m.jointPositions = st.jointPositions;
+      m.jointVelocities = st.jointVelocities;
+      m.wheelNormal = st.wheelNormal;
+      m.wheelTangential = st.wheelTangential;
+      m.roll = st.roll;
+      m.pitch = st.pitch;
+      m.rttMs = link_.rttMs(id);
+      m.lost = s.lost;
+      m.failsafe = link_.failsafeLatched();
+      m.estop = link_.estopLatched();
+      m.health = st.health;
+      frames.emplace_back(id, std::move(m));
+    }
+  }
+  if (std::optional<LaserScanState> scan = robot_.laserAfter(lastLaser_)) {
+    lastLaser_ = scan->count;
+    for (ClientId id : link_.subscribers()) {
+      auto it = sessions_.find(id);
+      if (it == sessions_.end()) continue;
+      frames.emplace_back(id, LaserMsg{++it->second->laserSeq, scan->time, scan->angleMin, scan->angleStep,
+                                       scan->ranges});
+    }
+  }
+  for (auto& [id, m] : frames) {
+    auto it = sessions_.find(id);
+    if (it != sessions_.end() && !it->second->closed) enqueue(*it->second, m, true);
+  }
+  flush();
+}
+
+}  // namespace sp::net

@@ -1,0 +1,120 @@
+#pragma once
+// The robot's TCP endpoint: accepts clients on loopback (or another address
+// with a token), decodes frames, lets RobotLink decide, and sends replies,
+// telemetry, laser scans and heartbeats. The same server fronts the twin
+// (simpartner-robot) and would front a real robot's adapter: the robot is
+// reached only through RobotPort.
+//
+// Thread: everything runs on the io_context's thread; RobotPort methods are
+// called from it.
+
+#include <asio.hpp>
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "net/frame.h"
+#include "net/message.h"
+#include "net/robot_link.h"
+
+namespace sp::net {
+
+/// The robot's state for one TELEMETRY frame (the server adds the per-client
+/// sequence number, round trip, losses and latches).
+struct RobotState {
+  double time = 0;
+  Pose pose;
+  std::vector<std::string> jointNames;
+  std::vector<double> jointPositions, jointVelocities;
+  std::array<double, 4> wheelNormal{}, wheelTangential{};
+  double roll = 0, pitch = 0;
+  std::string health;  ///< empty when healthy
+};
+
+struct LaserScanState {
+  uint64_t count = 0;  ///< scans taken so far; a new scan has a higher count
+  double time = 0, angleMin = 0, angleStep = 0;
+  std::vector<double> ranges;
+};
+
+/// What the server needs of the robot. Called on the server's thread; an
+/// implementation hands work to its own threads (the twin's physics thread).
+class RobotPort {
+ public:
+  virtual ~RobotPort() = default;
+  virtual const RobotModel* model() const = 0;
+  /// "" if the command is within limits, else why not.
+  virtual std::string check(const Command& command) const = 0;
+  /// Carries out checked commands, in order, at the next step boundary.
+  virtual void apply(const std::vector<Command>& commands) = 0;
+  virtual RobotState state() const = 0;
+  /// The latest laser scan, if one newer than `afterCount` exists.
+  virtual std::optional<LaserScanState> laserAfter(uint64_t afterCount) const = 0;
+};
+
+struct RobotServerConfig {
+  std::string address = "127.0.0.1";
+  uint16_t port = 47800;             ///< 0 = any free port
+  RobotLinkConfig link;
+  size_t maxQueuedFrames = 64;       ///< per client; telemetry beyond it is dropped and counted
+  size_t maxQueuedControl = 1024;    ///< replies and events beyond it close a client that does not read
+};
+
+struct RobotServerStats {
+  uint64_t clientsAccepted = 0;
+  uint64_t framesIn = 0;
+  uint64_t badFrames = 0;       ///< connections closed for a malformed frame
+  uint64_t telemetryDropped = 0;
+};
+
+class RobotServer {
+ public:
+  RobotServer(asio::io_context& io, RobotServerConfig config, RobotPort& robot);
+  ~RobotServer();
+  /// Binds and starts accepting; "" on success, else why not (address in use,
+  /// a non-loopback address without a token, a token under 128 bits).
+  std::string start();
+  void stop();
+  uint16_t port() const { return port_; }
+  const RobotServerStats& stats() const { return stats_; }
+  const RobotLink& link() const { return link_; }
+
+ private:
+  class Session;
+  void accept();
+  void startRead(ClientId id);
+  void enqueue(Session& session, const Message& message, bool telemetry);
+  void schedule();
+  void onTimer();
+  void flush();
+  void received(ClientId id, const std::string& bytes);
+  void closeSession(ClientId id);
+  double now() const;
+
+  asio::io_context& io_;
+  RobotServerConfig config_;
+  RobotPort& robot_;
+  RobotLink link_;
+  asio::ip::tcp::acceptor acceptor_;
+  asio::steady_timer timer_;
+  // Sessions are owned here; asynchronous handlers hold only their id and
+  // look the session up, so a closed session is never touched.
+  std::map<ClientId, std::unique_ptr<Session>> sessions_;
+  ClientId nextId_ = 1;
+  uint16_t port_ = 0;
+  double nextTelemetry_ = 0, nextHeartbeat_ = 0;
+  uint64_t lastLaser_ = 0;
+  RobotServerStats stats_;
+  bool stopped_ = false;
+};
+
+/// A random token of 128 bits, as 32 hex digits.
+std::string randomToken();
+
+}  // namespace sp::net
