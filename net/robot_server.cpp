@@ -82,6 +82,10 @@ void RobotServer::accept() {
     if (ec || stopped_) return;
     asio::error_code ignored;
     socket.set_option(asio::ip::tcp::no_delay(true), ignored);
+    // A small kernel send buffer keeps a slow client's backlog in our
+    // bounded queue, where old telemetry is dropped, instead of megabytes of
+    // stale frames in the kernel.
+    socket.set_option(asio::socket_base::send_buffer_size(64 * 1024), ignored);
     const ClientId id = nextId_++;
     auto session = std::make_unique<Session>(std::move(socket), id);
     Session& s = *session;

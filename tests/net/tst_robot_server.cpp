@@ -1,0 +1,272 @@
+// The stand-in robot's server on real loopback sockets, with the real twin
+// behind it: authentication, bad frames (the server keeps serving everyone
+// else), lease races, the deadman, e-stop, and a monitor that never reads.
+
+#include <QtTest>
+
+#include <asio.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <random>
+#include <thread>
+
+#include "app/twin_host.h"
+#include "net/robot_server.h"
+#include "sim/model_loader.h"
+
+using namespace sp;
+using namespace sp::net;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+const std::string kToken = "00112233445566778899aabbccddeeff";
+
+double seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
+
+/// The twin and its server on an io_context thread, on a free port.
+struct Robot {
+  std::unique_ptr<TwinHost> host;
+  asio::io_context io;
+  std::unique_ptr<RobotServer> server;
+  std::thread thread;
+
+  Robot() {
+    Diagnostics diag;
+    auto model = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
+    if (!model) qFatal("%s", diag.format().c_str());
+    host = std::make_unique<TwinHost>(World::create(*model, SimParams{}, diag), 1.0);
+    RobotServerConfig config;
+    config.port = 0;
+    config.link.token = kToken;
+    server = std::make_unique<RobotServer>(io, config, *host);
+    const std::string error = server->start();
+    if (!error.empty()) qFatal("%s", error.c_str());
+    host->start();
+    thread = std::thread([this] { io.run(); });
+  }
+  ~Robot() {
+    asio::post(io, [this] { server->stop(); io.stop(); });
+    thread.join();
+    host->stop();
+  }
+};
+
+/// A blocking client for tests: frames in and out, with timeouts.
+struct Client {
+  asio::io_context io;
+  asio::ip::tcp::socket socket{io};
+  FrameDecoder decoder;
+  bool eof = false;
+
+  explicit Client(uint16_t port) {
+    socket.connect({asio::ip::make_address("127.0.0.1"), port});
+    socket.non_blocking(true);
+  }
+  void send(const Message& m) {
+    std::string error;
+    const auto frame = encodeMessage(m, error);
+    if (!frame) qFatal("%s", error.c_str());
+    asio::error_code ec;
+    asio::write(socket, asio::buffer(*frame), ec);
+  }
+  void sendRaw(const std::string& bytes) {
+    asio::error_code ec;
+    asio::write(socket, asio::buffer(bytes), ec);
+  }
+  /// The next message within `timeout` seconds, or nullopt.
+  std::optional<Message> next(double timeout) {
+    const auto t0 = Clock::now();
+    while (true) {
+      if (auto frame = decoder.next()) {
+        std::string error;
+        return decodeMessage(*frame, error);
+      }
+      if (eof || seconds(t0) > timeout) return std::nullopt;
+      char buf[4096];
+      asio::error_code ec;
+      const size_t n = socket.read_some(asio::buffer(buf), ec);
+      if (ec == asio::error::would_block) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        continue;
+      }
+      if (ec) {
+        eof = true;
+        continue;
+      }
+      decoder.feed(buf, n);
+    }
+  }
+  /// Waits for a message of type T (skipping others) within `timeout`.
+  template <typename T>
+  std::optional<T> waitFor(double timeout) {
+    const auto t0 = Clock::now();
+    while (seconds(t0) < timeout) {
+      auto m = next(timeout - seconds(t0));
+      if (!m) return std::nullopt;
+      if (auto* t = std::get_if<T>(&*m)) return *t;
+    }
+    return std::nullopt;
+  }
+  void hello(Role role, const std::string& name) {
+    send(HelloMsg{name, kToken, role});
+    QVERIFY(waitFor<WelcomeMsg>(2.0));
+  }
+};
+
+}  // namespace
+
+class TestRobotServer : public QObject {
+  Q_OBJECT
+
+ private slots:
+  // A wrong token gets ERROR and the connection is closed.
+  void wrongToken() {
+    Robot robot;
+    Client c(robot.server->port());
+    c.send(HelloMsg{"intruder", "ffffffffffffffffffffffffffffffff", Role::Control});
+    const auto error = c.waitFor<ErrorMsg>(2.0);
+    QVERIFY(error);
+    QCOMPARE(error->reason, std::string("authentication failed"));
+    QVERIFY(!c.next(1.0));
+    QVERIFY(c.eof);
+  }
+
+  // Garbage and an oversize frame close only their own connections; a
+  // monitor keeps receiving telemetry throughout.
+  void badFramesCloseOnlyTheirConnection() {
+    Robot robot;
+    Client monitor(robot.server->port());
+    monitor.hello(Role::Monitor, "monitor");
+    QVERIFY(monitor.waitFor<TelemetryMsg>(1.0));
+    Client garbage(robot.server->port());
+    garbage.sendRaw("GET / HTTP/1.1\r\nHost: robot\r\n\r\n");
+    QVERIFY(garbage.waitFor<ErrorMsg>(2.0));
+    Client oversize(robot.server->port());
+    // A header claiming a 1 GiB payload: refused at once, nothing allocated.
+    oversize.sendRaw(std::string("SP\x01\x07", 4) + std::string("\x00\x00\x00\x40", 4));
+    QVERIFY(oversize.waitFor<ErrorMsg>(2.0));
+    QVERIFY(!oversize.next(0.5));
+    QVERIFY(oversize.eof);
+    int telemetry = 0;
+    const auto t0 = Clock::now();
+    while (seconds(t0) < 1.0)
+      if (monitor.waitFor<TelemetryMsg>(0.2)) ++telemetry;
+    QVERIFY2(telemetry >= 40, qPrintable(QString::number(telemetry)));
+    QCOMPARE(robot.server->stats().badFrames, uint64_t{2});
+  }
+
+  // Several controlling clients race for the lease: exactly one wins.
+  void leaseRace() {
+    Robot robot;
+    std::vector<std::unique_ptr<Client>> clients;
+    for (int i = 0; i < 5; ++i) {
+      clients.push_back(std::make_unique<Client>(robot.server->port()));
+      clients.back()->hello(Role::Control, "c" + std::to_string(i));
+    }
+    std::vector<std::thread> racers;
+    for (auto& c : clients) racers.emplace_back([&c] { c->send(LeaseAcquireMsg{}); });
+    for (auto& t : racers) t.join();
+    int winners = 0;
+    for (auto& c : clients) {
+      const auto t0 = Clock::now();
+      bool mine = false;
+      while (seconds(t0) < 0.5)
+        if (auto s = c->waitFor<LeaseStateMsg>(0.5 - seconds(t0)); s && s->yours) mine = true;
+      winners += mine;
+    }
+    QCOMPARE(winners, 1);
+  }
+
+  // Deadman over the network: the holder drives, then goes silent at a
+  // random moment; a monitor hears the failsafe 200-300 ms after the last
+  // packet, and the robot stops. Reports the worst of the trials.
+  void deadmanOverSockets() {
+    Robot robot;
+    Client monitor(robot.server->port());
+    monitor.hello(Role::Monitor, "monitor");
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> cut(0.05, 0.4);
+    double worst = 0;
+    for (int trial = 0; trial < 6; ++trial) {
+      Client holder(robot.server->port());
+      holder.hello(Role::Control, "operator");
+      holder.send(LeaseAcquireMsg{});
+      holder.send(RearmMsg{});  // clear the previous trial's failsafe
+      holder.send(CommandMsg{1, 1000, "drive 0.3 0"});
+      const double silentAfter = cut(rng);
+      auto lastPacket = Clock::now();
+      const auto t0 = Clock::now();
+      while (seconds(t0) < silentAfter) {
+        holder.send(LeaseKeepaliveMsg{});
+        lastPacket = Clock::now();
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+      // Silent from here, connection still open.
+      std::optional<EventMsg> event;
+      while (!event || event->kind != EventKind::Failsafe) {
+        event = monitor.waitFor<EventMsg>(1.0);
+        QVERIFY(event);
+      }
+      const double delay = seconds(lastPacket);
+      QVERIFY2(delay >= 0.2 && delay < 0.3 + 0.02, qPrintable(QString::number(delay)));
+      worst = std::max(worst, delay);
+    }
+    qInfo("deadman over loopback: worst failsafe event %.0f ms after the last packet (6 random cuts)",
+          worst * 1000);
+  }
+
+  // E-stop from a monitor stops a driving robot and latches.
+  void estopStops() {
+    Robot robot;
+    Client holder(robot.server->port());
+    holder.hello(Role::Control, "operator");
+    Client monitor(robot.server->port());
+    monitor.hello(Role::Monitor, "supervisor");
+    holder.send(LeaseAcquireMsg{});
+    holder.send(CommandMsg{1, 1000, "wheels 3 3 3 3"});
+    std::this_thread::sleep_for(std::chrono::milliseconds(800));
+    monitor.send(EstopMsg{"test"});
+    // Telemetry queued before the e-stop comes first; wait for the latch,
+    // then a second for the wheels to stop.
+    std::optional<TelemetryMsg> t;
+    const auto t0 = Clock::now();
+    while (seconds(t0) < 5.0 && !(t && t->estop)) t = monitor.waitFor<TelemetryMsg>(1.0);
+    QVERIFY(t && t->estop);
+    const double latched = t->time;
+    while (seconds(t0) < 8.0 && t && t->time < latched + 1.0) t = monitor.waitFor<TelemetryMsg>(1.0);
+    QVERIFY(t && t->estop);
+    const size_t wheel = static_cast<size_t>(
+        std::find(t->jointNames.begin(), t->jointNames.end(), "wheel_fl") - t->jointNames.begin());
+    QVERIFY(wheel < t->jointNames.size());
+    QVERIFY2(std::abs(t->jointVelocities.at(wheel)) < 0.1, qPrintable(QString::number(t->jointVelocities.at(wheel))));
+    holder.send(CommandMsg{2, 1000, "wheels 1 1 1 1"});
+    std::optional<ReplyMsg> reply;
+    const auto t1 = Clock::now();
+    while (seconds(t1) < 5.0 && !(reply && reply->seq == 2)) reply = holder.waitFor<ReplyMsg>(1.0);
+    QVERIFY(reply && reply->seq == 2 && reply->status == ReplyStatus::Failed);
+    QVERIFY(reply->reason.find("latched") != std::string::npos);
+  }
+
+  // A monitor that never reads cannot stall anyone: its telemetry is
+  // dropped and counted while another client keeps getting 50 Hz.
+  void slowMonitorDropsOnlyItsOwn() {
+    Robot robot;
+    Client sleeper(robot.server->port());
+    sleeper.hello(Role::Monitor, "sleeper");
+    sleeper.socket.set_option(asio::socket_base::receive_buffer_size(4096));
+    Client reader(robot.server->port());
+    reader.hello(Role::Monitor, "reader");
+    int telemetry = 0;
+    const auto t0 = Clock::now();
+    while (seconds(t0) < 4.0)
+      if (reader.waitFor<TelemetryMsg>(0.2)) ++telemetry;
+    QVERIFY2(telemetry >= 170, qPrintable(QString::number(telemetry)));
+    QVERIFY(robot.server->stats().telemetryDropped > 0);
+  }
+};
+
+QTEST_GUILESS_MAIN(TestRobotServer)
+#include "tst_robot_server.moc"
