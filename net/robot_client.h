@@ -1,0 +1,207 @@
+#pragma once
+// The console's client of the robot link (docs/protocol.md): one TCP
+// connection to the robot or to `simpartner-robot`, kept up by reconnecting,
+// with the protocol's housekeeping done for the caller: HELLO after every
+// connect, keep-alives while holding the lease, heartbeats both ways, and
+// link statistics (round-trip time, telemetry rate, lost telemetry frames).
+//
+// Threads. The client owns a worker thread running its own asio::io_context
+// (start() creates it, stop() joins it). Every public method may be called
+// from any thread: it posts its work into the io_context and returns at once
+// (stats() copies under a mutex). All callbacks run on the worker thread,
+// one at a time, in the order the messages arrived: they must return quickly
+// and must not touch widgets. A Qt console re-posts what it needs to the GUI
+// thread, e.g.
+//
+//   callbacks.telemetry = [console](const sp::net::TelemetryMsg& t) {
+//     QMetaObject::invokeMethod(console, [console, t] { console->showTelemetry(t); },
+//                               Qt::QueuedConnection);
+//   };
+//
+// Asio does not appear in this header (the state lives behind a pointer), so
+// the console's Qt code includes it without Asio's headers.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "net/link_emulator.h"
+#include "net/message.h"
+#include "sim/command.h"
+
+namespace sp::net {
+
+/// Where the client connects and how it behaves. Defaults give a console
+/// client of a robot on this machine at the protocol's default port.
+struct RobotClientConfig {
+  std::string host = "127.0.0.1";  ///< name or address of the robot
+  uint16_t port = 47800;           ///< the robot's `port.robot`
+  std::string name = "console";    ///< HELLO `name`: shown to other clients as the lease holder
+  std::string token;               ///< HELLO `token`: the robot's shared secret, >= 32 hex digits
+  Role role = Role::Control;       ///< HELLO `role`: Monitor never asks for the lease
+
+  double reconnectMin = 0.2;  ///< [s] wait before the first reconnect after a drop or failed connect
+  double reconnectMax = 2.0;  ///< [s] the wait doubles up to this after each failure
+  double keepaliveInterval = 0.05;  ///< [s] LEASE_KEEPALIVE period while holding the lease (robot deadman: 0.2 s)
+  double heartbeatInterval = 0.2;   ///< [s] period of the client's own HEARTBEATs (round-trip time)
+  uint64_t commandExpiryMs = 500;   ///< [ms] COMMAND `expires_ms` when a send call passes 0
+  /// [s] a command without REPLY after its expiry plus max(this, 3 x RTT) is
+  /// answered locally (status Failed, see sendCommand()).
+  double replyGrace = 2.0;
+  /// [s] nothing received from the robot for this long (telemetry flows at
+  /// tens of Hz, heartbeats every few hundred ms) => the connection is taken
+  /// for dead, closed and made again. Must exceed the round trip of the
+  /// slowest emulated link (a WELCOME answers the HELLO one round trip later).
+  double silenceTimeout = 5.0;
+  /// After a reconnect, ask for the lease again if it was held when the
+  /// connection dropped. Off by default: the operator takes control again
+  /// deliberately. With it on and a reconnect quicker than the robot's
+  /// deadman (reconnectMin below 0.2 s plus a round trip), the new lease can
+  /// come before the failsafe fires, and the robot carries on; once fired,
+  /// the failsafe stays latched until rearm() whatever this says.
+  bool reacquireLease = false;
+  /// Emulated delay, jitter and loss for the frames this client sends
+  /// (inactive by default). Frames still on the emulated link when the
+  /// connection drops are lost with it.
+  LinkEmulatorConfig emulation;
+};
+
+/// The client's connection, as reported to the `connection` callback.
+enum class ConnectionState {
+  Stopped,         ///< not started, or stop() called
+  Connecting,      ///< resolving the host and connecting
+  Authenticating,  ///< connected, HELLO sent, waiting for WELCOME
+  Ready,           ///< WELCOME received: telemetry flows, the lease may be taken
+  Waiting,         ///< the connection dropped or failed; reconnecting after the backoff
+  Refused,         ///< the robot refused the HELLO (wrong token): no more attempts until stop() and start()
+};
+const char* toString(ConnectionState state);  ///< "stopped", "connecting", ...
+
+/// Link statistics, a copy taken by RobotClient::stats(). Counters run over
+/// the client's life (across reconnects) unless said otherwise.
+struct RobotClientStats {
+  ConnectionState state = ConnectionState::Stopped;
+  bool connected = false;  ///< Ready: WELCOME received on the current connection
+  bool leaseHeld = false;  ///< the last LEASE_STATE on this connection said `yours=1`
+  std::string robot;       ///< the robot's name from WELCOME
+  double rttMs = 0;        ///< [ms] last round trip of our heartbeats (0 before the first echo)
+  double rttMeanMs = 0;    ///< [ms] smoothed round trip (moving average, gain 1/8, as TCP's SRTT)
+  double rttMaxMs = 0;     ///< [ms] largest round trip seen
+  uint64_t rttSamples = 0;            ///< heartbeat echoes received
+  double robotRttMs = 0;              ///< [ms] round trip as the robot measures it (TELEMETRY `rtt_ms`)
+  double telemetryRateAnnounced = 0;  ///< [Hz] WELCOME `telemetry_rate`
+  double telemetryRateHz = 0;         ///< [Hz] TELEMETRY frames received per second, over the last ~1 s
+  uint64_t telemetryFrames = 0;       ///< TELEMETRY frames received
+  uint64_t telemetryLost = 0;         ///< frames missing from gaps in TELEMETRY `seq` (within each connection)
+  uint64_t robotDropped = 0;          ///< TELEMETRY `lost` of the last frame: the robot's count for this connection
+  uint64_t reconnects = 0;            ///< connections established after the first
+  uint64_t framesSent = 0;            ///< frames written to the socket
+  uint64_t framesReceived = 0;        ///< frames decoded from the socket
+  uint64_t emulatorDropped = 0;       ///< outgoing frames the link emulation dropped
+  uint64_t commandsSent = 0;          ///< COMMANDs written (or handed to the emulated link)
+  uint64_t repliesReceived = 0;       ///< REPLYs from the robot that matched a pending command
+  std::string lastError;              ///< the last connection problem or robot ERROR, for the operator
+};
+
+/// Callbacks of a RobotClient, each optional (empty = not called). All run
+/// on the client's worker thread (see the file comment); a callback must
+/// not call stop() and then wait for it (stop() from a callback only
+/// requests the stop).
+struct RobotClientCallbacks {
+  std::function<void(const TelemetryMsg&)> telemetry;
+  std::function<void(const LaserMsg&)> laser;
+  /// Exactly one per sendCommand(): the robot's REPLY, or a local one with
+  /// status Failed when the command could not be sent, the connection
+  /// dropped before the answer, or no answer came in time (see sendCommand()).
+  std::function<void(const ReplyMsg&)> reply;
+  std::function<void(const EventMsg&)> event;
+  /// Every LEASE_STATE from the robot, and a local {"", false} when the
+  /// connection drops while holding the lease.
+  std::function<void(const LeaseStateMsg&)> lease;
+  /// Each change of state, with a detail for the operator (the robot's name
+  /// when Ready, the reason when Waiting or Refused).
+  std::function<void(ConnectionState, const std::string& detail)> connection;
+  /// ERRORs from the robot (a message of ours it refused), and local notices
+  /// prefixed `client: ` (an ESTOP or REARM that could not be sent).
+  std::function<void(const ErrorMsg&)> error;
+  /// Each heartbeat round trip [ms], as measured (for plots and benchmarks).
+  std::function<void(double rttMs)> rtt;
+};
+
+/// An asynchronous, reconnecting client of the robot link. Not copyable.
+/// See the file comment for threads; every method below may be called from
+/// any thread, including from the callbacks, unless it says otherwise.
+class RobotClient {
+ public:
+  RobotClient(RobotClientConfig config, RobotClientCallbacks callbacks);
+  /// Calls stop().
+  ~RobotClient();
+  RobotClient(const RobotClient&) = delete;
+  RobotClient& operator=(const RobotClient&) = delete;
+
+  /// Starts the worker thread and connects; after a drop or a failed
+  /// connect it reconnects after 0.2 s, doubling to 2 s (the config's
+  /// reconnectMin/Max), and sends HELLO again. Does nothing if running.
+  /// May be called again after stop(). Not from a callback.
+  void start();
+  /// Closes the connection, after writing what is already queued (at most
+  /// 100 ms; frames held by the link emulation are dropped), and joins the
+  /// worker thread; no callback runs after stop() returns. Does NOT release
+  /// the lease: to the robot this is a lost operator, its deadman stops the
+  /// robot and latches the failsafe. Call releaseLease() first for a clean
+  /// exit. Called from a callback, it only requests the stop (the thread is
+  /// joined by the next start() or the destructor).
+  void stop();
+
+  /// Asks for the control lease (LEASE_ACQUIRE) now, or as soon as the
+  /// robot has welcomed the connection. While the robot says the lease is
+  /// ours, the client sends LEASE_KEEPALIVE every keepaliveInterval.
+  void acquireLease();
+  /// Gives the lease up (LEASE_RELEASE; the robot stops, without latching)
+  /// and stops asking for it after reconnects.
+  void releaseLease();
+
+  /// Sends `command` as a COMMAND expiring `expiresMs` [ms] after sending
+  /// (0: the config's commandExpiryMs) and returns its sequence number, which
+  /// increases over the client's life. The REPLY comes through the `reply`
+  /// callback with this `seq`. If the client is not Ready the command is not
+  /// sent and the reply is local: Failed, `client: not connected, not sent`
+  /// (Invalid, `client: ` and the encoder's error, for a text that cannot be
+  /// sent at all: empty or with a line feed).
+  /// If the connection drops before the reply: Failed, `client: connection
+  /// lost before the reply (the robot may have applied it)`. If no reply
+  /// comes within the expiry plus max(replyGrace, 3 x RTT): Failed, `client:
+  /// no reply within N ms`; a REPLY arriving after that is dropped.
+  uint64_t sendCommand(const Command& command, uint64_t expiresMs = 0);
+  /// As sendCommand(), with the command in sequence-file syntax (`drive 0.5
+  /// 0`, `stop`); the robot parses it and answers `invalid` if it cannot.
+  uint64_t sendCommandText(std::string text, uint64_t expiresMs = 0);
+
+  /// ESTOP with an optional reason. If not Ready, it is sent as soon as the
+  /// next connection is welcomed (and `error` reports the delay).
+  void estop(std::string reason = {});
+  /// REARM: clears a latched failsafe or e-stop (the robot accepts it from
+  /// the lease holder, or from a controlling client when nobody holds the
+  /// lease). If not Ready it is not sent; `error` says so.
+  void rearm();
+
+  /// Closes the current connection abruptly, as a lost link would (nothing
+  /// queued is flushed); the client then reconnects after the backoff. For
+  /// tests and for a console's "reconnect" button.
+  void dropConnection();
+  /// Replaces the link emulation of outgoing frames (applies to frames sent
+  /// from now on).
+  void setEmulation(const LinkEmulatorConfig& emulation);
+
+  /// A copy of the statistics. Thread-safe (a short lock).
+  RobotClientStats stats() const;
+  /// The configuration given to the constructor.
+  const RobotClientConfig& config() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sp::net
