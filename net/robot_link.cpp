@@ -29,6 +29,7 @@ void RobotLink::disconnected(ClientId client, double) {
     // The lease goes with the connection; the deadman keeps counting from
     // the holder's last packet and stops the robot (tick()).
     holder_ = 0;
+    holderLost_ = true;
     broadcastLease();
   }
 }
@@ -99,6 +100,11 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
         if constexpr (std::is_same_v<T, LeaseAcquireMsg>) {
           if (c.role != Role::Control) return send(client, ErrorMsg{"a monitor cannot take the control lease"});
           if (holder_ && holder_ != client) return send(client, LeaseStateMsg{clients_[holder_].name, false});
+          // A new holder must not inherit a lost operator's motion: if the
+          // deadman is still counting for a dropped holder, fire it now.
+          if (holderLost_ && deadmanArmed_ && !failsafe_)
+            stopEverything(EventKind::Failsafe, "the previous controlling client's connection was lost", now);
+          holderLost_ = false;
           holder_ = client;
           lastFromHolder_ = now;
           deadmanArmed_ = true;
@@ -183,6 +189,7 @@ void RobotLink::tick(double now) {
                        std::to_string(static_cast<int>(config_.deadman * 1000)) + " ms",
                    now);
     deadmanArmed_ = false;  // until a holder is heard again
+    holderLost_ = false;
   }
 }
 

@@ -108,6 +108,7 @@ class RobotLink {
   ClientId holder_ = 0;
   double lastFromHolder_ = 0;
   bool deadmanArmed_ = false;
+  bool holderLost_ = false;  // the holder's connection dropped; deadman not fired yet
   bool failsafe_ = false, estop_ = false;
   double lastFailsafe_ = -1;
   uint64_t session_ = 0;

@@ -203,6 +203,24 @@ class TestRobotLink : public QObject {
     QCOMPARE(f.command(2, 2, "drive 0.5 0").status, ReplyStatus::Ok);
   }
 
+  // A client taking the lease right after the holder's connection dropped
+  // does not inherit its motion: the failsafe fires at once and latches.
+  void newHolderDoesNotInheritMotion() {
+    Fixture f;
+    f.hello(1, Role::Control);
+    f.link.received(1, LeaseAcquireMsg{}, f.now);
+    QCOMPARE(f.command(1, 1, "drive 0.5 0").status, ReplyStatus::Ok);
+    f.link.takeCommands();
+    f.link.disconnected(1, f.now);
+    f.now += 0.05;  // well inside the 200 ms deadman
+    f.hello(2, Role::Control);
+    f.link.received(2, LeaseAcquireMsg{}, f.now);
+    QVERIFY(f.link.failsafeLatched());
+    QVERIFY(std::holds_alternative<StopCmd>(f.link.takeCommands().at(0)));
+    QCOMPARE(f.link.holder(), ClientId{2});
+    QCOMPARE(f.command(2, 1, "drive 0.5 0").status, ReplyStatus::Failed);
+  }
+
   // E-stop from any authenticated client, even a monitor, stops at once and
   // latches; every client hears of it.
   void estopFromMonitor() {
