@@ -26,6 +26,9 @@ constexpr const char* kUsage = R"(usage:
                         loopback a random one is made and printed
       --params FILE     parameters file; --set KEY=VALUE overrides (repeatable)
       --rtf X|max       real-time factor (default: realtime.factor)
+      --delay S         emulate a slow link: one-way delay [s] in both directions
+      --jitter S        and +- this much jitter [s]
+      --loss P          and lose each frame with probability P
   Prints `listening on ADDRESS:PORT` when ready; stops on SIGINT or SIGTERM.
 )";
 
@@ -37,6 +40,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   std::optional<int> port;
   std::optional<double> rtf;
+  sp::net::LinkEmulatorConfig emulation;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--help" || a == "-h") {
@@ -55,6 +59,16 @@ int main(int argc, char** argv) {
     else if (a == "--token") token = v;
     else if (a == "--port") port = std::atoi(v.c_str());
     else if (a == "--rtf") rtf = v == "max" ? 0.0 : std::atof(v.c_str());
+    else if (a == "--delay" || a == "--jitter" || a == "--loss") {
+      char* end = nullptr;
+      const double x = std::strtod(v.c_str(), &end);
+      if (end == v.c_str() || *end != '\0' || !(x >= 0) || (a == "--loss" && x > 1)) {
+        std::cerr << "<command line>: error: " << a << ": expected a number " << (a == "--loss" ? "in [0, 1]" : ">= 0")
+                  << ", got '" << v << "'\n";
+        return 2;
+      }
+      (a == "--delay" ? emulation.delay : a == "--jitter" ? emulation.jitter : emulation.loss) = x;
+    }
     else {
       std::cerr << "<command line>: error: unknown option '" << a << "'\n" << kUsage;
       return 2;
@@ -96,6 +110,7 @@ int main(int argc, char** argv) {
   config.link.robotName = model->robots[0].name;
   config.link.token = token;
   config.link.telemetryRate = simParams->telemetryRate;
+  config.emulation = emulation;
   sp::net::RobotServer server(io, config, host);
   if (const std::string error = server.start(); !error.empty()) {
     std::cerr << "error: " << error << "\n";
@@ -103,6 +118,9 @@ int main(int argc, char** argv) {
   }
   host.start();
   if (generated) std::cout << "token " << token << "\n";
+  if (emulation.active())
+    std::cout << "emulating a link with " << emulation.delay << " s delay, +-" << emulation.jitter << " s jitter, "
+              << emulation.loss * 100 << " % loss\n";
   std::cout << "listening on " << bind << ":" << server.port() << std::endl;
   asio::signal_set signals(io, SIGINT, SIGTERM);
   signals.async_wait([&](const asio::error_code&, int) {

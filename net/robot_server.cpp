@@ -16,7 +16,13 @@ std::string randomToken() {
 /// One client connection: its socket, decoder and bounded write queue.
 class RobotServer::Session {
  public:
-  Session(asio::ip::tcp::socket connected, ClientId clientId) : socket(std::move(connected)), id(clientId) {}
+  Session(asio::ip::tcp::socket connected, ClientId clientId, const LinkEmulatorConfig& emulation)
+      : socket(std::move(connected)), id(clientId), toClient(emulation), fromClient(emulation) {
+    // Each direction its own engine, so the two do not mirror each other.
+    LinkEmulatorConfig back = emulation;
+    back.seed = emulation.seed * 2 + 1;
+    fromClient.setConfig(back);
+  }
 
   asio::ip::tcp::socket socket;
   ClientId id;
@@ -25,6 +31,7 @@ class RobotServer::Session {
   struct Queued {
     std::string bytes;
     bool telemetry;  // telemetry and laser frames may be dropped
+    double due;      // when the emulated link lets it go
   };
   std::deque<Queued> queue;  // frames to write, front first
   size_t queuedTelemetry = 0;
@@ -32,6 +39,8 @@ class RobotServer::Session {
   bool closing = false;  // write what is queued, then close
   bool closed = false;
   uint64_t telemetrySeq = 0, laserSeq = 0, lost = 0;
+  LinkEmulator toClient, fromClient;
+  std::deque<std::pair<double, Message>> inbox;  // received, held back by the emulated link
 };
 
 RobotServer::RobotServer(asio::io_context& io, RobotServerConfig config, RobotPort& robot)
@@ -87,7 +96,7 @@ void RobotServer::accept() {
     // stale frames in the kernel.
     socket.set_option(asio::socket_base::send_buffer_size(64 * 1024), ignored);
     const ClientId id = nextId_++;
-    auto session = std::make_unique<Session>(std::move(socket), id);
+    auto session = std::make_unique<Session>(std::move(socket), id, config_.emulation);
     Session& s = *session;
     sessions_[id] = std::move(session);
     ++stats_.clientsAccepted;
@@ -130,8 +139,17 @@ void RobotServer::enqueue(Session& s, const Message& message, bool telemetry) {
     s.closing = true;  // a client that does not read its replies is dropped
     return;
   }
+  double due = 0;
+  if (config_.emulation.active()) {
+    const std::optional<double> at = s.toClient.schedule(frame->size(), now());
+    if (!at) {
+      ++stats_.emulatedLost;
+      return;
+    }
+    due = *at;
+  }
   s.queuedTelemetry += telemetry;
-  s.queue.push_back({std::move(*frame), telemetry});
+  s.queue.push_back({std::move(*frame), telemetry, due});
 }
 
 void RobotServer::received(ClientId id, const std::string& bytes) {
@@ -140,10 +158,14 @@ void RobotServer::received(ClientId id, const std::string& bytes) {
   while (std::optional<Frame> frame = s.decoder.next()) {
     ++stats_.framesIn;
     std::string error;
-    const std::optional<Message> message = decodeMessage(*frame, error);
-    if (!message) {
-      // A well-framed message with bad content: refused, connection kept.
-      link_.received(id, ErrorMsg{"refused: " + error}, now());
+    std::optional<Message> message = decodeMessage(*frame, error);
+    // A well-framed message with bad content: refused, connection kept.
+    if (!message) message = ErrorMsg{"refused: " + error};
+    if (config_.emulation.active()) {
+      const std::optional<double> at =
+          s.fromClient.schedule(frame->payload.size() + kFrameHeaderSize + kFrameCrcSize, now());
+      if (!at) ++stats_.emulatedLost;
+      else s.inbox.emplace_back(*at, std::move(*message));
       continue;
     }
     link_.received(id, *message, now());
@@ -154,6 +176,18 @@ void RobotServer::received(ClientId id, const std::string& bytes) {
     link_.malformed(id, s.decoder.errorMessage(), now());
   }
   flush();
+}
+
+void RobotServer::deliverDue() {
+  const double t = now();
+  for (auto& [id, ptr] : sessions_) {
+    Session& s = *ptr;
+    while (!s.closed && !s.inbox.empty() && s.inbox.front().first <= t) {
+      const Message m = std::move(s.inbox.front().second);
+      s.inbox.pop_front();
+      link_.received(id, m, t);
+    }
+  }
 }
 
 void RobotServer::flush() {
@@ -167,15 +201,18 @@ void RobotServer::flush() {
     auto it = sessions_.find(id);
     if (it != sessions_.end()) it->second->closing = true;
   }
+  std::vector<ClientId> finished;  // closed after the loop: closing erases sessions
   for (auto& [id, ptr] : sessions_) {
     Session& s = *ptr;
     if (s.writing || s.closed) continue;
     if (s.queue.empty()) {
-      if (s.closing) closeSession(id);
+      if (s.closing) finished.push_back(id);
       continue;
     }
+    if (s.queue.front().due > now()) continue;  // the emulated link holds it; the timer comes back
     s.writing = true;
     const ClientId sid = id;
+    // One frame per write; the completion continues with the next.
     asio::async_write(s.socket, asio::buffer(s.queue.front().bytes), [this, sid](asio::error_code ec, size_t) {
       auto it = sessions_.find(sid);
       if (it == sessions_.end()) return;
@@ -186,8 +223,8 @@ void RobotServer::flush() {
       ses.queue.pop_front();
       flush();
     });
-    // Only one frame per write; flush() continues from the completion.
   }
+  for (ClientId id : finished) closeSession(id);
 }
 
 void RobotServer::closeSession(ClientId id) {
@@ -219,6 +256,7 @@ void RobotServer::schedule() {
 
 void RobotServer::onTimer() {
   const double t = now();
+  if (config_.emulation.active()) deliverDue();
   link_.tick(t);
   if (t >= nextHeartbeat_) {
     nextHeartbeat_ = t + 0.5;

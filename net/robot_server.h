@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "net/frame.h"
+#include "net/link_emulator.h"
 #include "net/message.h"
 #include "net/robot_link.h"
 
@@ -64,6 +65,9 @@ struct RobotServerConfig {
   RobotLinkConfig link;
   size_t maxQueuedFrames = 64;       ///< per client; telemetry beyond it is dropped and counted
   size_t maxQueuedControl = 1024;    ///< replies and events beyond it close a client that does not read
+  /// Emulated link (delay, jitter, loss), applied to frames in both
+  /// directions of every connection; inactive by default.
+  LinkEmulatorConfig emulation;
 };
 
 struct RobotServerStats {
@@ -71,6 +75,7 @@ struct RobotServerStats {
   uint64_t framesIn = 0;
   uint64_t badFrames = 0;       ///< connections closed for a malformed frame
   uint64_t telemetryDropped = 0;
+  uint64_t emulatedLost = 0;    ///< frames the emulated link dropped (both directions)
 };
 
 class RobotServer {
@@ -94,6 +99,7 @@ class RobotServer {
   void onTimer();
   void flush();
   void received(ClientId id, const std::string& bytes);
+  void deliverDue();
   void closeSession(ClientId id);
   double now() const;
 

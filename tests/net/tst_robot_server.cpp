@@ -33,7 +33,7 @@ struct Robot {
   std::unique_ptr<RobotServer> server;
   std::thread thread;
 
-  Robot() {
+  explicit Robot(LinkEmulatorConfig emulation = {}) {
     Diagnostics diag;
     auto model = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
     if (!model) qFatal("%s", diag.format().c_str());
@@ -41,6 +41,7 @@ struct Robot {
     RobotServerConfig config;
     config.port = 0;
     config.link.token = kToken;
+    config.emulation = emulation;
     server = std::make_unique<RobotServer>(io, config, *host);
     const std::string error = server->start();
     if (!error.empty()) qFatal("%s", error.c_str());
@@ -248,6 +249,25 @@ class TestRobotServer : public QObject {
     while (seconds(t1) < 5.0 && !(reply && reply->seq == 2)) reply = holder.waitFor<ReplyMsg>(1.0);
     QVERIFY(reply && reply->seq == 2 && reply->status == ReplyStatus::Failed);
     QVERIFY(reply->reason.find("latched") != std::string::npos);
+  }
+
+  // An emulated 250 ms link each way: a command's round trip takes at least
+  // 500 ms, and the robot's measured round trip expires short-lived commands.
+  void emulatedDelay() {
+    LinkEmulatorConfig slow;
+    slow.delay = 0.25;
+    Robot robot(slow);
+    Client c(robot.server->port());
+    c.send(HelloMsg{"far away", kToken, Role::Control});
+    QVERIFY(c.waitFor<WelcomeMsg>(3.0));
+    c.send(LeaseAcquireMsg{});
+    const auto t0 = Clock::now();
+    c.send(CommandMsg{1, 5000, "stop"});
+    std::optional<ReplyMsg> reply;
+    while (seconds(t0) < 3.0 && !(reply && reply->seq == 1)) reply = c.waitFor<ReplyMsg>(3.0);
+    const double rtt = seconds(t0);
+    QVERIFY(reply && reply->status == ReplyStatus::Ok);
+    QVERIFY2(rtt >= 0.5 && rtt < 0.9, qPrintable(QString::number(rtt)));
   }
 
   // A monitor that never reads cannot stall anyone: its telemetry is
