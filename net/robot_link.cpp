@@ -193,6 +193,8 @@ void RobotLink::tick(double now) {
   }
 }
 
+void RobotLink::announce(EventKind kind, const std::string& text) { broadcast(EventMsg{kind, text}); }
+
 void RobotLink::sendHeartbeats(double now) {
   // Our sequence numbers live above 2^62, apart from the clients' own.
   const uint64_t seq = (uint64_t{1} << 62) + ++heartbeatSeq_;

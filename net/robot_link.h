@@ -81,6 +81,9 @@ class RobotLink {
   /// When the failsafe last fired [s], for deadman timing; -1 if never.
   double lastFailsafeTime() const { return lastFailsafe_; }
 
+  /// Tells every client of something about the robot (a divergence, say).
+  void announce(EventKind kind, const std::string& text);
+
   /// A heartbeat to send to every client now (the robot's own, which
   /// clients echo so that the robot can measure round trips).
   void sendHeartbeats(double now);

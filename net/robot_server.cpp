@@ -267,6 +267,10 @@ void RobotServer::onTimer() {
     nextTelemetry_ += 1.0 / config_.link.telemetryRate;
     if (nextTelemetry_ < t) nextTelemetry_ = t;  // no burst after a stall
     const RobotState st = robot_.state();
+    if (st.health != lastHealth_) {
+      lastHealth_ = st.health;
+      if (!st.health.empty()) link_.announce(EventKind::Divergence, st.health);
+    }
     for (ClientId id : link_.subscribers()) {
       auto it = sessions_.find(id);
       if (it == sessions_.end()) continue;

@@ -116,6 +116,7 @@ class RobotServer {
   uint16_t port_ = 0;
   double nextTelemetry_ = 0, nextHeartbeat_ = 0;
   uint64_t lastLaser_ = 0;
+  std::string lastHealth_;  // announced divergence, so it is announced once
   RobotServerStats stats_;
   bool stopped_ = false;
 };

@@ -2,6 +2,7 @@
 // behind it: authentication, bad frames (the server keeps serving everyone
 // else), lease races, the deadman, e-stop, and a monitor that never reads.
 
+#include <QProcess>
 #include <QtTest>
 
 #include <asio.hpp>
@@ -33,11 +34,11 @@ struct Robot {
   std::unique_ptr<RobotServer> server;
   std::thread thread;
 
-  explicit Robot(LinkEmulatorConfig emulation = {}) {
+  explicit Robot(LinkEmulatorConfig emulation = {}, SimParams params = {}) {
     Diagnostics diag;
     auto model = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
     if (!model) qFatal("%s", diag.format().c_str());
-    host = std::make_unique<TwinHost>(World::create(*model, SimParams{}, diag), 1.0);
+    host = std::make_unique<TwinHost>(World::create(*model, params, diag), 1.0);
     RobotServerConfig config;
     config.port = 0;
     config.link.token = kToken;
@@ -268,6 +269,37 @@ class TestRobotServer : public QObject {
     const double rtt = seconds(t0);
     QVERIFY(reply && reply->status == ReplyStatus::Ok);
     QVERIFY2(rtt >= 0.5 && rtt < 0.9, qPrintable(QString::number(rtt)));
+  }
+
+  // The stand-in refuses to listen on an open address without a token, and
+  // says why.
+  void refusesOpenAddressWithoutToken() {
+    QProcess robot;
+    robot.start(QStringLiteral(SP_BINARY_DIR "/app/simpartner-robot"),
+                {"--world", "terrains/flat.world.xml", "--bind", "0.0.0.0", "--port", "0"});
+    QVERIFY(robot.waitForFinished(10000));
+    QCOMPARE(robot.exitCode(), 2);
+    QVERIFY(QString::fromUtf8(robot.readAllStandardError()).contains("without --token"));
+  }
+
+  // A diverging twin is announced to every client as a divergence event
+  // (here a health limit of 2 rad/s that spinning wheels break).
+  void divergenceIsAnnounced() {
+    SimParams strict;
+    strict.maxAngularSpeed = 2;
+    Robot robot({}, strict);
+    Client monitor(robot.server->port());
+    monitor.hello(Role::Monitor, "monitor");
+    Client holder(robot.server->port());
+    holder.hello(Role::Control, "operator");
+    holder.send(LeaseAcquireMsg{});
+    holder.send(CommandMsg{1, 1000, "wheels 5 5 5 5"});
+    std::optional<EventMsg> event;
+    const auto t0 = Clock::now();
+    while (seconds(t0) < 5.0 && !(event && event->kind == EventKind::Divergence)) event = monitor.waitFor<EventMsg>(1.0);
+    QVERIFY(event && event->kind == EventKind::Divergence);
+    QVERIFY2(event->text.find("wheel") != std::string::npos && event->text.find("angular speed") != std::string::npos,
+             event->text.c_str());
   }
 
   // A monitor that never reads cannot stall anyone: its telemetry is
