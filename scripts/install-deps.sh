@@ -8,7 +8,7 @@ packages=(
   libode-dev libtinyxml2-dev libsqlite3-dev libasio-dev
   qt6-base-dev libqt6opengl6-dev qt6-charts-dev libopenscenegraph-dev
   libxml2-utils xvfb xauth mesa-utils libgl1-mesa-dri imagemagick x11-apps
-  python3
+  python3 clang libclang-rt-14-dev
 )
 
 missing=()
