@@ -111,6 +111,7 @@ int main(int argc, char** argv) {
   config.link.token = token;
   config.link.telemetryRate = simParams->telemetryRate;
   config.emulation = emulation;
+  config.log = [](const std::string& line) { std::cerr << "simpartner-robot: " << line << "\n"; };
   sp::net::RobotServer server(io, config, host);
   if (const std::string error = server.start(); !error.empty()) {
     std::cerr << "error: " << error << "\n";

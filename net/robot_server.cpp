@@ -100,8 +100,13 @@ void RobotServer::accept() {
     Session& s = *session;
     sessions_[id] = std::move(session);
     ++stats_.clientsAccepted;
+    if (config_.log) {
+      asio::error_code peerError;
+      const auto peer = s.socket.remote_endpoint(peerError);
+      config_.log("client " + std::to_string(id) + " connected from " +
+                  (peerError ? std::string("?") : peer.address().to_string() + ":" + std::to_string(peer.port())));
+    }
     link_.connected(id, now());
-    (void)s;
     startRead(id);
     accept();
   });
@@ -173,6 +178,7 @@ void RobotServer::received(ClientId id, const std::string& bytes) {
   if (s.decoder.failed()) {
     // A broken frame: the stream cannot be resynchronised; close it.
     ++stats_.badFrames;
+    if (config_.log) config_.log("client " + std::to_string(id) + " closed: " + s.decoder.errorMessage());
     link_.malformed(id, s.decoder.errorMessage(), now());
   }
   flush();
@@ -233,6 +239,7 @@ void RobotServer::closeSession(ClientId id) {
   Session& s = *it->second;
   if (!s.closed) {
     s.closed = true;
+    if (config_.log) config_.log("client " + std::to_string(id) + " disconnected");
     asio::error_code ec;
     s.socket.shutdown(asio::ip::tcp::socket::shutdown_both, ec);
     s.socket.close(ec);

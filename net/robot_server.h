@@ -13,6 +13,7 @@
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -65,6 +66,9 @@ struct RobotServerConfig {
   RobotLinkConfig link;
   size_t maxQueuedFrames = 64;       ///< per client; telemetry beyond it is dropped and counted
   size_t maxQueuedControl = 1024;    ///< replies and events beyond it close a client that does not read
+  /// Where the server reports connections, refusals and bad frames (one
+  /// line each, no newline); may be empty.
+  std::function<void(const std::string&)> log;
   /// Emulated link (delay, jitter, loss), applied to frames in both
   /// directions of every connection; inactive by default.
   LinkEmulatorConfig emulation;
