@@ -7,7 +7,10 @@
 // - command round trip: COMMAND sent -> REPLY received, 1000 times;
 // - heartbeat round trip: the robot's echo of our HEARTBEAT;
 // - telemetry: arrival rate and the spread of the gaps between frames
-//   (the robot sends at 50 Hz from a 2 ms timer).
+//   (the robot sends at 50 Hz from a 2 ms timer);
+// - telemetry latency: how much older than the freshest frame each frame's
+//   state is on arrival (state published at 100 Hz, so up to 10 ms of it is
+//   the publishing period).
 
 #include <asio.hpp>
 
@@ -85,13 +88,16 @@ int main(int argc, char** argv) {
   c.send(HelloMsg{"bench", kToken, Role::Control});
   c.send(LeaseAcquireMsg{});
   const int n = quick ? 200 : 1000;
-  std::vector<double> commandRtt, heartbeatRtt, gaps;
+  std::vector<double> commandRtt, heartbeatRtt, gaps, age;
   double lastTelemetry = 0;
   auto collect = [&](const Message& m) {
-    if (std::holds_alternative<TelemetryMsg>(m)) {
+    if (const auto* tm = std::get_if<TelemetryMsg>(&m)) {
       const double t = now();
       if (lastTelemetry > 0) gaps.push_back(t - lastTelemetry);
       lastTelemetry = t;
+      // The twin runs at 1x, so wall time minus twin time is a constant
+      // plus the telemetry's age; its minimum over the run is taken as 0.
+      age.push_back(t - tm->time);
     } else if (const auto* h = std::get_if<HeartbeatMsg>(&m); h && h->seq >= (uint64_t{1} << 62)) {
       c.send(*h);  // echo the robot's heartbeats, as a client must
     }
@@ -122,6 +128,9 @@ int main(int argc, char** argv) {
   printStats("command -> reply round trip", commandRtt);
   printStats("heartbeat echo round trip", heartbeatRtt);
   printStats("gap between telemetry frames", gaps);
+  const double fresh = *std::min_element(age.begin(), age.end());
+  for (double& a : age) a -= fresh;
+  printStats("telemetry age beyond the freshest", age);
   double mean = 0;
   for (double g : gaps) mean += g / static_cast<double>(gaps.size());
   std::printf("telemetry rate %.1f Hz (configured %.0f Hz)\n", 1.0 / mean, config.link.telemetryRate);
