@@ -195,6 +195,7 @@ struct World::Impl {
   std::vector<dBodyID> objectBodies;  // nullptr for static objects
   std::vector<std::vector<dGeomID>> objectGeoms;
   std::vector<Pose> staticObjectPoses;
+  std::vector<Vec3> objectComOffset;  // dynamic objects: centre of mass in the object frame
 
   dGeomID terrainGeom = nullptr;
   dHeightfieldDataID heightData = nullptr;
@@ -497,6 +498,7 @@ bool World::build(Diagnostics& diag) {
     m.objectBodies.push_back(body);
     m.objectGeoms.push_back(std::move(geoms));
     m.staticObjectPoses.push_back(o.pose);
+    m.objectComOffset.push_back(com);
   }
 
   // Robots.
@@ -1420,9 +1422,7 @@ const ActuatorState& World::actuatorState(int robot, int actuator) const {
 Pose World::objectPose(int object) const {
   dBodyID b = impl_->objectBodies[object];
   if (!b) return impl_->staticObjectPoses[object];
-  const ObjectSpec& o = model_.objects[object];
-  const dMass mass = massOf(o.geoms, o.mass);
-  return bodyPose(b) * Pose{Vec3{-mass.c[0], -mass.c[1], -mass.c[2]}, {}};
+  return bodyPose(b) * Pose{-impl_->objectComOffset[object], {}};
 }
 
 const HeightGrid* World::terrainGrid() const {
