@@ -522,8 +522,8 @@ std::optional<Message> decodeMessage(const Frame& frame, std::string& error) {
   return message;
 }
 
-CommandMsg makeCommandMsg(uint64_t seq, uint64_t expiresMs, const Command& command) {
-  return CommandMsg{seq, expiresMs, toText(command)};
+CommandMsg makeCommandMsg(uint64_t seq, uint64_t expiresMs, const Command& command, const RobotModel* robot) {
+  return CommandMsg{seq, expiresMs, toText(command, robot)};
 }
 
 std::optional<Command> parseCommandMsg(const CommandMsg& message, const RobotModel* robot, std::string& error) {

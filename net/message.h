@@ -200,10 +200,11 @@ std::optional<std::string> encodeMessage(const Message& message, std::string& er
 /// control characters escaped; a bad token is never echoed.
 std::optional<Message> decodeMessage(const Frame& frame, std::string& error);
 
-/// A COMMAND carrying `command` as text (sp::toText: joint values are written
-/// as for hinges, in degrees; slider commands do not round-trip in this
-/// version, see sim/command.h).
-CommandMsg makeCommandMsg(uint64_t seq, uint64_t expiresMs, const Command& command);
+/// A COMMAND carrying `command` as text (sp::toText: degrees for hinges,
+/// metres for the slider joints of `robot`; without a robot every joint is
+/// written as a hinge).
+CommandMsg makeCommandMsg(uint64_t seq, uint64_t expiresMs, const Command& command,
+                          const RobotModel* robot = nullptr);
 
 /// The twin command a COMMAND carries, parsed with sp::parseCommand against
 /// `robot` (may be null: every joint taken for a hinge). On error nullopt and

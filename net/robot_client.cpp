@@ -613,8 +613,8 @@ void RobotClient::releaseLease() {
   impl_->post([impl = impl_.get()] { impl->doRelease(); });
 }
 
-uint64_t RobotClient::sendCommand(const Command& command, uint64_t expiresMs) {
-  return impl_->sendCommand(makeCommandMsg(0, expiresMs, command));
+uint64_t RobotClient::sendCommand(const Command& command, uint64_t expiresMs, const RobotModel* robot) {
+  return impl_->sendCommand(makeCommandMsg(0, expiresMs, command, robot));
 }
 uint64_t RobotClient::sendCommandText(std::string text, uint64_t expiresMs) {
   return impl_->sendCommand(CommandMsg{0, expiresMs, std::move(text)});

@@ -173,7 +173,9 @@ class RobotClient {
   /// lost before the reply (the robot may have applied it)`. If no reply
   /// comes within the expiry plus max(replyGrace, 3 x RTT): Failed, `client:
   /// no reply within N ms`; a REPLY arriving after that is dropped.
-  uint64_t sendCommand(const Command& command, uint64_t expiresMs = 0);
+  /// `robot` (may be null, must outlive the call) tells slider joints from
+  /// hinges, so their values travel in metres rather than degrees.
+  uint64_t sendCommand(const Command& command, uint64_t expiresMs = 0, const RobotModel* robot = nullptr);
   /// As sendCommand(), with the command in sequence-file syntax (`drive 0.5
   /// 0`, `stop`); the robot parses it and answers `invalid` if it cannot.
   uint64_t sendCommandText(std::string text, uint64_t expiresMs = 0);

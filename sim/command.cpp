@@ -1,5 +1,7 @@
 #include "sim/command.h"
 
+#include "sim/robot_model.h"
+
 #include <charconv>
 #include <system_error>
 
@@ -50,15 +52,20 @@ const char* toString(Gait gait) {
   return "?";
 }
 
-// Joint values are written as for hinges (degrees, deg/s); sequence files do
-// not command sliders in this version (see command_file.h).
-std::string toText(const Command& command) {
+std::string toText(const Command& command, const RobotModel* robot) {
   struct Writer {
+    const RobotModel* robot;
+    // Degrees for hinges, metres for sliders (as parseCommand reads them).
+    std::string jointValue(const std::string& joint, double value) const {
+      const int j = robot ? robot->findJoint(joint) : -1;
+      if (j >= 0 && robot->joints[j].type == JointType::Slider) return formatShortest(value);
+      return formatDegrees(value);
+    }
     std::string operator()(const JointVelocityCmd& c) const {
-      return "velocity " + c.joint + " " + formatDegrees(c.velocity);
+      return "velocity " + c.joint + " " + jointValue(c.joint, c.velocity);
     }
     std::string operator()(const JointTargetCmd& c) const {
-      return "target " + c.joint + " " + formatDegrees(c.position);
+      return "target " + c.joint + " " + jointValue(c.joint, c.position);
     }
     std::string operator()(const JointTorqueCmd& c) const {
       return "torque " + c.joint + " " + formatShortest(c.torque);
@@ -80,7 +87,7 @@ std::string toText(const Command& command) {
       return "turn " + formatShortest(c.speed) + " " + formatDegrees(c.yawRate);
     }
   };
-  return std::visit(Writer{}, command);
+  return std::visit(Writer{robot}, command);
 }
 
 }  // namespace sp

@@ -91,7 +91,12 @@ struct TimedCommand {
   int line = 0;  ///< source line in a sequence file, 0 if none
 };
 
-/// The command in sequence-file syntax (angles in degrees), e.g. `drive 0.5 10`.
-std::string toText(const Command& command);
+struct RobotModel;
+
+/// The command in sequence-file syntax, e.g. `drive 0.5 10`: angles in
+/// degrees; `target` and `velocity` values in metres for the slider joints
+/// of `robot` (without a robot every joint is written as a hinge). It reads
+/// back with parseCommand given the same robot.
+std::string toText(const Command& command, const RobotModel* robot = nullptr);
 
 }  // namespace sp

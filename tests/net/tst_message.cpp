@@ -9,6 +9,7 @@
 #include <string>
 
 #include "net/message.h"
+#include "sim/robot_model.h"
 #include "sim/math.h"
 
 using namespace sp;
@@ -380,6 +381,18 @@ void TestMessage::commandHelpers() {
   const Command wheels = WheelsCmd{{1, 2, 3, 4.5}};
   QVERIFY(parseCommandMsg(makeCommandMsg(1, 1, wheels), nullptr, error) == wheels);
   QVERIFY(parseCommandMsg(makeCommandMsg(1, 1, StopCmd{}), nullptr, error) == Command(StopCmd{}));
+  // A slider's target travels in metres when both ends know the robot.
+  RobotModel robot;
+  robot.links = {LinkSpec{"base", 1, {}, {}, 0}, LinkSpec{"finger", 0.1, {}, {}, 0}};
+  JointSpec slider;
+  slider.name = "finger";
+  slider.type = JointType::Slider;
+  slider.parent = 0;
+  slider.child = 1;
+  robot.joints = {slider};
+  const Command grip = JointTargetCmd{"finger", 0.03};
+  QCOMPARE(makeCommandMsg(1, 1, grip, &robot).command, std::string("target finger 0.03"));
+  QVERIFY(parseCommandMsg(makeCommandMsg(1, 1, grip, &robot), &robot, error) == grip);
 
   QVERIFY(!parseCommandMsg(CommandMsg{1, 10, "drvie 1 0"}, nullptr, error));
   QCOMPARE(q(error), QString("COMMAND: key 'command': unknown command 'drvie'"));
