@@ -1,0 +1,281 @@
+// The session log: a real run written and read back, the reader's refusals,
+// the snapshot codec's exact round trip, and a writer that never blocks.
+
+#include <sqlite3.h>
+
+#include <QElapsedTimer>
+#include <QTemporaryDir>
+#include <QtTest>
+#include <fstream>
+#include <sstream>
+
+#include "app/session_log.h"
+#include "app/snapshot_codec.h"
+#include "sim/model_loader.h"
+#include "sim/world.h"
+
+using namespace sp;
+
+namespace {
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string sourcePath(const std::string& relative) { return std::string(SP_SOURCE_DIR) + "/" + relative; }
+
+std::unique_ptr<World> makeWorld(const std::string& worldFile) {
+  Diagnostics diag;
+  std::optional<WorldModel> model = loadWorld(sourcePath(worldFile), diag);
+  if (!model) return nullptr;
+  return World::create(*model, SimParams{}, diag);
+}
+
+// Sets meta.format_version of an existing log.
+void setFormatVersion(const std::string& path, const std::string& version) {
+  sqlite3* db = nullptr;
+  QCOMPARE(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  std::string sql = "UPDATE meta SET value='" + version + "' WHERE key='format_version'";
+  QCOMPARE(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(db);
+}
+
+}  // namespace
+
+class TestSessionLog : public QObject {
+  Q_OBJECT
+
+ private slots:
+  // A 2 s drive on flat ground logged at 1 kHz (samples), 20 Hz (laser) and
+  // 1 Hz (snapshots, hashes) reads back complete and bit for bit.
+  void realRunReadsBack() {
+    QTemporaryDir dir;
+    QVERIFY(dir.isValid());
+    const std::string path = dir.filePath("session.sqlite").toStdString();
+    const std::string worldFile = "terrains/flat.world.xml";
+    std::unique_ptr<World> world = makeWorld(worldFile);
+    QVERIFY(world);
+    QCOMPARE(world->params().step, 0.001);
+
+    SessionInfo info;
+    info.programVersion = "test";
+    info.startTime = "2026-01-02T03:04:05Z";
+    info.files.push_back({"world", worldFile, readFile(sourcePath(worldFile))});
+    std::string error;
+    std::unique_ptr<SessionLogWriter> log = SessionLogWriter::open(path, info, error);
+    QVERIFY2(log, error.c_str());
+
+    const Command drive = DriveCmd{0.5, 0.1};
+    QCOMPARE(world->submit(drive), std::string());
+    log->logSnapshot(world->snapshot(), world->time(), world->stateHash());
+    log->logCommand(world->stepCount(), world->time(), "sequence", drive);
+    log->logEvent(0, 0, "note", "start");
+    std::vector<LogSample> samples;
+    std::vector<LogLaser> scans;
+    uint64_t hashAt1s = 0;
+    for (int i = 0; i < 2000; ++i) {
+      QVERIFY(world->step());
+      samples.push_back(makeLogSample(*world));
+      QVERIFY(log->logSample(samples.back()));
+      for (auto [robot, sensor] : world->sampledLastStep()) {
+        if (auto scan = makeLogLaser(world->sensorSample(robot, sensor))) {
+          scans.push_back(*scan);
+          QVERIFY(log->logLaser(*scan));
+        }
+      }
+      if (world->stepCount() % 1000 == 0) {
+        if (world->stepCount() == 1000) hashAt1s = world->stateHash();
+        log->logSnapshot(world->snapshot(), world->time(), world->stateHash());
+        log->logHash(world->stepCount(), world->stateHash());
+      }
+    }
+    log->close();
+    QCOMPARE(log->dropped(), int64_t{0});
+    QVERIFY(!log->failed());
+    QCOMPARE(scans.size(), std::size_t{40});
+
+    std::unique_ptr<SessionLogReader> reader = SessionLogReader::open(path, error);
+    QVERIFY2(reader, error.c_str());
+    std::map<std::string, std::string> meta = reader->meta();
+    QCOMPARE(meta["format_version"], std::string("1"));
+    QCOMPARE(meta["program_version"], std::string("test"));
+    QCOMPARE(meta["start_time"], std::string("2026-01-02T03:04:05Z"));
+    QCOMPARE(meta["world_file"], worldFile);
+    QCOMPARE(meta["world_contents"], readFile(sourcePath(worldFile)));
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx",
+                  static_cast<unsigned long long>(fnv1a64(readFile(sourcePath(worldFile)))));
+    QCOMPARE(meta["world_fnv1a64"], std::string(hex));
+
+    const std::vector<std::pair<std::string, int64_t>> expected = {
+        {"meta", static_cast<int64_t>(meta.size())}, {"commands", 1}, {"samples", 2000}, {"laser", 40},
+        {"events", 1}, {"snapshots", 3}, {"hashes", 2}};
+    QCOMPARE(reader->streams(), expected);
+
+    QCOMPARE(reader->commands(), (std::vector<LogCommand>{{0, 0.0, "sequence", toText(drive)}}));
+    QCOMPARE(reader->events(), (std::vector<LogEvent>{{0, 0.0, "note", "start"}}));
+    QCOMPARE(reader->samplesBetween(0, 10), samples);
+    // Samples of steps 500..600 (times are multiples of the step, compared with a margin).
+    std::vector<LogSample> window = reader->samplesBetween(0.4995, 0.6005);
+    QCOMPARE(window.size(), std::size_t{101});
+    QCOMPARE(window.front(), samples[499]);
+    QCOMPARE(window.back(), samples[599]);
+    QVERIFY(window.back().base[0] > samples.front().base[0]);  // it drove forwards
+    QCOMPARE(reader->laserBetween(0, 10), scans);
+    QCOMPARE(reader->snapshotSteps(), (std::vector<int64_t>{0, 1000, 2000}));
+    QCOMPARE(reader->hashes().front(), (std::pair<int64_t, uint64_t>{1000, hashAt1s}));
+
+    // The snapshot at 1 s restores into a fresh world with the logged hash.
+    auto snap = reader->snapshot(1000, &error);
+    QVERIFY2(snap, error.c_str());
+    QCOMPARE(snap->second, hashAt1s);
+    std::unique_ptr<World> fresh = makeWorld(worldFile);
+    QCOMPARE(fresh->restore(snap->first), std::string());
+    QCOMPARE(fresh->stateHash(), hashAt1s);
+    QVERIFY(!reader->snapshot(999, &error));
+    QCOMPARE(error, std::string("no snapshot at step 999"));
+  }
+
+  void codecRoundTrip_data() {
+    QTest::addColumn<QString>("worldFile");
+    QTest::newRow("plane") << "terrains/flat.world.xml";
+    QTest::newRow("heightfield") << "terrains/bumpy.world.xml";
+  }
+  // A snapshot with a pending command (and terrain heights, when the world
+  // has a heightfield) encodes, decodes and restores bit-exactly.
+  void codecRoundTrip() {
+    QFETCH(QString, worldFile);
+    std::unique_ptr<World> world = makeWorld(worldFile.toStdString());
+    QVERIFY(world);
+    QCOMPARE(world->submit(DriveCmd{0.3, 0}), std::string());
+    for (int i = 0; i < 300; ++i) QVERIFY(world->step());
+    QCOMPARE(world->submit(JointTargetCmd{"waist_yaw", 0.2}), std::string());
+    const Snapshot original = world->snapshot();
+    const std::vector<uint8_t> bytes = encodeSnapshot(original);
+    std::string error;
+    std::optional<Snapshot> decoded = decodeSnapshot(bytes, &error);
+    QVERIFY2(decoded, error.c_str());
+    QCOMPARE(encodeSnapshot(*decoded), bytes);
+    QCOMPARE(decoded->pending, original.pending);
+    QCOMPARE(decoded->terrain != nullptr, original.terrain != nullptr);
+    if (original.terrain) QCOMPARE(decoded->terrain->heights, original.terrain->heights);
+
+    std::unique_ptr<World> fresh = makeWorld(worldFile.toStdString());
+    QCOMPARE(fresh->restore(*decoded), std::string());
+    QCOMPARE(fresh->stateHash(), world->stateHash());
+    for (int i = 0; i < 100; ++i) {
+      QVERIFY(world->step());
+      QVERIFY(fresh->step());
+    }
+    QCOMPARE(fresh->stateHash(), world->stateHash());
+
+    // Truncated data and another version are refused.
+    std::vector<uint8_t> cut(bytes.begin(), bytes.end() - 3);
+    QVERIFY(!decodeSnapshot(cut, &error));
+    QCOMPARE(error, std::string("truncated snapshot data"));
+    std::vector<uint8_t> v2 = bytes;
+    v2[4] = 2;
+    QVERIFY(!decodeSnapshot(v2, &error));
+    QCOMPARE(error, std::string("snapshot format version 2 is not supported (expected 1)"));
+  }
+
+  // The reader refuses another format version, a database without meta and
+  // a file that is not SQLite, naming the file.
+  void readerRejects() {
+    QTemporaryDir dir;
+    const std::string path = dir.filePath("v2.sqlite").toStdString();
+    std::string error;
+    {
+      auto log = SessionLogWriter::open(path, SessionInfo{}, error);
+      QVERIFY2(log, error.c_str());
+    }
+    setFormatVersion(path, "2");
+    QVERIFY(!SessionLogReader::open(path, error));
+    QCOMPARE(error, path + ": session log format version 2 is not supported (this program reads version 1)");
+
+    const std::string empty = dir.filePath("empty.sqlite").toStdString();
+    sqlite3* db = nullptr;
+    QCOMPARE(sqlite3_open(empty.c_str(), &db), SQLITE_OK);
+    QCOMPARE(sqlite3_exec(db, "CREATE TABLE t(x)", nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(db);
+    QVERIFY(!SessionLogReader::open(empty, error));
+    QCOMPARE(error, empty + ": not a session log (no meta table)");
+
+    const std::string text = dir.filePath("notes.txt").toStdString();
+    std::ofstream(text) << std::string(2048, 'x');
+    QVERIFY(!SessionLogReader::open(text, error));
+    QCOMPARE(error, text + ": not a session log (not an SQLite database)");
+
+    const std::string missing = dir.filePath("missing.sqlite").toStdString();
+    QVERIFY(!SessionLogReader::open(missing, error));
+    QCOMPARE(error, missing + ": cannot open the session log: unable to open database file");
+  }
+
+  // The writer refuses a path it cannot create, and an existing file.
+  void writerRejectsPath() {
+    QTemporaryDir dir;
+    std::string error;
+    const std::string bad = dir.filePath("no/such/dir/log.sqlite").toStdString();
+    QVERIFY(!SessionLogWriter::open(bad, SessionInfo{}, error));
+    QCOMPARE(error, bad + ": cannot create the session log: unable to open database file");
+    const std::string existing = dir.filePath("x.sqlite").toStdString();
+    std::ofstream(existing) << "x";
+    QVERIFY(!SessionLogWriter::open(existing, SessionInfo{}, error));
+    QCOMPARE(error, existing + ": already exists");
+  }
+
+  // A full queue drops and counts instead of waiting for the writer.
+  void overflowDropsWithoutBlocking() {
+    QTemporaryDir dir;
+    const std::string path = dir.filePath("tiny.sqlite").toStdString();
+    SessionLogOptions options;
+    options.queueCapacity = 4;
+    options.batchMillis = 5000;  // the writer sleeps through the burst
+    std::string error;
+    auto log = SessionLogWriter::open(path, SessionInfo{}, error, options);
+    QVERIFY2(log, error.c_str());
+    QElapsedTimer timer;
+    timer.start();
+    int accepted = 0;
+    for (int i = 0; i < 100; ++i) accepted += log->logEvent(i, i * 0.001, "note", "n") ? 1 : 0;
+    QVERIFY(timer.elapsed() < 1000);
+    QCOMPARE(accepted, 4);
+    QCOMPARE(log->dropped(), int64_t{96});
+    log->close();
+    auto reader = SessionLogReader::open(path, error);
+    QVERIFY2(reader, error.c_str());
+    QCOMPARE(reader->events().size(), std::size_t{4});
+  }
+
+  // A full disk is reported, later items are dropped, and the file keeps
+  // what was committed before.
+  void diskFullIsReported() {
+    QTemporaryDir dir;
+    const std::string path = dir.filePath("full.sqlite").toStdString();
+    SessionLogOptions options;
+    options.maxPageCount = 64;
+    std::string error;
+    auto log = SessionLogWriter::open(path, SessionInfo{}, error, options);
+    QVERIFY2(log, error.c_str());
+    QVERIFY(log->logEvent(0, 0, "note", "before"));
+    QTest::qWait(200);  // committed
+    QVERIFY(!log->failed());
+    for (int i = 1; i <= 100 && !log->failed(); ++i) {
+      log->logLaser(LogLaser{i, i * 0.05, 0, 0.01, std::vector<double>(4000, 1.0)});
+      QTest::qWait(10);
+    }
+    QTRY_VERIFY_WITH_TIMEOUT(log->failed(), 2000);
+    QCOMPARE(log->errorMessage(), path + ": database or disk is full");
+    log->close();
+    QVERIFY(log->dropped() > 0);
+    auto reader = SessionLogReader::open(path, error);
+    QVERIFY2(reader, error.c_str());
+    QCOMPARE(reader->events(), (std::vector<LogEvent>{{0, 0.0, "note", "before"}}));
+  }
+};
+
+QTEST_GUILESS_MAIN(TestSessionLog)
+#include "tst_session_log.moc"
