@@ -1,7 +1,7 @@
 #pragma once
 // The headless runner behind `simpartner-sim run`: builds the twin from a
 // world file, feeds it a command sequence, paces it against a monotonic clock
-// and writes decimated CSV.
+// and writes decimated CSV and, optionally, a session log.
 
 #include <atomic>
 #include <functional>
@@ -26,6 +26,7 @@ struct RunOptions {
   double duration = 10;                ///< sim seconds
   std::optional<double> realTimeFactor;  ///< overrides realtime.factor; 0 = max
   std::string csvFile;                 ///< "" = none
+  std::string logFile;                 ///< session log (app/session_log.h); "" = none
   double progressInterval = 1.0;       ///< wall seconds between progress lines; 0 = none
 };
 
@@ -48,6 +49,8 @@ struct RunReport {
   bool interrupted = false;
   uint64_t stateHash = 0;    ///< World::stateHash() at the end
   HealthReport health;       ///< why the run stopped early, if it diverged
+  int64_t logDropped = 0;    ///< session log items dropped (full queue, failed disk)
+  std::string logError;      ///< why the session log failed, "" if it did not
 };
 
 /// Loads files and runs. Writes the narrative to `out` and diagnostics to

@@ -265,8 +265,9 @@ bool SessionLogWriter::push(Item item) {
   return true;
 }
 
-bool SessionLogWriter::logCommand(int64_t step, double time, const std::string& source, const Command& command) {
-  return push(LogCommand{step, time, source, toText(command)});
+bool SessionLogWriter::logCommand(int64_t step, double time, const std::string& source, const Command& command,
+                                  const RobotModel* robot) {
+  return push(LogCommand{step, time, source, toText(command, robot)});
 }
 bool SessionLogWriter::logSample(LogSample sample) { return push(std::move(sample)); }
 bool SessionLogWriter::logLaser(LogLaser scan) { return push(std::move(scan)); }

@@ -129,7 +129,10 @@ class SessionLogWriter {
   SessionLogWriter& operator=(const SessionLogWriter&) = delete;
 
   // Each queues one item; false when the queue was full and it was dropped.
-  bool logCommand(int64_t step, double time, const std::string& source, const Command& command);
+  /// The command's text is toText(command, robot) (slider values in metres
+  /// need the robot; see sim/command.h).
+  bool logCommand(int64_t step, double time, const std::string& source, const Command& command,
+                  const RobotModel* robot = nullptr);
   bool logSample(LogSample sample);
   bool logLaser(LogLaser scan);
   bool logEvent(int64_t step, double time, std::string kind, std::string text);

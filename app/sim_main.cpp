@@ -34,6 +34,7 @@ constexpr const char* kUsage = R"(usage:
       --duration S      sim seconds to run (default 10)
       --rtf X|max       real-time factor (default: realtime.factor)
       --csv FILE        write link poses and joint states (rate.csv Hz)
+      --log FILE        write a session log (SQLite; samples at rate.log Hz)
       --quiet           no progress lines
       Exits 0 when the run completed, 1 on bad input, 3 if the twin diverged
       (the report names what, where and when).
@@ -180,7 +181,7 @@ int run(const std::vector<std::string>& args) {
       continue;
     }
     if (a != "--world" && a != "--params" && a != "--set" && a != "--commands" && a != "--duration" &&
-        a != "--rtf" && a != "--csv") {
+        a != "--rtf" && a != "--csv" && a != "--log") {
       std::cerr << "<command line>: error: unknown option '" << a << "'\n" << kUsage;
       return 2;
     }
@@ -190,6 +191,7 @@ int run(const std::vector<std::string>& args) {
     else if (a == "--set") o.overrides.push_back(*v);
     else if (a == "--commands") o.commandsFile = *v;
     else if (a == "--csv") o.csvFile = *v;
+    else if (a == "--log") o.logFile = *v;
     else if (a == "--duration" || a == "--rtf") {
       if (a == "--rtf" && *v == "max") {
         o.realTimeFactor = 0;

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/headless_runner.h"
 #include "app/session_log.h"
 #include "app/snapshot_codec.h"
 #include "sim/model_loader.h"
@@ -274,6 +275,53 @@ class TestSessionLog : public QObject {
     auto reader = SessionLogReader::open(path, error);
     QVERIFY2(reader, error.c_str());
     QCOMPARE(reader->events(), (std::vector<LogEvent>{{0, 0.0, "note", "before"}}));
+  }
+
+  // `run --log`: the runner logs files, the initial snapshot, sequence
+  // commands, samples at rate.log, laser scans and a snapshot per second,
+  // and its final state hash is the last one logged.
+  void runnerWritesLog() {
+    QTemporaryDir dir;
+    const std::string path = dir.filePath("run.sqlite").toStdString();
+    const std::string commands = dir.filePath("drive.seq").toStdString();
+    std::ofstream(commands) << "0 drive 0.5 0\n0.5 stop\n";
+    RunOptions o;
+    o.worldFile = sourcePath("terrains/flat.world.xml");
+    o.commandsFile = commands;
+    o.duration = 2;
+    o.realTimeFactor = 0;
+    o.progressInterval = 0;
+    o.logFile = path;
+    std::ostringstream out, err;
+    double fakeClock = 0;
+    auto report = runHeadless(o, out, err, [&] { return fakeClock += 1e-4; }, [](double) {});
+    QVERIFY2(report, err.str().c_str());
+    QCOMPARE(err.str(), std::string());
+    QVERIFY2(out.str().find("logging the session at 100.0 Hz to " + path) != std::string::npos, out.str().c_str());
+    QCOMPARE(report->logDropped, int64_t{0});
+
+    std::string error;
+    auto reader = SessionLogReader::open(path, error);
+    QVERIFY2(reader, error.c_str());
+    std::map<std::string, std::string> meta = reader->meta();
+    QCOMPARE(meta["world_contents"], readFile(o.worldFile));
+    QCOMPARE(meta["commands_contents"], readFile(commands));
+    QVERIFY(meta["robot_contents"].find("<sensor name=\"laser\"") != std::string::npos);
+    const std::vector<LogCommand> logged = reader->commands();
+    QCOMPARE(logged.size(), std::size_t{2});
+    QCOMPARE(logged[0].step, int64_t{0});
+    QCOMPARE(logged[0].source, std::string("sequence"));
+    QCOMPARE(logged[1].step, int64_t{500});
+    QCOMPARE(logged[1].text, std::string("stop"));
+    QCOMPARE(reader->samplesBetween(0, 10).size(), std::size_t{201});
+    QCOMPARE(reader->laserBetween(0, 10).size(), std::size_t{40});
+    QCOMPARE(reader->snapshotSteps(), (std::vector<int64_t>{0, 1000, 2000}));
+    QCOMPARE(reader->hashes().back(), (std::pair<int64_t, uint64_t>{2000, report->stateHash}));
+
+    // A second run refuses to overwrite the log.
+    std::ostringstream out2, err2;
+    QVERIFY(!runHeadless(o, out2, err2, [&] { return fakeClock += 1e-4; }, [](double) {}));
+    QCOMPARE(err2.str(), path + ": already exists\n");
   }
 };
 
