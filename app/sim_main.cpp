@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <fstream>
 #include <filesystem>
 #include <iostream>
@@ -12,6 +13,8 @@
 #include <vector>
 
 #include "app/headless_runner.h"
+#include "app/log_export.h"
+#include "app/resimulation.h"
 #include "app/validation.h"
 #include "ui/plot_renderer.h"
 #include "sim/command_file.h"
@@ -45,6 +48,14 @@ constexpr const char* kUsage = R"(usage:
       experiment passes its target, 4 when some fail.
   simpartner-sim params
       Prints every parameter key with its default and meaning.
+  simpartner-sim resim LOG [--from S]
+      Re-simulates a session log from the files it stores: restores the
+      latest snapshot at or before S sim seconds (default 0), applies the
+      logged commands and compares every logged state hash. Exits 0 when all
+      match, 5 at the first divergence (printed), 1 if the log is unusable.
+  simpartner-sim export LOG --csv DIR
+      Writes one CSV per stream of a session log into DIR (samples.csv,
+      laser.csv, commands.csv, events.csv), headers naming columns and units.
 )";
 
 std::atomic<bool> gStop{false};
@@ -218,6 +229,70 @@ int run(const std::vector<std::string>& args) {
   return report->health.healthy() ? 0 : 3;
 }
 
+int resim(const std::vector<std::string>& args) {
+  std::string log;
+  sp::ResimOptions options;
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--from" && i + 1 < args.size()) {
+      char* end = nullptr;
+      options.from = std::strtod(args[++i].c_str(), &end);
+      if (*end != '\0' || !(options.from >= 0)) {
+        std::cerr << "<command line>: error: --from: expected seconds >= 0, got '" << args[i] << "'\n";
+        return 2;
+      }
+    } else if (log.empty() && !args[i].empty() && args[i][0] != '-') {
+      log = args[i];
+    } else {
+      std::cerr << "<command line>: error: unknown or incomplete option '" << args[i] << "'\n" << kUsage;
+      return 2;
+    }
+  }
+  if (log.empty()) {
+    std::cerr << "<command line>: error: resim needs a LOG file\n";
+    return 2;
+  }
+  std::string error;
+  const auto report = sp::resimulate(log, options, error);
+  if (!report) {
+    std::cerr << error << "\n";
+    return 1;
+  }
+  std::cout << "re-simulated steps " << report->startStep << " to " << report->endStep << ", "
+            << report->commandsApplied << " commands applied, " << report->hashesCompared << " hashes compared\n";
+  if (!report->healthMessage.empty()) std::cout << "the twin diverged: " << report->healthMessage << "\n";
+  if (const auto& d = report->divergence) {
+    std::cout << "divergence at step " << d->step << " (t = " << d->time << " s): expected hash "
+              << sp::hashHex(d->expected) << ", got " << sp::hashHex(d->actual) << "\n";
+    return 5;
+  }
+  std::cout << "no divergence\n";
+  return 0;
+}
+
+int exportLog(const std::vector<std::string>& args) {
+  std::string log, dir;
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--csv" && i + 1 < args.size()) dir = args[++i];
+    else if (log.empty() && !args[i].empty() && args[i][0] != '-') log = args[i];
+    else {
+      std::cerr << "<command line>: error: unknown or incomplete option '" << args[i] << "'\n" << kUsage;
+      return 2;
+    }
+  }
+  if (log.empty() || dir.empty()) {
+    std::cerr << "<command line>: error: export needs LOG and --csv DIR\n";
+    return 2;
+  }
+  std::string error;
+  std::vector<std::string> written;
+  if (!sp::exportLogCsv(log, dir, error, &written)) {
+    std::cerr << error << "\n";
+    return 1;
+  }
+  for (const std::string& f : written) std::cout << "wrote " << f << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -238,6 +313,8 @@ int main(int argc, char** argv) {
   if (cmd == "run") return run(args);
   if (cmd == "params") return printParams();
   if (cmd == "validate") return validate(args, argv[0]);
+  if (cmd == "resim") return resim(args);
+  if (cmd == "export") return exportLog(args);
   std::cerr << "<command line>: error: unknown command '" << cmd << "'\n" << kUsage;
   return 2;
 }

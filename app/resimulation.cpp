@@ -1,0 +1,230 @@
+#include "app/resimulation.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "app/session_log.h"
+#include "sim/command_file.h"
+#include "sim/model_loader.h"
+#include "sim/params.h"
+#include "sim/world.h"
+
+namespace sp {
+namespace fs = std::filesystem;
+namespace {
+
+// A temporary folder removed when it goes out of scope.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    const fs::path base = fs::temp_directory_path();
+    for (int i = 0; i < 100 && path_.empty(); ++i) {
+      fs::path p = base / ("simpartner-resim-" + std::to_string(rd()));
+      std::error_code ec;
+      if (fs::create_directory(p, ec)) path_ = p;
+    }
+  }
+  ~TempDir() {
+    std::error_code ec;
+    if (!path_.empty()) fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+bool writeFile(const fs::path& path, const std::string& contents) {
+  std::error_code ec;
+  fs::create_directories(path.parent_path(), ec);
+  std::ofstream out(path, std::ios::binary);
+  out << contents;
+  return static_cast<bool>(out);
+}
+
+std::string get(const std::map<std::string, std::string>& meta, const std::string& key) {
+  auto it = meta.find(key);
+  return it == meta.end() ? std::string() : it->second;
+}
+
+}  // namespace
+
+std::string hashHex(uint64_t hash) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
+std::optional<ResimReport> resimulate(const std::string& path, const ResimOptions& options, std::string& error) {
+  std::unique_ptr<SessionLogReader> reader = SessionLogReader::open(path, error);
+  if (!reader) return std::nullopt;
+  const std::map<std::string, std::string> meta = reader->meta();
+  const std::string worldName = get(meta, "world_file");
+  const std::string robotName = get(meta, "robot_file");
+  if (worldName.empty() || !meta.count("world_contents") || robotName.empty() || !meta.count("robot_contents")) {
+    error = path + ": the log holds no world or robot file to re-simulate from";
+    return std::nullopt;
+  }
+
+  // Lay the logged files out as recorded: the robot at its path relative to
+  // the world file's folder, the world file deep enough that every "..."
+  // of that relative path stays inside the temporary folder.
+  TempDir temp;
+  if (temp.path().empty()) {
+    error = path + ": cannot create a temporary folder to rebuild the world in";
+    return std::nullopt;
+  }
+  const fs::path worldAbs = fs::absolute(worldName).lexically_normal();
+  const fs::path robotAbs = fs::absolute(robotName).lexically_normal();
+  fs::path robotRel = robotAbs.lexically_relative(worldAbs.parent_path());
+  if (robotRel.empty()) robotRel = robotAbs.filename();
+  int depth = 0;
+  for (const fs::path& part : robotRel)
+    if (part == "..") ++depth;
+  fs::path worldDir = temp.path();
+  for (int i = 0; i < depth; ++i) worldDir /= "d" + std::to_string(i);
+  const fs::path worldFile = worldDir / worldAbs.filename();
+  const fs::path robotFile = (worldDir / robotRel).lexically_normal();
+  if (!writeFile(worldFile, get(meta, "world_contents")) || !writeFile(robotFile, get(meta, "robot_contents"))) {
+    error = path + ": cannot write the logged files to " + temp.path().string();
+    return std::nullopt;
+  }
+
+  Diagnostics diag;
+  // The terrain data file is not logged: parse the logged world XML with
+  // relative paths resolved beside the recorded world file, except the
+  // robot, which the temporary layout provides.
+  std::optional<WorldModel> model = loadWorld(worldFile.string(), diag);
+  if (!model || model->robots.empty()) {
+    // A heightfield's file is missing from the temporary layout: copy it from
+    // beside the recorded world file and try again.
+    diag = Diagnostics{};
+    std::optional<WorldModel> probe =
+        parseWorld(get(meta, "world_contents"), worldName, worldAbs.parent_path().string(), diag);
+    if (probe && probe->terrain.kind != TerrainSpec::Kind::Plane) {
+      const fs::path terrainAbs = fs::absolute(probe->terrain.file).lexically_normal();
+      const fs::path terrainRel = terrainAbs.lexically_relative(worldAbs.parent_path());
+      std::error_code ec;
+      fs::create_directories((worldDir / terrainRel).parent_path(), ec);
+      fs::copy_file(terrainAbs, worldDir / terrainRel, fs::copy_options::overwrite_existing, ec);
+    }
+    diag = Diagnostics{};
+    model = loadWorld(worldFile.string(), diag);
+  }
+  if (!model || model->robots.empty()) {
+    error = path + ": cannot rebuild the logged world:\n" + diag.format();
+    return std::nullopt;
+  }
+
+  SimParams params;
+  if (meta.count("params_contents")) {
+    const fs::path paramsFile = temp.path() / "session.params";
+    if (!writeFile(paramsFile, get(meta, "params_contents")) || !loadParams(paramsFile.string(), params, diag)) {
+      error = path + ": cannot load the logged parameters:\n" + diag.format();
+      return std::nullopt;
+    }
+  }
+  for (const LogEvent& e : reader->events())
+    if (e.kind == "param_override" && !applyOverride(params, e.text, diag)) {
+      error = path + ": cannot apply the logged override '" + e.text + "':\n" + diag.format();
+      return std::nullopt;
+    }
+
+  std::unique_ptr<World> world = World::create(*model, params, diag);
+  if (!world) {
+    error = path + ": cannot build the logged world:\n" + diag.format();
+    return std::nullopt;
+  }
+  const RobotModel& robot = model->robots[0].model;
+
+  // The commands as applied, parsed back against the robot.
+  struct StepCommand {
+    int64_t step;
+    Command command;
+  };
+  std::vector<StepCommand> commands;
+  for (const LogCommand& c : reader->commands()) {
+    std::string why;
+    std::optional<Command> command = parseCommand(c.text, why, &robot);
+    if (!command) {
+      error = path + ": logged command at step " + std::to_string(c.step) + " ('" + c.text + "'): " + why;
+      return std::nullopt;
+    }
+    commands.push_back({c.step, std::move(*command)});
+  }
+
+  // The latest snapshot at or before the requested start.
+  const std::vector<int64_t> snapshotSteps = reader->snapshotSteps();
+  if (snapshotSteps.empty()) {
+    error = path + ": the log holds no snapshot to start from";
+    return std::nullopt;
+  }
+  const double stepSize = params.step;
+  int64_t start = snapshotSteps.front();
+  for (int64_t s : snapshotSteps)
+    if (static_cast<double>(s) * stepSize <= options.from + 1e-9) start = s;
+  std::optional<std::pair<Snapshot, uint64_t>> snapshot = reader->snapshot(start, &error);
+  if (!snapshot) return std::nullopt;
+  if (std::string why = world->restore(snapshot->first); !why.empty()) {
+    error = path + ": cannot restore the snapshot at step " + std::to_string(start) + ": " + why;
+    return std::nullopt;
+  }
+
+  ResimReport report;
+  report.startStep = start;
+  const std::vector<std::pair<int64_t, uint64_t>> hashes = reader->hashes();
+  int64_t end = start;
+  for (const auto& h : hashes) end = std::max(end, h.first);
+
+  size_t nextHash = 0;
+  while (nextHash < hashes.size() && hashes[nextHash].first < start) ++nextHash;
+  size_t nextCommand = 0;
+  while (nextCommand < commands.size() && commands[nextCommand].step < start) ++nextCommand;
+
+  // Compares the hash logged at the current step, if any; true to go on.
+  auto compare = [&]() {
+    while (nextHash < hashes.size() && hashes[nextHash].first <= world->stepCount()) {
+      const auto [step, expected] = hashes[nextHash++];
+      if (step != world->stepCount()) continue;  // a step the re-simulation skipped cannot happen
+      ++report.hashesCompared;
+      const uint64_t actual = world->stateHash();
+      if (actual != expected) {
+        report.divergence = ResimDivergence{step, world->time(), expected, actual};
+        return false;
+      }
+    }
+    return true;
+  };
+
+  bool going = compare();
+  while (going && world->stepCount() < end) {
+    // A command logged at step s was submitted before the step from s.
+    while (nextCommand < commands.size() && commands[nextCommand].step <= world->stepCount()) {
+      const std::string why = world->submit(commands[nextCommand++].command, 0);
+      if (why.empty()) ++report.commandsApplied;
+    }
+    if (!world->step()) {
+      report.healthMessage = world->health().message();
+      break;
+    }
+    going = compare();
+  }
+  // A physical divergence before the end is a divergence from the log too.
+  if (!report.divergence && !report.healthMessage.empty() && nextHash < hashes.size()) {
+    const auto [step, expected] = hashes[nextHash];
+    report.divergence = ResimDivergence{step, static_cast<double>(step) * stepSize, expected, world->stateHash()};
+  }
+  report.endStep = world->stepCount();
+  return report;
+}
+
+}  // namespace sp

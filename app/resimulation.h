@@ -1,0 +1,52 @@
+#pragma once
+// Re-simulation of a session log (app/session_log.h): rebuilds the world from
+// the files stored in the log, restores a logged snapshot, applies the logged
+// commands at their steps and compares the state hash at every logged hash
+// step, reporting the first divergence (box2d's recording replay).
+//
+// The world is rebuilt from the logged file *contents*, never from the paths
+// on disk: the contents are written to a fresh temporary folder that keeps
+// the recorded relative layout (the robot file where the world file's
+// relative reference expects it), so a log still re-simulates after the
+// files on disk were edited or moved. Limitations: a heightfield terrain's
+// data file is not stored in the log, so it is read from beside the recorded
+// world file (its heights are restored from the snapshot when the snapshot
+// carries them); parameter overrides come from the log's "param_override"
+// events.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace sp {
+
+struct ResimOptions {
+  double from = 0;  ///< start at the latest snapshot at or before this sim time [s]
+};
+
+/// The first logged hash that the re-simulation did not reproduce.
+struct ResimDivergence {
+  int64_t step = 0;
+  double time = 0;         ///< [s]
+  uint64_t expected = 0;   ///< the logged hash
+  uint64_t actual = 0;     ///< the re-simulation's
+};
+
+struct ResimReport {
+  int64_t startStep = 0;     ///< the step of the snapshot restored
+  int64_t endStep = 0;       ///< the last step simulated
+  int hashesCompared = 0;
+  int commandsApplied = 0;
+  std::optional<ResimDivergence> divergence;  ///< nullopt: every hash matched
+  std::string healthMessage;  ///< the twin diverged physically while re-simulating, else ""
+};
+
+/// Re-simulates the log at `path`. Returns nullopt and sets `error` when the
+/// log cannot be read or the world cannot be rebuilt. Thread: any; the
+/// calling thread owns the rebuilt world for the whole call.
+std::optional<ResimReport> resimulate(const std::string& path, const ResimOptions& options, std::string& error);
+
+/// One-line hex form of a state hash ("%016llx").
+std::string hashHex(uint64_t hash);
+
+}  // namespace sp
