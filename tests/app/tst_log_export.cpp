@@ -10,12 +10,12 @@
 
 #include "app/headless_runner.h"
 #include "app/log_export.h"
+#include "tests/app/demo_log.h"
 
 using namespace sp;
 
 namespace {
 
-std::string sourcePath(const std::string& relative) { return std::string(SP_SOURCE_DIR) + "/" + relative; }
 
 std::string firstLine(const std::string& path) {
   std::ifstream in(path);
@@ -26,17 +26,7 @@ std::string firstLine(const std::string& path) {
 
 // Logs a 1.5 s run of the demo sequence on flat ground to `path`.
 bool logRun(const std::string& path) {
-  RunOptions o;
-  o.worldFile = sourcePath("terrains/flat.world.xml");
-  o.commandsFile = sourcePath("terrains/demo.seq");
-  o.duration = 1.5;
-  o.realTimeFactor = 0;
-  o.progressInterval = 0;
-  o.logFile = path;
-  o.overrides = {"rate.log=100"};
-  std::ostringstream out, err;
-  double fakeClock = 0;
-  auto report = runHeadless(o, out, err, [&] { return fakeClock += 1e-4; }, [](double) {});
+  const auto report = sp::test::logDemoRun(path, 1.5, {"rate.log=100"});
   return report && report->health.healthy();
 }
 

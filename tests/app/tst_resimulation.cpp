@@ -11,26 +11,16 @@
 #include "app/headless_runner.h"
 #include "app/resimulation.h"
 #include "app/session_log.h"
+#include "tests/app/demo_log.h"
 
 using namespace sp;
 
 namespace {
 
-std::string sourcePath(const std::string& relative) { return std::string(SP_SOURCE_DIR) + "/" + relative; }
 
 // Logs a 3 s run of the demo sequence on flat ground to `path`.
 bool logRun(const std::string& path) {
-  RunOptions o;
-  o.worldFile = sourcePath("terrains/flat.world.xml");
-  o.commandsFile = sourcePath("terrains/demo.seq");
-  o.duration = 3;
-  o.realTimeFactor = 0;
-  o.progressInterval = 0;
-  o.logFile = path;
-  std::ostringstream out, err;
-  double fakeClock = 0;
-  auto report = runHeadless(o, out, err, [&] { return fakeClock += 1e-4; }, [](double) {});
-  if (!report) qWarning("%s", err.str().c_str());
+  const auto report = sp::test::logDemoRun(path, 3);
   return report && report->health.healthy() && report->logDropped == 0;
 }
 
