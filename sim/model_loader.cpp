@@ -296,6 +296,20 @@ void readVersion(ElementReader& r) {
   (void)version;
 }
 
+/// Parses `xml`, checks its root element is `<expected>` and reads the
+/// root's name and version; nullptr (with diagnostics) if any of that fails.
+const XMLElement* openRoot(XMLDocument& doc, std::string_view xml, std::string_view file, const char* expected,
+                           std::string& name, Diagnostics& diag) {
+  if (!parseXml(doc, xml, file, diag)) return nullptr;
+  const XMLElement* root = rootElement(doc, expected, file, diag);
+  if (!root) return nullptr;
+  ElementReader r(root, file, diag);
+  name = r.name();
+  readVersion(r);
+  r.finish();
+  return root;
+}
+
 std::optional<GeomSpec> readGeom(const XMLElement* e, std::string_view file, Diagnostics& diag) {
   ElementReader r(e, file, diag);
   const int errorsBefore = diag.errorCount();
@@ -563,18 +577,10 @@ void readDrive(const XMLElement* e, RobotModel& robot, std::string_view file, Di
 std::optional<RobotModel> parseRobot(std::string_view xml, std::string_view file, Diagnostics& diag) {
   const int errorsBefore = diag.errorCount();
   XMLDocument doc;
-  if (!parseXml(doc, xml, file, diag)) return std::nullopt;
-  const XMLElement* root = rootElement(doc, "robot", file, diag);
-  if (!root) return std::nullopt;
-
   RobotModel robot;
   robot.file = std::string(file);
-  {
-    ElementReader r(root, file, diag);
-    robot.name = r.name();
-    readVersion(r);
-    r.finish();
-  }
+  const XMLElement* root = openRoot(doc, xml, file, "robot", robot.name, diag);
+  if (!root) return std::nullopt;
   NameSet links("link", file, diag), joints("joint", file, diag), actuators("actuator", file, diag),
       sensors("sensor", file, diag);
   std::vector<PendingJoint> pendingJoints;
@@ -818,18 +824,10 @@ std::optional<WorldModel> parseWorld(std::string_view xml, std::string_view file
                                      Diagnostics& diag) {
   const int errorsBefore = diag.errorCount();
   XMLDocument doc;
-  if (!parseXml(doc, xml, file, diag)) return std::nullopt;
-  const XMLElement* root = rootElement(doc, "world", file, diag);
-  if (!root) return std::nullopt;
-
   WorldModel world;
   world.file = std::string(file);
-  {
-    ElementReader r(root, file, diag);
-    world.name = r.name();
-    readVersion(r);
-    r.finish();
-  }
+  const XMLElement* root = openRoot(doc, xml, file, "world", world.name, diag);
+  if (!root) return std::nullopt;
   NameSet materials("material", file, diag), objects("object", file, diag), robots("robot", file, diag);
   std::vector<std::pair<std::string, int>> materialRefs;
   bool haveDefault = false, haveGravity = false;
