@@ -1,0 +1,23 @@
+#pragma once
+// Forward kinematics of a robot model: where each link is, given where the
+// base link is and every joint's position. The console draws the robot as
+// telemetry reports it (base pose + joint positions) with this, without a
+// physics world of its own.
+
+#include <span>
+#include <vector>
+
+#include "sim/math.h"
+#include "sim/robot_model.h"
+
+namespace sp {
+
+/// World poses of every link of `robot` (robot.links order). `base` is link
+/// 0's pose in the world; `jointPositions` holds one value per joint in
+/// robot.joints order ([rad] for hinges, [m] for sliders; universal, ball and
+/// fixed joints are drawn at zero). Missing values count as zero. Links not
+/// reachable from link 0 through joints keep their zero-pose place relative
+/// to the base. Uses the same sign conventions as World::jointPosition.
+std::vector<Pose> linkPoses(const RobotModel& robot, const Pose& base, std::span<const double> jointPositions);
+
+}  // namespace sp
