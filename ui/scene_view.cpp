@@ -1,0 +1,702 @@
+#include "ui/scene_view.h"
+
+#include <QElapsedTimer>
+#include <QLabel>
+#include <QMouseEvent>
+#include <QOpenGLContext>
+#include <QOpenGLFunctions>
+#include <QTimer>
+#include <QWheelEvent>
+
+#include <osg/BlendFunc>
+#include <osg/Fog>
+#include <osg/Geode>
+#include <osg/Geometry>
+#include <osg/Light>
+#include <osg/LightModel>
+#include <osg/LightSource>
+#include <osg/LineWidth>
+#include <osg/Material>
+#include <osg/MatrixTransform>
+#include <osg/Point>
+#include <osg/PolygonOffset>
+#include <osg/ShapeDrawable>
+#include <osgViewer/GraphicsWindow>
+#include <osgViewer/Viewer>
+
+#include <algorithm>
+#include <cmath>
+
+#include "sim/kinematics.h"
+
+namespace sp {
+namespace {
+
+// Sky blue; the fog fades distant ground into it so the horizon has no edge.
+const osg::Vec4 kSkyColor(0.66f, 0.78f, 0.90f, 1.0f);
+const osg::Vec4 kEarthColor(0.60f, 0.56f, 0.48f, 1.0f);
+const osg::Vec4 kGridColor(0.45f, 0.42f, 0.36f, 1.0f);
+const osg::Vec4 kGridMajorColor(0.33f, 0.31f, 0.27f, 1.0f);  // every 5 m
+const osg::Vec4 kBeamHitColor(1.0f, 0.15f, 0.10f, 0.35f);
+const osg::Vec4 kBeamMissColor(1.0f, 1.0f, 1.0f, 0.18f);
+const osg::Vec4 kHitPointColor(1.0f, 0.10f, 0.05f, 1.0f);
+
+constexpr double kFovY = 40.0;            // [deg]
+constexpr double kPlaneHalfSize = 200.0;  // [m]; fogged out long before its edge
+constexpr double kPlaneCell = 4.0;        // [m]
+constexpr int kGridHalfSize = 50;         // [m] of 1 m grid around the origin
+constexpr double kGridLift = 0.005;       // [m] lines above the ground, with polygon offset
+constexpr double kDefaultAzimuth = degToRad(-150);  // behind the robot, to its right
+constexpr double kDefaultElevation = degToRad(19);
+constexpr double kDefaultDistance = 7.0;  // [m]
+constexpr double kMinElevation = degToRad(1), kMaxElevation = degToRad(89);
+constexpr double kMinDistance = 0.5, kMaxDistance = 300.0;
+constexpr double kOrbitRadPerPixel = 0.006;
+
+float f(double v) { return static_cast<float>(v); }
+osg::Vec3 toOsg(Vec3 v) { return {f(v.x), f(v.y), f(v.z)}; }
+osg::Vec3d toOsgD(Vec3 v) { return {v.x, v.y, v.z}; }
+osg::Quat toOsg(const Quat& q) { return {q.x, q.y, q.z, q.w}; }  // osg order: x, y, z, w
+osg::Vec4 toOsg(const Color& c) { return {f(c.r), f(c.g), f(c.b), f(c.a)}; }
+// OSG multiplies row vectors: rotate first, then translate.
+osg::Matrixd toMatrix(const Pose& p) {
+  return osg::Matrixd::rotate(toOsg(p.q)) * osg::Matrixd::translate(toOsgD(p.p));
+}
+
+// Buffers rather than display lists: the laser's arrays change every scan.
+osg::ref_ptr<osg::Geometry> newGeometry() {
+  osg::ref_ptr<osg::Geometry> g = new osg::Geometry;
+  g->setUseDisplayList(false);
+  g->setUseVertexBufferObjects(true);
+  return g;
+}
+
+void makeTransparent(osg::StateSet* s) {
+  // Colour blends; the framebuffer's alpha stays 1, or Qt would compose the
+  // widget's image as translucent over whatever lies behind it.
+  s->setAttributeAndModes(new osg::BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE));
+  s->setRenderingHint(osg::StateSet::TRANSPARENT_BIN);
+}
+
+/// One geom of a link or object, in its owner's frame.
+osg::ref_ptr<osg::Drawable> geomDrawable(const GeomSpec& g) {
+  const osg::Vec3 c = toOsg(g.pose.p);
+  const osg::Quat q = toOsg(g.pose.q);
+  auto rotated = [&q](auto* s) {
+    s->setRotation(q);
+    return s;
+  };
+  osg::ref_ptr<osg::Shape> shape;
+  switch (g.type) {
+    case GeomType::Box:
+      shape = rotated(new osg::Box(c, f(g.size.x), f(g.size.y), f(g.size.z)));
+      break;
+    case GeomType::Cylinder:
+      shape = rotated(new osg::Cylinder(c, f(g.radius), f(g.length)));
+      break;
+    case GeomType::Sphere:
+      shape = new osg::Sphere(c, f(g.radius));
+      break;
+    case GeomType::Capsule:  // osg::Capsule's height is the straight part, as in ODE
+      shape = rotated(new osg::Capsule(c, f(g.radius), f(g.length)));
+      break;
+  }
+  osg::ref_ptr<osg::ShapeDrawable> d = new osg::ShapeDrawable(shape.get());
+  d->setColor(toOsg(g.color));
+  if (g.color.a < 1.0) makeTransparent(d->getOrCreateStateSet());
+  return d;
+}
+
+osg::ref_ptr<osg::Geode> geomsNode(const std::vector<GeomSpec>& geoms) {
+  osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+  for (const GeomSpec& g : geoms) geode->addDrawable(geomDrawable(g));
+  return geode;
+}
+
+/// Ground height at world (x, y): the plane's height, or the heightfield's
+/// (its edge value outside it, as HeightGrid::heightAt does).
+double groundHeight(const TerrainSpec& t, double x, double y) {
+  if (t.kind == TerrainSpec::Kind::Plane || t.grid.columns < 2 || t.grid.rows < 2) return t.pose.p.z;
+  const Vec3 local = transformPoint(inverse(t.pose), {x, y, 0});
+  return t.grid.heightAt(local.x, local.y) + t.pose.p.z;
+}
+
+/// Earth at the bottom, grass in the middle, dry light grass on top.
+osg::Vec4 heightColor(double t) {
+  const osg::Vec4 low(0.45f, 0.38f, 0.28f, 1.0f), mid(0.50f, 0.55f, 0.33f, 1.0f),
+      high(0.74f, 0.72f, 0.56f, 1.0f);
+  t = std::clamp(t, 0.0, 1.0);
+  return t < 0.5 ? low + (mid - low) * f(2 * t) : mid + (high - mid) * f(2 * t - 1);
+}
+
+/// The plane as a grid of cells rather than one quad: fixed-function fog is
+/// computed per vertex, and a quad whose corners lie far away (or behind the
+/// camera) would be fogged all over.
+osg::ref_ptr<osg::Node> planeNode(double z) {
+  const int n = static_cast<int>(2 * kPlaneHalfSize / kPlaneCell);  // cells per side
+  osg::ref_ptr<osg::Geometry> g = newGeometry();
+  auto* v = new osg::Vec3Array;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      v->push_back({f(-kPlaneHalfSize + i * kPlaneCell), f(-kPlaneHalfSize + j * kPlaneCell), f(z)});
+  g->setVertexArray(v);
+  auto* normal = new osg::Vec3Array;
+  normal->push_back({0, 0, 1});
+  g->setNormalArray(normal, osg::Array::BIND_OVERALL);
+  auto* c = new osg::Vec4Array;
+  c->push_back(kEarthColor);
+  g->setColorArray(c, osg::Array::BIND_OVERALL);
+  auto* tris = new osg::DrawElementsUInt(GL_TRIANGLES);
+  auto index = [n](int i, int j) { return static_cast<unsigned>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      for (unsigned k : {index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j), index(i + 1, j + 1),
+                         index(i, j + 1)})
+        tris->push_back(k);
+  g->addPrimitiveSet(tris);
+  osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+  geode->addDrawable(g);
+  return geode;
+}
+
+/// The heightfield as a smooth-shaded mesh in the terrain frame, split along
+/// the same cell diagonals as ODE's, placed by the terrain pose (grid centre).
+osg::ref_ptr<osg::Node> heightfieldNode(const TerrainSpec& t) {
+  const HeightGrid& grid = t.grid;
+  osg::ref_ptr<osg::MatrixTransform> xf = new osg::MatrixTransform(toMatrix(t.pose));
+  const int nx = grid.columns, ny = grid.rows;
+  if (nx < 2 || ny < 2 || grid.heights.size() != static_cast<size_t>(nx) * static_cast<size_t>(ny)) return xf;
+  const double sx = grid.spacingX(), sy = grid.spacingY();
+  // The colour ramp spans at least 0.5 m, so gentle bumps stay gentle.
+  const double lo = grid.minHeight(), span = std::max(grid.maxHeight() - lo, 0.5);
+  osg::ref_ptr<osg::Geometry> g = newGeometry();
+  auto* v = new osg::Vec3Array;
+  auto* n = new osg::Vec3Array;
+  auto* c = new osg::Vec4Array;
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const double h = grid.at(i, j);
+      v->push_back({f(-grid.width / 2 + i * sx), f(-grid.depth / 2 + j * sy), f(h)});
+      // Central differences (one-sided at the edges).
+      const int i0 = std::max(i - 1, 0), i1 = std::min(i + 1, nx - 1);
+      const int j0 = std::max(j - 1, 0), j1 = std::min(j + 1, ny - 1);
+      const double dx = (grid.at(i1, j) - grid.at(i0, j)) / ((i1 - i0) * sx);
+      const double dy = (grid.at(i, j1) - grid.at(i, j0)) / ((j1 - j0) * sy);
+      osg::Vec3 normal(f(-dx), f(-dy), 1.0f);
+      normal.normalize();
+      n->push_back(normal);
+      c->push_back(heightColor((h - lo) / span));
+    }
+  }
+  g->setVertexArray(v);
+  g->setNormalArray(n, osg::Array::BIND_PER_VERTEX);
+  g->setColorArray(c, osg::Array::BIND_PER_VERTEX);
+  auto* tris = new osg::DrawElementsUInt(GL_TRIANGLES);
+  tris->reserve(static_cast<size_t>(nx - 1) * static_cast<size_t>(ny - 1) * 6);
+  auto index = [nx](int i, int j) { return static_cast<unsigned>(j * nx + i); };
+  for (int j = 0; j + 1 < ny; ++j) {
+    for (int i = 0; i + 1 < nx; ++i) {
+      // Diagonal (i, j)-(i+1, j+1), counter-clockwise seen from above.
+      for (unsigned k : {index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j), index(i + 1, j + 1),
+                         index(i, j + 1)})
+        tris->push_back(k);
+    }
+  }
+  g->addPrimitiveSet(tris);
+  osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+  geode->addDrawable(g);
+  xf->addChild(geode);
+  return xf;
+}
+
+/// 1 m grid lines in world x and y, darker every 5 m: flat over the plane
+/// around the origin, or draped over the heightfield's extent.
+osg::ref_ptr<osg::Node> gridNode(const TerrainSpec& t) {
+  auto* v = new osg::Vec3Array;
+  auto* c = new osg::Vec4Array;
+  auto addSegment = [&](osg::Vec3 a, osg::Vec3 b, int line) {
+    const osg::Vec4& color = line % 5 == 0 ? kGridMajorColor : kGridColor;
+    v->push_back(a);
+    v->push_back(b);
+    c->push_back(color);
+    c->push_back(color);
+  };
+  const HeightGrid& grid = t.grid;
+  if (t.kind == TerrainSpec::Kind::Plane || grid.columns < 2 || grid.rows < 2) {
+    // In 2 m pieces, for per-vertex fog as on the plane.
+    const float z = f(t.pose.p.z + kGridLift);
+    for (int k = -kGridHalfSize; k <= kGridHalfSize; ++k) {
+      const float p = static_cast<float>(k);
+      for (int s = -kGridHalfSize; s < kGridHalfSize; s += 2) {
+        const float a = static_cast<float>(s), b = static_cast<float>(s + 2);
+        addSegment({p, a, z}, {p, b, z}, k);
+        addSegment({a, p, z}, {b, p, z}, k);
+      }
+    }
+  } else {
+    // World-axis lines over the (possibly yawed) grid's bounding box, cut
+    // where they leave the grid, sampled finely enough to follow its cells.
+    const Pose toGrid = inverse(t.pose);
+    double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
+    for (double sxn : {-0.5, 0.5}) {
+      for (double syn : {-0.5, 0.5}) {
+        const Vec3 w = transformPoint(t.pose, {sxn * grid.width, syn * grid.depth, 0});
+        xmin = std::min(xmin, w.x), xmax = std::max(xmax, w.x);
+        ymin = std::min(ymin, w.y), ymax = std::max(ymax, w.y);
+      }
+    }
+    const double step = std::min(grid.spacingX(), grid.spacingY()) / 2;
+    const double lift = std::max(0.01, 0.01 * (grid.maxHeight() - grid.minHeight()));
+    auto point = [&](double x, double y, osg::Vec3& out) {
+      const Vec3 local = transformPoint(toGrid, {x, y, 0});
+      const double eps = 1e-9;
+      if (std::abs(local.x) > grid.width / 2 + eps || std::abs(local.y) > grid.depth / 2 + eps) return false;
+      out = {f(x), f(y), f(grid.heightAt(local.x, local.y) + t.pose.p.z + lift)};
+      return true;
+    };
+    auto drape = [&](double x0, double y0, double x1, double y1, int line) {
+      const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(x1 - x0, y1 - y0) / step)));
+      osg::Vec3 a, b;
+      bool aIn = point(x0, y0, a);
+      for (int s = 1; s <= n; ++s) {
+        const double u = static_cast<double>(s) / n;
+        const bool bIn = point(x0 + u * (x1 - x0), y0 + u * (y1 - y0), b);
+        if (aIn && bIn) addSegment(a, b, line);
+        a = b;
+        aIn = bIn;
+      }
+    };
+    for (int k = static_cast<int>(std::ceil(xmin)); k <= static_cast<int>(std::floor(xmax)); ++k)
+      drape(k, ymin, k, ymax, k);
+    for (int k = static_cast<int>(std::ceil(ymin)); k <= static_cast<int>(std::floor(ymax)); ++k)
+      drape(xmin, k, xmax, k, k);
+  }
+  osg::ref_ptr<osg::Geometry> g = newGeometry();
+  g->setVertexArray(v);
+  g->setColorArray(c, osg::Array::BIND_PER_VERTEX);
+  g->addPrimitiveSet(new osg::DrawArrays(GL_LINES, 0, static_cast<int>(v->size())));
+  osg::StateSet* s = g->getOrCreateStateSet();
+  s->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
+  osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+  geode->addDrawable(g);
+  return geode;
+}
+
+/// Red x, green y, blue z arrows of 1 m at the origin, resting on the ground.
+osg::ref_ptr<osg::Node> axesNode(double groundZ) {
+  constexpr float kRadius = 0.02f, kLength = 1.0f, kTipRadius = 0.05f, kTipLength = 0.15f;
+  osg::ref_ptr<osg::MatrixTransform> xf =
+      new osg::MatrixTransform(osg::Matrixd::translate(0, 0, groundZ + kRadius));
+  osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+  const struct {
+    osg::Vec3 axis;
+    osg::Vec4 color;
+  } axes[] = {{{1, 0, 0}, {0.85f, 0.10f, 0.10f, 1}},
+              {{0, 1, 0}, {0.10f, 0.70f, 0.15f, 1}},
+              {{0, 0, 1}, {0.15f, 0.25f, 0.90f, 1}}};
+  for (const auto& a : axes) {
+    osg::Quat q;
+    q.makeRotate(osg::Vec3(0, 0, 1), a.axis);  // shapes lie along z
+    const float shaft = kLength - kTipLength;
+    auto* cyl = new osg::Cylinder(a.axis * (shaft / 2), kRadius, shaft);
+    cyl->setRotation(q);
+    // A cone's centre sits a quarter of its height above its base.
+    auto* cone = new osg::Cone(a.axis * (shaft + kTipLength / 4), kTipRadius, kTipLength);
+    cone->setRotation(q);
+    for (osg::Shape* shape : {static_cast<osg::Shape*>(cyl), static_cast<osg::Shape*>(cone)}) {
+      auto* d = new osg::ShapeDrawable(shape);
+      d->setColor(a.color);
+      geode->addDrawable(d);
+    }
+  }
+  xf->addChild(geode);
+  return xf;
+}
+
+}  // namespace
+
+struct SceneView::Impl {
+  osg::ref_ptr<osgViewer::Viewer> viewer;
+  osg::ref_ptr<osgViewer::GraphicsWindowEmbedded> window;
+  osg::ref_ptr<osg::Group> root;
+  osg::ref_ptr<osg::Group> worldNode;  // terrain, grid, axes, objects
+  osg::ref_ptr<osg::Group> robotNode;
+  std::vector<osg::ref_ptr<osg::MatrixTransform>> links;
+  osg::ref_ptr<osg::Geode> laserNode;
+  osg::ref_ptr<osg::Geometry> beams, hits;
+  osg::ref_ptr<osg::Fog> fog;
+
+  // The robot as last set, and whether the graph still shows an older state.
+  bool hasRobot = false;
+  RobotModel robot;
+  Pose base;
+  std::vector<double> joints;
+  std::vector<Pose> linkWorld;
+  bool robotDirty = false;
+
+  // Laser: robot.sensors index, or -1 without one.
+  int laser = -1;
+  double laserAngleMin = 0, laserAngleStep = 0;
+  std::vector<double> laserRanges;
+  bool laserDirty = false;
+  bool laserVisible = true;
+
+  // Orbit camera around `centre`, z up.
+  osg::Vec3d centre;
+  double azimuth = kDefaultAzimuth, elevation = kDefaultElevation, distance = kDefaultDistance;
+  bool follow = true;
+  Qt::MouseButton dragButton = Qt::NoButton;
+  QPointF lastMouse;  // device pixels
+  double dpr = 1.0;
+  int pixelWidth = 1, pixelHeight = 1;
+
+  QTimer timer;
+  QLabel* hud = nullptr;  // child of the view
+  QElapsedTimer clock;
+  int64_t frames = 0;
+  int64_t windowFrames = 0;  // frames since windowStart
+  qint64 windowStart = 0;    // [ms] of clock
+  double fps = 0;
+
+  Impl();
+  void buildLaser();
+  void updateLaser();
+  void sync();
+  void updateHud();
+};
+
+SceneView::Impl::Impl() {
+  root = new osg::Group;
+  worldNode = new osg::Group;
+  robotNode = new osg::Group;
+  root->addChild(worldNode);
+  root->addChild(robotNode);
+  buildLaser();
+  root->addChild(laserNode);
+
+  osg::StateSet* s = root->getOrCreateStateSet();
+  // Geometry colours drive ambient and diffuse; a little gloss on the shapes.
+  auto* material = new osg::Material;
+  material->setColorMode(osg::Material::AMBIENT_AND_DIFFUSE);
+  material->setSpecular(osg::Material::FRONT_AND_BACK, {0.25f, 0.25f, 0.25f, 1.0f});
+  material->setShininess(osg::Material::FRONT_AND_BACK, 32.0f);
+  s->setAttributeAndModes(material);
+  auto* lightModel = new osg::LightModel;
+  lightModel->setAmbientIntensity({0.18f, 0.18f, 0.20f, 1.0f});
+  s->setAttributeAndModes(lightModel);
+  // A dim fill light from the opposite side of the sun, so faces turned away
+  // from the sun still show their shape.
+  auto* fill = new osg::Light(1);
+  fill->setPosition({-0.5f, 0.6f, 0.4f, 0.0f});
+  fill->setAmbient({0, 0, 0, 1});
+  fill->setDiffuse({0.28f, 0.29f, 0.32f, 1.0f});
+  fill->setSpecular({0, 0, 0, 1});
+  auto* fillSource = new osg::LightSource;
+  fillSource->setLight(fill);
+  fillSource->setStateSetModes(*s, osg::StateAttribute::ON);
+  root->addChild(fillSource);
+  fog = new osg::Fog;
+  fog->setMode(osg::Fog::LINEAR);
+  fog->setColor(kSkyColor);
+  s->setAttributeAndModes(fog);
+
+  window = new osgViewer::GraphicsWindowEmbedded(0, 0, 1, 1);
+  viewer = new osgViewer::Viewer;
+  viewer->setThreadingModel(osgViewer::Viewer::SingleThreaded);
+  viewer->setKeyEventSetsDone(0);  // Esc must not end the viewer
+  viewer->setQuitEventSetsDone(false);
+  osg::Camera* camera = viewer->getCamera();
+  camera->setGraphicsContext(window);
+  camera->setViewport(0, 0, 1, 1);
+  camera->setClearColor(kSkyColor);
+  // The sun: a directional light fixed in the world, high up towards +x, -y.
+  viewer->setLightingMode(osg::View::SKY_LIGHT);
+  osg::Light* sun = viewer->getLight();
+  sun->setPosition({0.45f, -0.35f, 0.82f, 0.0f});
+  sun->setAmbient({0.30f, 0.30f, 0.32f, 1.0f});
+  sun->setDiffuse({0.80f, 0.78f, 0.72f, 1.0f});
+  sun->setSpecular({0.5f, 0.5f, 0.5f, 1.0f});
+  viewer->setSceneData(root);
+  clock.start();
+}
+
+void SceneView::Impl::buildLaser() {
+  laserNode = new osg::Geode;
+  beams = newGeometry();
+  beams->setVertexArray(new osg::Vec3Array);
+  beams->setColorArray(new osg::Vec4Array, osg::Array::BIND_PER_VERTEX);
+  beams->addPrimitiveSet(new osg::DrawArrays(GL_LINES, 0, 0));
+  beams->setDataVariance(osg::Object::DYNAMIC);
+  hits = newGeometry();
+  hits->setVertexArray(new osg::Vec3Array);
+  auto* hitColor = new osg::Vec4Array;
+  hitColor->push_back(kHitPointColor);
+  hits->setColorArray(hitColor, osg::Array::BIND_OVERALL);
+  hits->addPrimitiveSet(new osg::DrawArrays(GL_POINTS, 0, 0));
+  hits->setDataVariance(osg::Object::DYNAMIC);
+  laserNode->addDrawable(beams);
+  laserNode->addDrawable(hits);
+  osg::StateSet* s = laserNode->getOrCreateStateSet();
+  s->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
+  s->setAttributeAndModes(new osg::LineWidth(1.0f));
+  s->setAttributeAndModes(new osg::Point(5.0f));
+  makeTransparent(s);
+}
+
+// Rebuilds the beams from the stored scan and the laser's current pose.
+void SceneView::Impl::updateLaser() {
+  auto* bv = static_cast<osg::Vec3Array*>(beams->getVertexArray());
+  auto* bc = static_cast<osg::Vec4Array*>(beams->getColorArray());
+  auto* hv = static_cast<osg::Vec3Array*>(hits->getVertexArray());
+  bv->clear();
+  bc->clear();
+  hv->clear();
+  if (laser >= 0 && static_cast<size_t>(robot.sensors[laser].link) < linkWorld.size()) {
+    const SensorSpec& sensor = robot.sensors[laser];
+    const Pose pose = linkWorld[sensor.link] * sensor.pose;
+    const osg::Vec3 origin = toOsg(pose.p);
+    for (size_t k = 0; k < laserRanges.size(); ++k) {
+      const double r = laserRanges[k];
+      if (std::isnan(r) || r < 0) continue;  // invalid reading: nothing to show
+      const bool hit = r <= sensor.maxRange;
+      const double a = laserAngleMin + static_cast<double>(k) * laserAngleStep;
+      const osg::Vec3 end = toOsg(transformPoint(pose, {std::cos(a) * (hit ? r : sensor.maxRange),
+                                                        std::sin(a) * (hit ? r : sensor.maxRange), 0}));
+      bv->push_back(origin);
+      bv->push_back(end);
+      bc->push_back(hit ? kBeamHitColor : kBeamMissColor);
+      bc->push_back(hit ? kBeamHitColor : kBeamMissColor);
+      if (hit) hv->push_back(end);
+    }
+  }
+  static_cast<osg::DrawArrays*>(beams->getPrimitiveSet(0))->setCount(static_cast<int>(bv->size()));
+  static_cast<osg::DrawArrays*>(hits->getPrimitiveSet(0))->setCount(static_cast<int>(hv->size()));
+  for (osg::Array* array : {static_cast<osg::Array*>(bv), static_cast<osg::Array*>(bc),
+                            static_cast<osg::Array*>(hv)})
+    array->dirty();
+  beams->dirtyBound();
+  hits->dirtyBound();
+}
+
+// Brings the scene graph and camera up to the stored state; called before
+// each frame, so setters never touch the graph.
+void SceneView::Impl::sync() {
+  if (robotDirty) {
+    linkWorld = linkPoses(robot, base, joints);
+    for (size_t i = 0; i < links.size() && i < linkWorld.size(); ++i) links[i]->setMatrix(toMatrix(linkWorld[i]));
+    robotDirty = false;
+    laserDirty = true;  // the laser rides on the robot
+  }
+  if (laserDirty) {
+    updateLaser();
+    laserDirty = false;
+  }
+  laserNode->setNodeMask(laserVisible ? ~0u : 0u);
+  if (follow && hasRobot) centre = toOsgD(base.p);
+  const osg::Vec3d eye =
+      centre + osg::Vec3d(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                          std::sin(elevation)) *
+                   distance;
+  viewer->getCamera()->setViewMatrixAsLookAt(eye, centre, osg::Vec3d(0, 0, 1));
+  // Fog starts behind what the camera looks at, whatever the zoom.
+  fog->setStart(f(distance + 15));
+  fog->setEnd(f(distance * 2 + 80));
+}
+
+void SceneView::Impl::updateHud() {
+  hud->setText(QStringLiteral("%1 fps · %2").arg(fps, 0, 'f', 0).arg(follow ? QStringLiteral("follow")
+                                                                          : QStringLiteral("free camera")));
+  hud->adjustSize();
+}
+
+SceneView::SceneView(QWidget* parent) : QOpenGLWidget(parent), m_(std::make_unique<Impl>()) {
+  setMinimumSize(160, 120);
+  m_->hud = new QLabel(this);
+  m_->hud->setAttribute(Qt::WA_TransparentForMouseEvents);
+  m_->hud->setStyleSheet(QStringLiteral(
+      "QLabel { color: white; background: rgba(0, 0, 0, 110); padding: 2px 6px; border-radius: 3px; }"));
+  m_->hud->move(8, 8);
+  m_->updateHud();
+  m_->hud->show();  // children made after the parent is shown stay hidden otherwise
+  m_->timer.setInterval(16);
+  connect(&m_->timer, &QTimer::timeout, this, qOverload<>(&QWidget::update));
+  m_->timer.start();
+}
+
+SceneView::~SceneView() {
+  m_->timer.stop();
+  // OSG deletes its GL objects as the viewer goes: in our context.
+  makeCurrent();
+  m_.reset();
+  doneCurrent();
+}
+
+void SceneView::setWorld(const WorldModel& world) {
+  Impl& m = *m_;
+  m.worldNode->removeChildren(0, m.worldNode->getNumChildren());
+  m.robotNode->removeChildren(0, m.robotNode->getNumChildren());
+  m.links.clear();
+
+  const TerrainSpec& t = world.terrain;
+  osg::ref_ptr<osg::Node> terrain = t.kind == TerrainSpec::Kind::Plane ? planeNode(t.pose.p.z) : heightfieldNode(t);
+  // Matte ground, pushed back in depth so the grid lines on it always win.
+  auto* matte = new osg::Material;
+  matte->setColorMode(osg::Material::AMBIENT_AND_DIFFUSE);
+  matte->setSpecular(osg::Material::FRONT_AND_BACK, {0, 0, 0, 1});
+  terrain->getOrCreateStateSet()->setAttributeAndModes(matte);
+  terrain->getOrCreateStateSet()->setAttributeAndModes(new osg::PolygonOffset(1.0f, 1.0f));
+  m.worldNode->addChild(terrain);
+  m.worldNode->addChild(gridNode(t));
+  m.worldNode->addChild(axesNode(groundHeight(t, 0, 0)));
+  // Dynamic objects stay where the file puts them: telemetry does not carry them.
+  for (const ObjectSpec& o : world.objects) {
+    osg::ref_ptr<osg::MatrixTransform> xf = new osg::MatrixTransform(toMatrix(o.pose));
+    xf->addChild(geomsNode(o.geoms));
+    m.worldNode->addChild(xf);
+  }
+
+  m.hasRobot = !world.robots.empty() && !world.robots[0].model.links.empty();
+  m.robot = m.hasRobot ? world.robots[0].model : RobotModel{};
+  m.laser = -1;
+  for (size_t i = 0; i < m.robot.sensors.size(); ++i) {
+    const SensorSpec& s = m.robot.sensors[i];
+    if (s.type == SensorType::Laser && s.link >= 0 && static_cast<size_t>(s.link) < m.robot.links.size()) {
+      m.laser = static_cast<int>(i);
+      break;
+    }
+  }
+  for (const LinkSpec& link : m.robot.links) {
+    osg::ref_ptr<osg::MatrixTransform> xf = new osg::MatrixTransform;
+    xf->setDataVariance(osg::Object::DYNAMIC);
+    xf->addChild(geomsNode(link.geoms));
+    m.robotNode->addChild(xf);
+    m.links.push_back(xf);
+  }
+  m.base = m.hasRobot ? world.robots[0].pose * m.robot.links[0].pose : Pose{};
+  m.joints.assign(m.robot.joints.size(), 0.0);
+  m.linkWorld.clear();
+  m.robotDirty = true;
+  m.laserRanges.clear();
+  m.laserDirty = true;
+  if (!m.hasRobot) m.centre = {};
+}
+
+void SceneView::setRobotState(const Pose& base, const std::vector<double>& jointPositions) {
+  m_->base = base;
+  m_->joints = jointPositions;
+  m_->robotDirty = true;
+}
+
+void SceneView::setLaser(double angleMin, double angleStep, const std::vector<double>& ranges) {
+  m_->laserAngleMin = angleMin;
+  m_->laserAngleStep = angleStep;
+  m_->laserRanges = ranges;
+  m_->laserDirty = true;
+}
+
+void SceneView::setLaserVisible(bool visible) { m_->laserVisible = visible; }
+bool SceneView::laserVisible() const { return m_->laserVisible; }
+
+void SceneView::setFollow(bool on) {
+  m_->follow = on;
+  m_->updateHud();
+}
+
+bool SceneView::follow() const { return m_->follow; }
+
+void SceneView::resetView() {
+  m_->azimuth = kDefaultAzimuth;
+  m_->elevation = kDefaultElevation;
+  m_->distance = kDefaultDistance;
+  m_->centre = m_->hasRobot ? toOsgD(m_->base.p) : osg::Vec3d();
+}
+
+int64_t SceneView::framesDrawn() const { return m_->frames; }
+double SceneView::framesPerSecond() const { return m_->fps; }
+
+void SceneView::initializeGL() {
+  if (!isValid()) return;
+  // OSG needs the context current while it realizes; Qt has made it so.
+  if (!m_->viewer->isRealized()) m_->viewer->realize();
+}
+
+void SceneView::resizeGL(int w, int h) {
+  // Qt passes logical pixels; OSG draws in device pixels.
+  m_->dpr = devicePixelRatioF();
+  m_->pixelWidth = std::max(1, static_cast<int>(std::lround(w * m_->dpr)));
+  m_->pixelHeight = std::max(1, static_cast<int>(std::lround(h * m_->dpr)));
+  m_->window->resized(0, 0, m_->pixelWidth, m_->pixelHeight);
+  m_->window->getEventQueue()->windowResize(0, 0, m_->pixelWidth, m_->pixelHeight);
+  osg::Camera* camera = m_->viewer->getCamera();
+  camera->setViewport(0, 0, m_->pixelWidth, m_->pixelHeight);
+  camera->setProjectionMatrixAsPerspective(kFovY, static_cast<double>(m_->pixelWidth) / m_->pixelHeight, 0.1,
+                                           1000.0);
+}
+
+void SceneView::paintGL() {
+  Impl& m = *m_;
+  if (!isValid() || !m.viewer->isRealized()) return;
+  // QOpenGLWidget draws into its own FBO, not 0 (shared/STACK.md).
+  m.window->setDefaultFboId(defaultFramebufferObject());
+  m.sync();
+  m.viewer->frame();
+  // OSG leaves byte-aligned unpacking after texture uploads; Qt expects 4.
+  QOpenGLFunctions* gl = context()->functions();
+  gl->glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  gl->glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+
+  ++m.frames;
+  ++m.windowFrames;
+  const qint64 now = m.clock.elapsed();
+  if (now - m.windowStart >= 1000) {
+    m.fps = 1000.0 * static_cast<double>(m.windowFrames) / static_cast<double>(now - m.windowStart);
+    m.windowFrames = 0;
+    m.windowStart = now;
+    m.updateHud();
+  }
+}
+
+void SceneView::mousePressEvent(QMouseEvent* event) {
+  if (m_->dragButton == Qt::NoButton) {
+    m_->dragButton = event->button();
+    m_->lastMouse = event->position() * m_->dpr;
+  }
+  event->accept();
+}
+
+void SceneView::mouseMoveEvent(QMouseEvent* event) {
+  Impl& m = *m_;
+  if (m.dragButton == Qt::NoButton) return;
+  const QPointF p = event->position() * m.dpr;
+  const QPointF d = p - m.lastMouse;
+  m.lastMouse = p;
+  if (m.dragButton == Qt::LeftButton) {
+    m.azimuth -= d.x() * kOrbitRadPerPixel;
+    m.elevation = std::clamp(m.elevation + d.y() * kOrbitRadPerPixel, kMinElevation, kMaxElevation);
+  } else if (m.dragButton == Qt::RightButton || m.dragButton == Qt::MiddleButton) {
+    // Drag the ground under the cursor: the centre moves against the mouse,
+    // in the image plane, by the metres one pixel spans at the centre.
+    if (m.follow) setFollow(false);
+    const double metresPerPixel = 2 * m.distance * std::tan(degToRad(kFovY) / 2) / m.pixelHeight;
+    const osg::Vec3d forward(-std::cos(m.elevation) * std::cos(m.azimuth),
+                             -std::cos(m.elevation) * std::sin(m.azimuth), -std::sin(m.elevation));
+    const osg::Vec3d right(-std::sin(m.azimuth), std::cos(m.azimuth), 0);
+    const osg::Vec3d up = right ^ forward;
+    m.centre += (right * -d.x() + up * d.y()) * metresPerPixel;
+  }
+  event->accept();
+}
+
+void SceneView::mouseReleaseEvent(QMouseEvent* event) {
+  if (event->button() == m_->dragButton) m_->dragButton = Qt::NoButton;
+  event->accept();
+}
+
+void SceneView::wheelEvent(QWheelEvent* event) {
+  // One notch (120) zooms by 12 %.
+  const double notches = event->angleDelta().y() / 120.0;
+  m_->distance = std::clamp(m_->distance * std::pow(0.88, notches), kMinDistance, kMaxDistance);
+  event->accept();
+}
+
+}  // namespace sp

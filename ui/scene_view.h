@@ -1,0 +1,94 @@
+#pragma once
+// The console's 3D view: the world (terrain, objects, a 1 m ground grid, axes
+// at the origin), the robot as telemetry reports it (base pose + joint
+// positions through sp::linkPoses) and the latest laser scan, drawn with
+// OpenSceneGraph inside a QOpenGLWidget.
+//
+// OSG is built for fixed-function GL 2: the application must set a default
+// QSurfaceFormat of OpenGL 2.1 CompatibilityProfile before creating its
+// QApplication (shared/STACK.md). QT_QPA_PLATFORM=offscreen cannot draw it;
+// headless runs use xvfb-run.
+
+#include <QOpenGLWidget>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "sim/math.h"
+#include "sim/robot_model.h"
+
+namespace sp {
+
+/// An orbit-camera 3D view of one world and its first robot.
+///
+/// Setters only store state and mark it dirty; a 16 ms QTimer schedules a
+/// repaint, and the scene graph is brought up to date in paintGL, so setters
+/// are cheap enough for telemetry rates.
+///
+/// Mouse: left drag orbits, the wheel zooms, right or middle drag pans (which
+/// turns follow mode off).
+///
+/// Thread: GUI thread only, like every QWidget. The view must stay in its
+/// top-level window: moving it to another one recreates Qt's GL context,
+/// which this view does not rebuild its GL objects for.
+class SceneView : public QOpenGLWidget {
+  Q_OBJECT
+
+ public:
+  explicit SceneView(QWidget* parent = nullptr);
+  ~SceneView() override;
+
+  /// Builds the scene from `world` (copied; the view keeps what it needs):
+  /// the terrain (a plane as a large quad, a heightfield as a lit mesh
+  /// coloured by height), the objects at their initial poses, the ground grid
+  /// and axes, and robots[0]'s links at its initial pose with zero joints.
+  /// Replaces any previous world and laser scan; the camera keeps its angles
+  /// and distance. A world without robots shows no robot and no laser.
+  void setWorld(const WorldModel& world);
+
+  /// Places the robot: `base` is link 0's pose in the world, `jointPositions`
+  /// one value per joint in robot.joints order ([rad] or [m]; missing values
+  /// count as zero). Cheap: the link transforms are updated on the next paint.
+  void setRobotState(const Pose& base, const std::vector<double>& jointPositions);
+
+  /// The latest laser scan of robots[0]'s first laser sensor, drawn from the
+  /// sensor's pose under the robot's current state (link pose * mounting
+  /// pose). Beam k points at angleMin + k * angleStep [rad] about the
+  /// sensor's z axis. Ranges in [m]: finite ones within the sensor's maxRange
+  /// are hits (a beam and a point); inf or beyond maxRange (no return) draws a
+  /// faint beam to maxRange; NaN (invalid) is omitted. An empty `ranges`
+  /// clears the scan.
+  void setLaser(double angleMin, double angleStep, const std::vector<double>& ranges);
+  /// Shows or hides the laser scan (shown by default).
+  void setLaserVisible(bool visible);
+  bool laserVisible() const;
+
+  /// Follow mode keeps the orbit centre on the robot base (default on).
+  void setFollow(bool on);
+  bool follow() const;
+  /// Default camera angles and distance, centred on the robot base (the
+  /// origin without a robot). Follow mode is left as it is.
+  void resetView();
+
+  /// Frames drawn since construction.
+  int64_t framesDrawn() const;
+  /// Frames drawn per second over the last completed second; 0 before the
+  /// first second of drawing.
+  double framesPerSecond() const;
+
+ protected:
+  void initializeGL() override;
+  void resizeGL(int w, int h) override;
+  void paintGL() override;
+  void mousePressEvent(QMouseEvent* event) override;
+  void mouseMoveEvent(QMouseEvent* event) override;
+  void mouseReleaseEvent(QMouseEvent* event) override;
+  void wheelEvent(QWheelEvent* event) override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> m_;
+};
+
+}  // namespace sp
