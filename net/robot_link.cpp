@@ -24,14 +24,24 @@ RobotLink::RobotLink(RobotLinkConfig config, const RobotModel* robot,
 void RobotLink::connected(ClientId client, double) { clients_[client] = Client{}; }
 
 void RobotLink::disconnected(ClientId client, double) {
+  const std::string name = who(client);
   clients_.erase(client);
   if (holder_ == client) {
     // The lease goes with the connection; the deadman keeps counting from
     // the holder's last packet and stops the robot (tick()).
     holder_ = 0;
     holderLost_ = true;
+    notice("link", "lease lost with the connection of " + name);
     broadcastLease();
   }
+}
+
+void RobotLink::notice(std::string kind, std::string text) { notices_.push_back({std::move(kind), std::move(text)}); }
+
+std::string RobotLink::who(ClientId client) const {
+  auto it = clients_.find(client);
+  const std::string id = "client " + std::to_string(client);
+  return it == clients_.end() || !it->second.authenticated ? id : "'" + it->second.name + "' (" + id + ")";
 }
 
 void RobotLink::send(ClientId client, Message message) { outgoing_.push_back({client, std::move(message)}); }
@@ -54,6 +64,7 @@ void RobotLink::close(ClientId client, const std::string& reason) {
 
 void RobotLink::refuse(ClientId client, uint64_t seq, ReplyStatus status, std::string reason) {
   ++refused_;
+  notice("link", who(client) + ": command " + std::to_string(seq) + " refused (" + toString(status) + "): " + reason);
   send(client, ReplyMsg{seq, status, std::move(reason)});
 }
 
@@ -65,6 +76,7 @@ void RobotLink::stopEverything(EventKind why, const std::string& text, double no
   } else {
     estop_ = true;
   }
+  notice(toString(why), text);
   broadcast(EventMsg{why, text});
 }
 
@@ -79,11 +91,14 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
 
   if (const auto* hello = std::get_if<HelloMsg>(&message)) {
     if (c.authenticated) return send(client, ErrorMsg{"already authenticated"});
-    if (config_.token.empty() || !equalConstantTime(hello->token, config_.token))
+    if (config_.token.empty() || !equalConstantTime(hello->token, config_.token)) {
+      notice("link", who(client) + " refused: authentication failed");
       return close(client, "authentication failed");
+    }
     c.authenticated = true;
     c.name = hello->name;
     c.role = hello->role;
+    notice("link", who(client) + " authenticated as " + toString(c.role));
     send(client, WelcomeMsg{config_.robotName, ++session_, config_.telemetryRate});
     const std::string holderName = holder_ ? clients_[holder_].name : std::string();
     send(client, LeaseStateMsg{holderName, false});
@@ -92,19 +107,29 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
     return;
   }
   // Nothing but HELLO before authentication: no telemetry, no control.
-  if (!c.authenticated) return close(client, "HELLO first");
+  if (!c.authenticated) {
+    notice("link", who(client) + " closed: a message before HELLO");
+    return close(client, "HELLO first");
+  }
 
   std::visit(
       [&](const auto& m) {
         using T = std::decay_t<decltype(m)>;
         if constexpr (std::is_same_v<T, LeaseAcquireMsg>) {
-          if (c.role != Role::Control) return send(client, ErrorMsg{"a monitor cannot take the control lease"});
-          if (holder_ && holder_ != client) return send(client, LeaseStateMsg{clients_[holder_].name, false});
+          if (c.role != Role::Control) {
+            notice("link", who(client) + ": lease refused: a monitor cannot take the control lease");
+            return send(client, ErrorMsg{"a monitor cannot take the control lease"});
+          }
+          if (holder_ && holder_ != client) {
+            notice("link", who(client) + ": lease refused: " + who(holder_) + " holds it");
+            return send(client, LeaseStateMsg{clients_[holder_].name, false});
+          }
           // A new holder must not inherit a lost operator's motion: if the
           // deadman is still counting for a dropped holder, fire it now.
           if (holderLost_ && deadmanArmed_ && !failsafe_)
             stopEverything(EventKind::Failsafe, "the previous controlling client's connection was lost", now);
           holderLost_ = false;
+          if (holder_ != client) notice("link", "lease taken by " + who(client));
           holder_ = client;
           lastFromHolder_ = now;
           deadmanArmed_ = true;
@@ -123,6 +148,7 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
             holder_ = 0;
             deadmanArmed_ = false;
             commands_.emplace_back(std::in_place_type<StopCmd>);
+            notice("link", "lease released by " + who(client) + " (the robot stops)");
             broadcastLease();
           }
         } else if constexpr (std::is_same_v<T, CommandMsg>) {
@@ -166,12 +192,15 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
           stopEverything(EventKind::Estop, "e-stop from '" + c.name + "'" + (m.reason.empty() ? "" : ": " + m.reason),
                          now);
         } else if constexpr (std::is_same_v<T, RearmMsg>) {
-          if (c.role != Role::Control || (holder_ && holder_ != client))
+          if (c.role != Role::Control || (holder_ && holder_ != client)) {
+            notice("link", who(client) + ": re-arm refused: only the lease holder re-arms");
             return send(client, ErrorMsg{"only the lease holder re-arms"});
+          }
           if (!failsafe_ && !estop_) return;
           failsafe_ = estop_ = false;
           lastFromHolder_ = now;
           deadmanArmed_ = holder_ != 0;
+          notice(toString(EventKind::Rearmed), "re-armed by " + who(client));
           broadcast(EventMsg{EventKind::Rearmed, "re-armed by '" + c.name + "'"});
         } else {
           send(client, ErrorMsg{std::string(toString(typeOf(message))) + " is not sent to the robot"});
@@ -205,6 +234,7 @@ void RobotLink::sendHeartbeats(double now) {
 std::vector<RobotLink::Outgoing> RobotLink::takeOutgoing() { return std::exchange(outgoing_, {}); }
 std::vector<Command> RobotLink::takeCommands() { return std::exchange(commands_, {}); }
 std::vector<ClientId> RobotLink::takeClosing() { return std::exchange(closing_, {}); }
+std::vector<RobotLink::Notice> RobotLink::takeNotices() { return std::exchange(notices_, {}); }
 
 bool RobotLink::authenticated(ClientId client) const {
   auto it = clients_.find(client);

@@ -66,6 +66,18 @@ class RobotLink {
   /// Clients whose connection must be closed (after their last messages).
   std::vector<ClientId> takeClosing();
 
+  /// Something the link decided, for the robot's session log: `kind` is an
+  /// EVENT kind (toString(EventKind)): "estop", "failsafe", "rearmed", or
+  /// "link" for lease changes and refusals (clients, commands); `text` is
+  /// one line for a person.
+  struct Notice {
+    std::string kind;
+    std::string text;
+  };
+  /// Notices since the last call, in order. The server drains them after
+  /// every input; a user that never calls this lets them pile up.
+  std::vector<Notice> takeNotices();
+
   bool failsafeLatched() const { return failsafe_; }
   bool estopLatched() const { return estop_; }
   /// The lease holder, 0 if none.
@@ -103,6 +115,9 @@ class RobotLink {
   void refuse(ClientId client, uint64_t seq, ReplyStatus status, std::string reason);
   void stopEverything(EventKind why, const std::string& text, double now);
   void close(ClientId client, const std::string& reason);
+  void notice(std::string kind, std::string text);
+  /// "'NAME' (client N)" for notices.
+  std::string who(ClientId client) const;
 
   RobotLinkConfig config_;
   const RobotModel* robot_;
@@ -120,6 +135,7 @@ class RobotLink {
   std::vector<Outgoing> outgoing_;
   std::vector<Command> commands_;
   std::vector<ClientId> closing_;
+  std::vector<Notice> notices_;
 };
 
 }  // namespace sp::net

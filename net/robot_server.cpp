@@ -197,6 +197,10 @@ void RobotServer::deliverDue() {
 }
 
 void RobotServer::flush() {
+  // Notices before commands: an e-stop's notice reaches the robot's log no
+  // later than the stop it caused.
+  for (RobotLink::Notice& n : link_.takeNotices())
+    if (config_.events) config_.events(n.kind, n.text);
   const std::vector<Command> commands = link_.takeCommands();
   if (!commands.empty()) robot_.apply(commands);
   for (const RobotLink::Outgoing& o : link_.takeOutgoing()) {

@@ -69,6 +69,10 @@ struct RobotServerConfig {
   /// Where the server reports connections, refusals and bad frames (one
   /// line each, no newline); may be empty.
   std::function<void(const std::string&)> log;
+  /// Where the server reports what the link decided (RobotLink::Notice:
+  /// kind "estop", "failsafe", "rearmed" or "link" for lease changes and
+  /// refusals, and one line of text), for a session log; may be empty.
+  std::function<void(const std::string& kind, const std::string& text)> events;
   /// Emulated link (delay, jitter, loss), applied to frames in both
   /// directions of every connection; inactive by default.
   LinkEmulatorConfig emulation;
