@@ -7,7 +7,7 @@
 #include <ostream>
 #include <sstream>
 
-#include "app/session_log.h"
+#include "app/session_recorder.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/pacer.h"
@@ -47,56 +47,6 @@ class CsvWriter {
 
  private:
   std::ostream& out_;
-};
-
-std::string readWholeFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-// Feeds a session log from the physics loop: samples at the log rate, laser
-// scans as taken, a snapshot and a state hash every sim second.
-class RunLog {
- public:
-  RunLog(std::unique_ptr<SessionLogWriter> writer, const World& world)
-      : writer_(std::move(writer)),
-        sampleEvery_(std::max<int64_t>(1, std::llround(1.0 / (world.params().logRate * world.params().step)))),
-        snapshotEvery_(std::max<int64_t>(1, std::llround(1.0 / world.params().step))) {}
-
-  SessionLogWriter& writer() { return *writer_; }
-  bool toldFailure() const { return toldFailure_; }
-
-  // The state at the start: snapshot, hash and first sample.
-  void start(const World& world) {
-    writer_->logSnapshot(world.snapshot(), world.time(), world.stateHash());
-    writer_->logHash(world.stepCount(), world.stateHash());
-    writer_->logSample(makeLogSample(world));
-  }
-
-  // After each step.
-  void stepped(const World& world, std::ostream& err) {
-    const int64_t step = world.stepCount();
-    if (step % sampleEvery_ == 0) writer_->logSample(makeLogSample(world));
-    for (auto [robot, sensor] : world.sampledLastStep())
-      if (robot == 0)
-        if (auto scan = makeLogLaser(world.sensorSample(robot, sensor))) writer_->logLaser(std::move(*scan));
-    if (step % snapshotEvery_ == 0) {
-      writer_->logSnapshot(world.snapshot(), world.time(), world.stateHash());
-      writer_->logHash(step, world.stateHash());
-    }
-    if (!toldFailure_ && writer_->failed()) {
-      toldFailure_ = true;
-      err << "error: " << writer_->errorMessage() << "; the run goes on without logging\n";
-    }
-  }
-
- private:
-  std::unique_ptr<SessionLogWriter> writer_;
-  int64_t sampleEvery_;
-  int64_t snapshotEvery_;
-  bool toldFailure_ = false;
 };
 
 }  // namespace
@@ -164,26 +114,17 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
     csv = std::make_unique<CsvWriter>(csvFile, *world);
     out << "  writing CSV at " << params->csvRate << " Hz to " << options.csvFile << "\n";
   }
-  std::unique_ptr<RunLog> log;
+  std::unique_ptr<SessionRecorder> log;
   if (!options.logFile.empty()) {
-    SessionInfo info;
-#ifdef SP_VERSION
-    info.programVersion = SP_VERSION;
-#endif
-    info.files.push_back({"world", options.worldFile, readWholeFile(options.worldFile)});
-    info.files.push_back({"robot", robot.model.file, readWholeFile(robot.model.file)});
-    if (!options.paramsFile.empty())
-      info.files.push_back({"params", options.paramsFile, readWholeFile(options.paramsFile)});
-    if (!options.commandsFile.empty())
-      info.files.push_back({"commands", options.commandsFile, readWholeFile(options.commandsFile)});
     std::string error;
-    std::unique_ptr<SessionLogWriter> writer = SessionLogWriter::open(options.logFile, info, error);
+    std::unique_ptr<SessionLogWriter> writer = openSessionLog(
+        options.logFile,
+        {options.worldFile, robot.model.file, options.paramsFile, options.commandsFile, options.overrides}, error);
     if (!writer) {
       err << error << "\n";
       return std::nullopt;
     }
-    for (const std::string& o : options.overrides) writer->logEvent(0, 0, "param_override", o);
-    log = std::make_unique<RunLog>(std::move(writer), *world);
+    log = std::make_unique<SessionRecorder>(std::move(writer), *world);
     out << "  logging the session at " << params->logRate << " Hz to " << options.logFile << "\n";
   }
   const int64_t csvEvery = std::max<int64_t>(1, std::llround(1.0 / (params->csvRate * params->step)));
@@ -218,7 +159,11 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
       }
       if (!world->step()) break;
       if (csv && world->stepCount() % csvEvery == 0) csv->sample(*world);
-      if (log) log->stepped(*world, err);
+      if (log) {
+        log->stepped(*world);
+        if (log->newlyFailed())
+          err << "error: " << log->writer().errorMessage() << "; the run goes on without logging\n";
+      }
     }
     pacer.stepped(due);
     if (!world->health().healthy()) break;
@@ -247,6 +192,7 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
     if (!report.health.healthy())
       log->writer().logEvent(report.health.step, report.health.time, "health", report.health.message());
     if (report.interrupted) log->writer().logEvent(world->stepCount(), world->time(), "interrupted", "");
+    log->finish(*world);
     log->writer().close();
     report.logDropped = log->writer().dropped();
     report.logError = log->writer().errorMessage();
@@ -267,7 +213,7 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
   std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(report.stateHash));
   out << "\n  " << report.commandsApplied << " commands applied; base ended at (" << base.p.x << ", "
       << base.p.y << ", " << base.p.z << ") m; state hash " << hash << "\n";
-  if (log && !report.logError.empty() && !log->toldFailure()) err << "error: " << report.logError << "\n";
+  if (log && !report.logError.empty() && log->newlyFailed()) err << "error: " << report.logError << "\n";
   if (log && report.logError.empty() && report.logDropped > 0)
     err << "warning: " << options.logFile << ": " << report.logDropped
         << " log items dropped (the writer could not keep up)\n";

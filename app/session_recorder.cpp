@@ -1,0 +1,75 @@
+#include "app/session_recorder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace sp {
+namespace {
+
+std::string readWholeFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+std::unique_ptr<SessionLogWriter> openSessionLog(const std::string& path, const SessionSources& sources,
+                                                 std::string& error, const SessionLogOptions& options) {
+  SessionInfo info;
+#ifdef SP_VERSION
+  info.programVersion = SP_VERSION;
+#endif
+  info.files.push_back({"world", sources.worldFile, readWholeFile(sources.worldFile)});
+  info.files.push_back({"robot", sources.robotFile, readWholeFile(sources.robotFile)});
+  if (!sources.paramsFile.empty())
+    info.files.push_back({"params", sources.paramsFile, readWholeFile(sources.paramsFile)});
+  if (!sources.commandsFile.empty())
+    info.files.push_back({"commands", sources.commandsFile, readWholeFile(sources.commandsFile)});
+  std::unique_ptr<SessionLogWriter> writer = SessionLogWriter::open(path, info, error, options);
+  if (writer)
+    for (const std::string& o : sources.overrides) writer->logEvent(0, 0, "param_override", o);
+  return writer;
+}
+
+SessionRecorder::SessionRecorder(std::unique_ptr<SessionLogWriter> writer, const World& world)
+    : writer_(std::move(writer)),
+      sampleEvery_(std::max<int64_t>(1, std::llround(1.0 / (world.params().logRate * world.params().step)))),
+      snapshotEvery_(std::max<int64_t>(1, std::llround(1.0 / world.params().step))) {}
+
+void SessionRecorder::snapshot(const World& world) {
+  const uint64_t hash = world.stateHash();
+  writer_->logSnapshot(world.snapshot(), world.time(), hash);
+  writer_->logHash(world.stepCount(), hash);
+  lastSnapshot_ = world.stepCount();
+}
+
+void SessionRecorder::start(const World& world) {
+  snapshot(world);
+  writer_->logSample(makeLogSample(world));
+}
+
+void SessionRecorder::stepped(const World& world) {
+  const int64_t step = world.stepCount();
+  if (step % sampleEvery_ == 0) writer_->logSample(makeLogSample(world));
+  for (auto [robot, sensor] : world.sampledLastStep())
+    if (robot == 0)
+      if (auto scan = makeLogLaser(world.sensorSample(robot, sensor))) writer_->logLaser(std::move(*scan));
+  if (step % snapshotEvery_ == 0) snapshot(world);
+}
+
+void SessionRecorder::finish(const World& world) {
+  // A diverged world's state is not one to restore or compare against.
+  if (world.stepCount() != lastSnapshot_ && world.health().healthy()) snapshot(world);
+}
+
+bool SessionRecorder::newlyFailed() {
+  if (toldFailure_ || !writer_->failed()) return false;
+  toldFailure_ = true;
+  return true;
+}
+
+}  // namespace sp
