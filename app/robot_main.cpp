@@ -3,16 +3,14 @@
 // a real robot's adapter would, so that everything can be tested without
 // hardware.
 
-#include <asio.hpp>
+#include <signal.h>
 
 #include <iostream>
+#include <mutex>
 #include <string>
 #include <vector>
 
-#include "app/headless_runner.h"
-#include "app/twin_host.h"
-#include "net/robot_server.h"
-#include "sim/model_loader.h"
+#include "app/stand_in.h"
 
 namespace {
 
@@ -29,36 +27,50 @@ constexpr const char* kUsage = R"(usage:
       --delay S         emulate a slow link: one-way delay [s] in both directions
       --jitter S        and +- this much jitter [s]
       --loss P          and lose each frame with probability P
-  Prints `listening on ADDRESS:PORT` when ready; stops on SIGINT or SIGTERM.
+      --log FILE        write the session log to FILE (must not exist)
+      --log-dir DIR     write it to a new DIR/session-YYYYMMDD-HHMMSS.splog
+                        (default: sessions/ under the current directory)
+      --no-log          write no session log
+  Prints `logging to PATH`, then `listening on ADDRESS:PORT` when ready;
+  connections, lease changes and e-stops go to stderr. Stops on SIGINT or
+  SIGTERM. The session log (docs/session-format.md) re-simulates with
+  `simpartner-sim resim PATH`.
 )";
 
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  std::string world, params, bind = "127.0.0.1", token;
-  std::vector<std::string> overrides;
-  std::optional<int> port;
-  std::optional<double> rtf;
-  sp::net::LinkEmulatorConfig emulation;
+  sp::StandInOptions options;
+  std::mutex lineMutex;
+  options.lineLog = [&lineMutex](const std::string& line) {
+    std::lock_guard<std::mutex> lock(lineMutex);
+    std::cerr << "simpartner-robot: " << line << "\n";
+  };
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--help" || a == "-h") {
       std::cout << kUsage;
       return 0;
     }
+    if (a == "--no-log") {
+      options.log = false;
+      continue;
+    }
     if (i + 1 >= args.size()) {
       std::cerr << "<command line>: error: unknown option or missing value '" << a << "'\n" << kUsage;
       return 2;
     }
     const std::string& v = args[++i];
-    if (a == "--world") world = v;
-    else if (a == "--params") params = v;
-    else if (a == "--set") overrides.push_back(v);
-    else if (a == "--bind") bind = v;
-    else if (a == "--token") token = v;
-    else if (a == "--port") port = std::atoi(v.c_str());
-    else if (a == "--rtf") rtf = v == "max" ? 0.0 : std::atof(v.c_str());
+    if (a == "--world") options.worldFile = v;
+    else if (a == "--params") options.paramsFile = v;
+    else if (a == "--set") options.overrides.push_back(v);
+    else if (a == "--bind") options.bind = v;
+    else if (a == "--token") options.token = v;
+    else if (a == "--port") options.port = static_cast<uint16_t>(std::atoi(v.c_str()));
+    else if (a == "--rtf") options.realTimeFactor = v == "max" ? 0.0 : std::atof(v.c_str());
+    else if (a == "--log") options.logPath = v;
+    else if (a == "--log-dir") options.logDir = v;
     else if (a == "--delay" || a == "--jitter" || a == "--loss") {
       char* end = nullptr;
       const double x = std::strtod(v.c_str(), &end);
@@ -67,71 +79,75 @@ int main(int argc, char** argv) {
                   << ", got '" << v << "'\n";
         return 2;
       }
-      (a == "--delay" ? emulation.delay : a == "--jitter" ? emulation.jitter : emulation.loss) = x;
+      sp::net::LinkEmulatorConfig& e = options.emulation;
+      (a == "--delay" ? e.delay : a == "--jitter" ? e.jitter : e.loss) = x;
     }
     else {
       std::cerr << "<command line>: error: unknown option '" << a << "'\n" << kUsage;
       return 2;
     }
   }
-  if (world.empty()) {
+  if (options.worldFile.empty()) {
     std::cerr << "<command line>: error: --world FILE is required\n" << kUsage;
     return 2;
   }
-  const bool loopback = bind == "127.0.0.1" || bind == "::1" || bind == "localhost";
-  if (token.empty() && !loopback) {
+  const std::string& bind = options.bind;
+  if (options.token.empty() && !(bind == "127.0.0.1" || bind == "::1" || bind == "localhost")) {
     std::cerr << "<command line>: error: refusing to listen on " << bind
               << " without --token: only loopback may run with a generated token\n";
     return 2;
   }
-  sp::Diagnostics diag;
-  auto simParams = sp::loadRunParams(params, overrides, diag);
-  auto model = sp::loadWorld(world, diag);
-  std::cerr << diag.format();
-  if (!simParams || !model) return 1;
-  if (model->robots.empty()) {
-    std::cerr << world << ": error: the world has no <robot>\n";
-    return 1;
+  if (!options.log && (!options.logPath.empty() || options.logDir != sp::StandInOptions{}.logDir)) {
+    std::cerr << "<command line>: error: --no-log contradicts --log and --log-dir\n";
+    return 2;
   }
-  if (rtf) simParams->realTimeFactor = *rtf;
-  auto twin = sp::World::create(*model, *simParams, diag);
-  if (!twin) {
-    std::cerr << diag.format();
-    return 1;
-  }
-  const bool generated = token.empty();
-  if (generated) token = sp::net::randomToken();
 
-  sp::TwinHost host(std::move(twin), simParams->realTimeFactor);
-  asio::io_context io;
-  sp::net::RobotServerConfig config;
-  config.address = bind;
-  config.port = static_cast<uint16_t>(port.value_or(simParams->robotPort));
-  config.link.robotName = model->robots[0].name;
-  config.link.token = token;
-  config.link.telemetryRate = simParams->telemetryRate;
-  config.emulation = emulation;
-  config.log = [](const std::string& line) { std::cerr << "simpartner-robot: " << line << "\n"; };
-  sp::net::RobotServer server(io, config, host);
-  if (const std::string error = server.start(); !error.empty()) {
+  sp::Diagnostics diag;
+  std::unique_ptr<sp::StandInRobot> robot = sp::StandInRobot::create(options, diag);
+  std::cerr << diag.format();
+  if (!robot) return 1;
+
+  // SIGINT and SIGTERM are taken by sigtimedwait below: blocked before
+  // start() so that the threads it starts inherit the mask.
+  sigset_t stopSignals;
+  sigemptyset(&stopSignals);
+  sigaddset(&stopSignals, SIGINT);
+  sigaddset(&stopSignals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
+
+  if (const std::string error = robot->start(); !error.empty()) {
     std::cerr << "error: " << error << "\n";
     return 1;
   }
-  host.start();
-  if (generated) std::cout << "token " << token << "\n";
+  if (options.token.empty()) std::cout << "token " << robot->token() << "\n";
+  const sp::net::LinkEmulatorConfig& emulation = options.emulation;
   if (emulation.active())
     std::cout << "emulating a link with " << emulation.delay << " s delay, +-" << emulation.jitter << " s jitter, "
               << emulation.loss * 100 << " % loss\n";
-  std::cout << "listening on " << bind << ":" << server.port() << std::endl;
-  asio::signal_set signals(io, SIGINT, SIGTERM);
-  signals.async_wait([&](const asio::error_code&, int) {
-    server.stop();
-    io.stop();
-  });
-  io.run();
-  host.stop();
-  std::cout << "stopped: " << server.stats().clientsAccepted << " clients, " << server.stats().framesIn
-            << " frames in, " << server.stats().badFrames << " closed for bad frames, "
-            << server.stats().telemetryDropped << " telemetry frames dropped for slow clients\n";
+  if (!robot->logPath().empty()) std::cout << "logging to " << robot->logPath() << "\n";
+  std::cout << "listening on " << bind << ":" << robot->port() << std::endl;
+
+  // Waits for a stop signal, looking at the log's health meanwhile: a
+  // failed log is told once and the twin runs on.
+  bool toldLogFailure = false;
+  const timespec poll{0, 200'000'000};
+  while (sigtimedwait(&stopSignals, nullptr, &poll) < 0) {
+    if (!toldLogFailure && robot->logFailed()) {
+      toldLogFailure = true;
+      std::lock_guard<std::mutex> lock(lineMutex);
+      std::cerr << "simpartner-robot: error: " << robot->logError() << "; the twin runs on without logging\n";
+    }
+  }
+  robot->stop();
+  const sp::StandInStats stats = robot->stats();
+  std::cout << "stopped: " << stats.clientsAccepted << " clients, " << stats.framesIn << " frames in, "
+            << stats.badFrames << " closed for bad frames, " << stats.telemetryDropped
+            << " telemetry frames dropped for slow clients\n";
+  if (!robot->logPath().empty()) {
+    if (robot->logDropped() > 0)
+      std::cerr << "simpartner-robot: warning: " << robot->logPath() << ": " << robot->logDropped()
+                << " log items dropped\n";
+    std::cout << "session log " << robot->logPath() << "\n";
+  }
   return 0;
 }

@@ -20,11 +20,35 @@ TwinHost::TwinHost(std::unique_ptr<World> world, double realTimeFactor)
 
 TwinHost::~TwinHost() { stop(); }
 
-void TwinHost::start() { thread_ = std::thread([this] { run(); }); }
+void TwinHost::logTo(std::unique_ptr<SessionLogWriter> writer) {
+  if (writer) log_ = std::make_unique<SessionRecorder>(std::move(writer), *world_);
+}
+
+void TwinHost::start() {
+  if (started_) return;
+  started_ = true;
+  thread_ = std::thread([this] { run(); });
+}
 
 void TwinHost::stop() {
   stop_ = true;
-  if (thread_.joinable()) thread_.join();
+  if (thread_.joinable()) {
+    thread_.join();
+    // The physics thread is gone: this thread may touch the World. Events
+    // queued since its last pass are logged; commands are not applied any
+    // more (they would sit in the last snapshot, never stepped).
+    if (log_) {
+      logQueuedEvents();
+      log_->finish(*world_);
+    }
+  }
+  if (log_) log_->writer().close();
+}
+
+void TwinHost::logEvent(std::string kind, std::string text) {
+  if (!log_) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  events_.push_back({std::move(kind), std::move(text)});
 }
 
 std::string TwinHost::check(const Command& command) const { return checkCommand(command, model_); }
@@ -81,21 +105,51 @@ void TwinHost::publish() {
   if (scan && scan->count > laser_.count) laser_ = std::move(*scan);
 }
 
+void TwinHost::logQueuedEvents() {
+  std::vector<PendingEvent> events;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    events.swap(events_);
+  }
+  for (PendingEvent& e : events)
+    log_->writer().logEvent(world_->stepCount(), world_->time(), std::move(e.kind), std::move(e.text));
+}
+
+void TwinHost::takeCommands() {
+  if (log_) logQueuedEvents();
+  std::vector<Command> commands;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    commands.swap(pending_);
+  }
+  World& w = *world_;
+  for (const Command& c : commands) {
+    // Checked by the server already; a command the World still refuses was
+    // not applied, so it is not logged either.
+    if (w.submit(c).empty() && log_) log_->writer().logCommand(w.stepCount(), w.time(), "operator", c, &model_);
+  }
+}
+
 void TwinHost::run() {
   Pacer pacer({world_->params().step, realTimeFactor_, 0.1, 50});
   pacer.start(monotonic());
   const int64_t publishEvery = std::max<int64_t>(1, std::llround(0.01 / world_->params().step));  // 100 Hz
+  if (log_) log_->start(*world_);
   while (!stop_) {
-    std::vector<Command> commands;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      commands.swap(pending_);
-    }
-    for (const Command& c : commands) world_->submit(c);
     const int64_t due = pacer.stepsDue(monotonic());
+    // Commands only when a step follows: none is left pending in the last
+    // snapshot when the loop stops.
+    if (due > 0) takeCommands();
     for (int64_t i = 0; i < due; ++i) {
-      world_->step();  // a diverged twin stops stepping and says so in state().health
+      // A diverged twin stops stepping and says so in state().health.
+      if (!world_->step()) break;
+      if (log_) log_->stepped(*world_);
       if (world_->stepCount() % publishEvery == 0) publish();
+    }
+    if (log_ && !healthLogged_ && !world_->health().healthy()) {
+      const HealthReport& h = world_->health();
+      log_->writer().logEvent(h.step, h.time, "health", h.message());
+      healthLogged_ = true;
     }
     pacer.stepped(due);
     if (due == 0) {

@@ -1,18 +1,23 @@
 #pragma once
 // The twin as a robot behind the link: a World stepped on its own physics
-// thread, paced by the monotonic clock, taking commands at step boundaries
-// and publishing its state for the server (net::RobotPort).
+// thread, paced by the monotonic clock, taking commands at step boundaries,
+// publishing its state for the server (net::RobotPort), and optionally
+// writing the session log (app/session_recorder.h).
 //
-// Thread: the World lives on the physics thread alone; the RobotPort methods
-// may be called from any one other thread (the server's) and exchange values
-// under a short lock.
+// Thread: the World lives on the physics thread alone (between start() and
+// stop()); the RobotPort methods may be called from any one other thread
+// (the server's) and exchange values under a short lock. logEvent() and the
+// log's status may be called from any thread. The constructor, logTo(),
+// start() and stop() belong to the owner's thread.
 
 #include <atomic>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
+#include "app/session_recorder.h"
 #include "net/robot_server.h"
 #include "sim/world.h"
 
@@ -22,9 +27,31 @@ class TwinHost : public net::RobotPort {
  public:
   /// `realTimeFactor` <= 0 runs unpaced.
   TwinHost(std::unique_ptr<World> world, double realTimeFactor);
+  /// Calls stop().
   ~TwinHost() override;
+  TwinHost(const TwinHost&) = delete;
+  TwinHost& operator=(const TwinHost&) = delete;
+
+  /// Logs the session into `writer` (taken; nullptr: no log), from the
+  /// physics thread: the initial snapshot, every command applied (source
+  /// "operator"), samples at rate.log, robot 0's laser scans, a snapshot and
+  /// state hash every sim second and at stop(), a "health" event when the
+  /// twin diverges, and the events of logEvent(). Call before start().
+  void logTo(std::unique_ptr<SessionLogWriter> writer);
+  /// Starts the physics thread. Once only.
   void start();
+  /// Stops and joins the physics thread, then logs the last snapshot and
+  /// closes the log (the file is complete when this returns). Idempotent.
   void stop();
+
+  /// Queues an event for the log (kind "link", "estop", "note", ...); the
+  /// physics thread writes it with the twin's step and time when it next
+  /// takes commands (within a few ms). Without a log it is dropped. Thread:
+  /// any; never blocks on the disk.
+  void logEvent(std::string kind, std::string text);
+  /// The log's writer, or null without one; its failed(), errorMessage()
+  /// and dropped() may be read from any thread.
+  const SessionLogWriter* log() const { return log_ ? &log_->writer() : nullptr; }
 
   const RobotModel* model() const override { return &model_; }
   std::string check(const Command& command) const override;
@@ -33,16 +60,29 @@ class TwinHost : public net::RobotPort {
   std::optional<net::LaserScanState> laserAfter(uint64_t afterCount) const override;
 
  private:
+  struct PendingEvent {
+    std::string kind, text;
+  };
   void run();
   void publish();
+  // Writes the queued events with the twin's step and time. Physics thread
+  // (or the owner's once it has stopped); only with a log.
+  void logQueuedEvents();
+  // Logs the queued events, then submits the queued commands and logs those
+  // the World took. Physics thread.
+  void takeCommands();
 
   std::unique_ptr<World> world_;
   const RobotModel model_;  // a copy: read by the server thread
   double realTimeFactor_;
+  std::unique_ptr<SessionRecorder> log_;  // fed by the physics thread only
+  bool healthLogged_ = false;             // physics thread
+  bool started_ = false;
   std::thread thread_;
   std::atomic<bool> stop_{false};
-  mutable std::mutex mutex_;  // guards the three below
+  mutable std::mutex mutex_;  // guards the four below
   std::vector<Command> pending_;
+  std::vector<PendingEvent> events_;
   net::RobotState state_;
   net::LaserScanState laser_;
 };

@@ -13,8 +13,9 @@ token=00112233445566778899aabbccddeeff
 
 out=$(mktemp)
 trap 'rm -f "$out"' EXIT
-# --port 0: the robot picks a free port and prints it.
-"$robot" --world "$src/terrains/flat.world.xml" --port 0 --token "$token" >"$out" 2>&1 &
+# --port 0: the robot picks a free port and prints it; --no-log: no
+# sessions/ folder left behind.
+"$robot" --world "$src/terrains/flat.world.xml" --port 0 --token "$token" --no-log >"$out" 2>&1 &
 pid=$!
 
 port=

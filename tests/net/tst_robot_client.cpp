@@ -47,12 +47,13 @@ QString robotExecutable() {
 // The stand-in robot as a child process on a free port of 127.0.0.1.
 class RobotProcess {
  public:
-  // Starts it (--port 0: the robot picks a free port and prints it) and
-  // waits for `listening on 127.0.0.1:PORT`; "" on success, else why not.
+  // Starts it (--port 0: the robot picks a free port and prints it; no
+  // session log) and waits for `listening on 127.0.0.1:PORT`; "" on
+  // success, else why not.
   QString start() {
     process_.setProgram(robotExecutable());
     process_.setArguments({"--world", SP_SOURCE_DIR "/terrains/flat.world.xml", "--port", "0", "--token",
-                           QString::fromStdString(kToken)});
+                           QString::fromStdString(kToken), "--no-log"});
     process_.setWorkingDirectory(SP_SOURCE_DIR);
     process_.start();
     if (!process_.waitForStarted(10000)) return "cannot start " + robotExecutable() + ": " + process_.errorString();

@@ -276,7 +276,7 @@ class TestRobotServer : public QObject {
   void refusesOpenAddressWithoutToken() {
     QProcess robot;
     robot.start(QStringLiteral(SP_BINARY_DIR "/app/simpartner-robot"),
-                {"--world", "terrains/flat.world.xml", "--bind", "0.0.0.0", "--port", "0"});
+                {"--world", "terrains/flat.world.xml", "--bind", "0.0.0.0", "--port", "0", "--no-log"});
     QVERIFY(robot.waitForFinished(10000));
     QCOMPARE(robot.exitCode(), 2);
     QVERIFY(QString::fromUtf8(robot.readAllStandardError()).contains("without --token"));

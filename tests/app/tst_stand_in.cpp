@@ -1,0 +1,279 @@
+// The stand-in robot as one object (app/stand_in.h): a console client drives
+// it over loopback, and its session log then holds the files, the operator's
+// commands, samples, link and e-stop events and snapshots, and re-simulates
+// without divergence. Also: where logs go, and what create() and start()
+// refuse.
+
+#include <QRegularExpression>
+#include <QTemporaryDir>
+#include <QtTest>
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include "app/resimulation.h"
+#include "app/session_log.h"
+#include "app/stand_in.h"
+#include "net/robot_client.h"
+
+using namespace sp;
+using namespace sp::net;
+using namespace std::chrono_literals;
+
+namespace {
+
+const std::string kToken = "00112233445566778899aabbccddeeff";
+
+std::string sourcePath(const std::string& relative) { return std::string(SP_SOURCE_DIR) + "/" + relative; }
+
+StandInOptions options(const std::string& logPath) {
+  StandInOptions o;
+  o.worldFile = sourcePath("terrains/flat.world.xml");
+  o.port = 0;
+  o.token = kToken;
+  o.logPath = logPath;
+  o.log = !logPath.empty();
+  return o;
+}
+
+// What a client's callbacks report (on its thread), for the test's thread.
+struct Seen {
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool ready = false, lease = false;
+  std::vector<ReplyMsg> replies;
+  std::vector<EventKind> events;
+
+  template <typename F>
+  void add(F f) {
+    {
+      std::lock_guard lock(mutex);
+      f();
+    }
+    cv.notify_all();
+  }
+  template <typename P>
+  bool waitFor(P pred) {
+    std::unique_lock lock(mutex);
+    return cv.wait_for(lock, 5s, pred);
+  }
+  RobotClientCallbacks callbacks() {
+    RobotClientCallbacks cb;
+    cb.connection = [this](ConnectionState s, const std::string&) { add([&] { ready = s == ConnectionState::Ready; }); };
+    cb.lease = [this](const LeaseStateMsg& m) { add([&] { lease = m.yours; }); };
+    cb.reply = [this](const ReplyMsg& m) { add([&] { replies.push_back(m); }); };
+    cb.event = [this](const EventMsg& m) { add([&] { events.push_back(m.kind); }); };
+    return cb;
+  }
+  bool replied(uint64_t seq, ReplyStatus status) {
+    return waitFor([&] {
+      return std::any_of(replies.begin(), replies.end(), [&](const ReplyMsg& r) { return r.seq == seq && r.status == status; });
+    });
+  }
+  bool got(EventKind kind) {
+    return waitFor([&] { return std::find(events.begin(), events.end(), kind) != events.end(); });
+  }
+};
+
+bool hasEvent(const std::vector<LogEvent>& events, const std::string& kind, const std::string& part) {
+  return std::any_of(events.begin(), events.end(),
+                     [&](const LogEvent& e) { return e.kind == kind && e.text.find(part) != std::string::npos; });
+}
+
+std::string eventList(const std::vector<LogEvent>& events) {
+  std::string out;
+  for (const LogEvent& e : events) out += std::to_string(e.step) + " " + e.kind + ": " + e.text + "\n";
+  return out;
+}
+
+}  // namespace
+
+class TestStandIn : public QObject {
+  Q_OBJECT
+
+ private slots:
+  // A client takes the lease, drives, e-stops and re-arms; the log then
+  // holds all of it, and re-simulates hash for hash.
+  void sessionIsLoggedAndResimulates() {
+    QTemporaryDir dir;
+    const std::string path = dir.filePath("session.splog").toStdString();
+    std::vector<std::string> lines;
+    std::mutex linesMutex;
+    StandInOptions o = options(path);
+    o.lineLog = [&](const std::string& line) {
+      std::lock_guard lock(linesMutex);
+      lines.push_back(line);
+    };
+    Diagnostics diag;
+    auto robot = StandInRobot::create(o, diag);
+    QVERIFY2(robot, diag.format().c_str());
+    QCOMPARE(robot->start(), std::string());
+    QVERIFY(robot->port() != 0);
+    QCOMPARE(robot->logPath(), path);
+    QCOMPARE(robot->token(), kToken);
+    QCOMPARE(robot->world().robots.size(), size_t{1});
+
+    Seen seen;
+    RobotClientConfig config;
+    config.port = robot->port();
+    config.token = robot->token();
+    config.name = "tester";
+    {
+      RobotClient client(config, seen.callbacks());
+      client.start();
+      QVERIFY(seen.waitFor([&] { return seen.ready; }));
+      client.acquireLease();
+      QVERIFY(seen.waitFor([&] { return seen.lease; }));
+      QVERIFY(seen.replied(client.sendCommandText("drive 0.5 10"), ReplyStatus::Ok));
+      std::this_thread::sleep_for(1200ms);  // past a periodic snapshot
+      client.estop("test");
+      QVERIFY(seen.got(EventKind::Estop));
+      client.rearm();
+      QVERIFY(seen.got(EventKind::Rearmed));
+      robot->addNote("operator note from the test");
+      client.releaseLease();
+      QVERIFY(seen.waitFor([&] { return !seen.lease; }));
+      client.stop();
+    }
+    std::this_thread::sleep_for(100ms);  // the disconnection reaches the log
+    robot->stop();
+    QVERIFY2(!robot->logFailed(), robot->logError().c_str());
+    QCOMPARE(robot->logDropped(), int64_t{0});
+    QCOMPARE(robot->stats().clientsAccepted, uint64_t{1});
+    {
+      std::lock_guard lock(linesMutex);
+      QVERIFY(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return l.find("connected") != std::string::npos; }));
+      QVERIFY(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return l.rfind("estop: ", 0) == 0; }));
+    }
+
+    std::string error;
+    auto reader = SessionLogReader::open(path, error);
+    QVERIFY2(reader, error.c_str());
+    const auto meta = reader->meta();
+    QCOMPARE(meta.at("world_file"), o.worldFile);
+    QVERIFY(meta.at("world_contents").find("<world") != std::string::npos);
+    QVERIFY(meta.at("robot_contents").find("<robot") != std::string::npos);
+    QCOMPARE(meta.at("robot_fnv1a64").size(), size_t{16});
+
+    // The drive as the operator sent it, then the e-stop's and the
+    // release's stops, all from the link.
+    const std::vector<LogCommand> commands = reader->commands();
+    QVERIFY(commands.size() >= 3);
+    QCOMPARE(commands.front().text.rfind("drive 0.5", 0), size_t{0});
+    for (const LogCommand& c : commands) QCOMPARE(c.source, std::string("operator"));
+    QCOMPARE(commands[1].text, std::string("stop"));
+    QVERIFY(commands[1].step > commands[0].step);
+
+    const std::vector<LogEvent> events = reader->events();
+    QVERIFY2(hasEvent(events, "link", "client 1 connected from 127.0.0.1"), eventList(events).c_str());
+    QVERIFY2(hasEvent(events, "link", "'tester' (client 1) authenticated as control"), eventList(events).c_str());
+    QVERIFY2(hasEvent(events, "link", "lease taken by 'tester'"), eventList(events).c_str());
+    QVERIFY2(hasEvent(events, "estop", "e-stop from 'tester': test"), eventList(events).c_str());
+    QVERIFY2(hasEvent(events, "rearmed", "re-armed by 'tester'"), eventList(events).c_str());
+    QVERIFY2(hasEvent(events, "note", "operator note from the test"), eventList(events).c_str());
+    QVERIFY2(hasEvent(events, "link", "lease released by 'tester'"), eventList(events).c_str());
+    QVERIFY2(hasEvent(events, "link", "client 1 disconnected"), eventList(events).c_str());
+    // Events carry the twin's step and time; the e-stop's stop command is
+    // applied at or after the step its event was written at.
+    const auto estop = std::find_if(events.begin(), events.end(), [](const LogEvent& e) { return e.kind == "estop"; });
+    QVERIFY(estop->step > commands[0].step && estop->step <= commands[1].step);
+    QCOMPARE(estop->time, static_cast<double>(estop->step) * 0.001);
+
+    // Samples at 100 Hz, a snapshot at start, every second and at the end.
+    const std::vector<int64_t> snapshots = reader->snapshotSteps();
+    QVERIFY(snapshots.size() >= 3);
+    QCOMPARE(snapshots.front(), int64_t{0});
+    QCOMPARE(snapshots[1], int64_t{1000});
+    const double end = static_cast<double>(snapshots.back()) * 0.001;
+    const std::vector<LogSample> samples = reader->samplesBetween(0, end);
+    QVERIFY2(std::abs(static_cast<double>(samples.size()) - end * 100) <= 2, qPrintable(QString::number(samples.size())));
+    QVERIFY(!reader->laserBetween(0, end).empty());
+    reader.reset();
+
+    // simpartner-sim resim's engine: every hash reproduced, commands included.
+    auto report = resimulate(path, {}, error);
+    QVERIFY2(report, error.c_str());
+    QVERIFY2(!report->divergence, ("diverged at step " + std::to_string(report->divergence->step)).c_str());
+    QCOMPARE(report->healthMessage, std::string());
+    QCOMPARE(report->endStep, snapshots.back());
+    QCOMPARE(report->hashesCompared, static_cast<int>(snapshots.size()));
+    QCOMPARE(report->commandsApplied, static_cast<int>(commands.size()));
+  }
+
+  // Without a file name the log is a new session-DATE-TIME.splog in the
+  // folder (created); a second one started in the same second gets "-2".
+  void logDirGetsNewFiles() {
+    QTemporaryDir dir;
+    const std::string folder = dir.filePath("logs/today").toStdString();
+    StandInOptions o = options("");
+    o.log = true;
+    o.logDir = folder;
+    Diagnostics diag;
+    auto first = StandInRobot::create(o, diag);
+    auto second = StandInRobot::create(o, diag);
+    QVERIFY2(first && second, diag.format().c_str());
+    QCOMPARE(first->start(), std::string());
+    QCOMPARE(second->start(), std::string());
+    first->stop();
+    second->stop();
+    const QRegularExpression name(R"(^session-\d{8}-\d{6}(-2)?\.splog$)");
+    for (const std::string& p : {first->logPath(), second->logPath()}) {
+      const std::filesystem::path path(p);
+      QCOMPARE(path.parent_path().string(), folder);
+      QVERIFY2(name.match(QString::fromStdString(path.filename().string())).hasMatch(), p.c_str());
+      QVERIFY(std::filesystem::exists(path));
+    }
+    QVERIFY(first->logPath() != second->logPath());
+  }
+
+  // With logging off no file is written anywhere.
+  void noLogWritesNothing() {
+    QTemporaryDir dir;
+    StandInOptions o = options("");
+    o.logDir = dir.filePath("sessions").toStdString();
+    Diagnostics diag;
+    auto robot = StandInRobot::create(o, diag);
+    QVERIFY(robot);
+    QCOMPARE(robot->start(), std::string());
+    robot->addNote("nowhere to go");
+    robot->stop();
+    QCOMPARE(robot->logPath(), std::string());
+    QVERIFY(!robot->logFailed());
+    QVERIFY(!std::filesystem::exists(o.logDir));
+  }
+
+  // start() refuses a log file that exists, and then runs nothing; create()
+  // names what is wrong with the options.
+  void refusals() {
+    QTemporaryDir dir;
+    const std::string path = dir.filePath("taken.splog").toStdString();
+    std::ofstream(path) << "not mine";
+    Diagnostics diag;
+    auto robot = StandInRobot::create(options(path), diag);
+    QVERIFY(robot);
+    QCOMPARE(robot->start(), path + ": already exists");
+    QCOMPARE(robot->port(), uint16_t{0});
+    robot->stop();
+
+    StandInOptions open = options("");
+    open.bind = "0.0.0.0";
+    open.token.clear();
+    QVERIFY(!StandInRobot::create(open, diag));
+    QVERIFY2(diag.format().find("refusing to listen on 0.0.0.0 without a token") != std::string::npos,
+             diag.format().c_str());
+
+    Diagnostics missing;
+    StandInOptions none = options("");
+    none.worldFile = dir.filePath("nowhere.world.xml").toStdString();
+    QVERIFY(!StandInRobot::create(none, missing));
+    QVERIFY(missing.hasErrors());
+  }
+};
+
+QTEST_GUILESS_MAIN(TestStandIn)
+#include "tst_stand_in.moc"
