@@ -201,6 +201,8 @@ class SessionLogReader {
   std::vector<std::pair<std::string, int64_t>> streams() const;
   /// Samples with t0 <= time <= t1 [s], in step order (uses the time index).
   std::vector<LogSample> samplesBetween(double t0, double t1) const;
+  /// Laser scans with t0 <= time <= t1 [s], in step order (uses the time
+  /// index where the log has one: logs since laser_time was added).
   std::vector<LogLaser> laserBetween(double t0, double t1) const;
   std::vector<LogCommand> commands() const;
   std::vector<LogEvent> events() const;

@@ -323,6 +323,50 @@ class TestSessionLog : public QObject {
     QVERIFY(!runHeadless(o, out2, err2, [&] { return fakeClock += 1e-4; }, [](double) {}));
     QCOMPARE(err2.str(), path + ": already exists\n");
   }
+
+  // Seeking by time uses the time indexes of samples and laser scans (a
+  // one-hour 1 kHz log seeks in ~ms with them, bench_log --hour; a scan
+  // reads the whole table): the plans of time-range queries search
+  // samples_time and laser_time, and the reader's seeks answer.
+  void seekUsesTimeIndex() {
+    QTemporaryDir dir;
+    const std::string path = dir.filePath("seek.splog").toStdString();
+    std::string error;
+    auto writer = SessionLogWriter::open(path, SessionInfo{}, error);
+    QVERIFY2(writer, error.c_str());
+    for (int64_t step = 0; step < 2000; ++step) {
+      LogSample s;
+      s.step = step;
+      s.time = static_cast<double>(step) * 1e-3;
+      QVERIFY(writer->logSample(s));
+      if (step % 50 == 0) QVERIFY(writer->logLaser(LogLaser{step, s.time, 0, 0.01, {1.0, 2.0}}));
+    }
+    writer->close();
+
+    sqlite3* db = nullptr;
+    QCOMPARE(sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+    auto plan = [db](const char* sql) {
+      sqlite3_stmt* q = nullptr;
+      std::string out;
+      if (sqlite3_prepare_v2(db, (std::string("EXPLAIN QUERY PLAN ") + sql).c_str(), -1, &q, nullptr) != SQLITE_OK)
+        return std::string(sqlite3_errmsg(db));
+      while (sqlite3_step(q) == SQLITE_ROW) out += reinterpret_cast<const char*>(sqlite3_column_text(q, 3)) + std::string("\n");
+      sqlite3_finalize(q);
+      return out;
+    };
+    const std::string samplesPlan = plan("SELECT * FROM samples WHERE time >= 1.0 AND time <= 1.1 ORDER BY time, step");
+    const std::string laserPlan = plan("SELECT * FROM laser WHERE time >= 1.0 AND time <= 1.1 ORDER BY step");
+    sqlite3_close(db);
+    QVERIFY2(samplesPlan.find("SEARCH samples USING INDEX samples_time") != std::string::npos, samplesPlan.c_str());
+    QVERIFY2(laserPlan.find("SEARCH laser USING INDEX laser_time") != std::string::npos, laserPlan.c_str());
+
+    auto reader = SessionLogReader::open(path, error);
+    QVERIFY2(reader, error.c_str());
+    const std::vector<LogSample> found = reader->samplesBetween(1.0, 1.0999);
+    QCOMPARE(found.size(), std::size_t{100});
+    QCOMPARE(found.front().step, int64_t{1000});
+    QCOMPARE(reader->laserBetween(1.0, 1.0999).size(), std::size_t{2});
+  }
 };
 
 QTEST_GUILESS_MAIN(TestSessionLog)
