@@ -35,8 +35,9 @@ void TwinHost::stop() {
   if (thread_.joinable()) {
     thread_.join();
     // The physics thread is gone: this thread may touch the World. Events
-    // queued since its last pass are logged; commands are not applied any
-    // more (they would sit in the last snapshot, never stepped).
+    // queued since its last pass are logged; commands that came after it
+    // (stop the server first) are not applied: they would sit in the last
+    // snapshot, never stepped.
     if (log_) {
       logQueuedEvents();
       log_->finish(*world_);
@@ -140,17 +141,9 @@ void TwinHost::run() {
     // Commands only when a step follows: none is left pending in the last
     // snapshot when the loop stops.
     if (due > 0) takeCommands();
-    for (int64_t i = 0; i < due; ++i) {
-      // A diverged twin stops stepping and says so in state().health.
-      if (!world_->step()) break;
-      if (log_) log_->stepped(*world_);
-      if (world_->stepCount() % publishEvery == 0) publish();
-    }
-    if (log_ && !healthLogged_ && !world_->health().healthy()) {
-      const HealthReport& h = world_->health();
-      log_->writer().logEvent(h.step, h.time, "health", h.message());
-      healthLogged_ = true;
-    }
+    for (int64_t i = 0; i < due; ++i)
+      if (!stepOnce(publishEvery)) break;  // a diverged twin says so in state().health
+    logHealth();
     pacer.stepped(due);
     if (due == 0) {
       if (pacer.paced()) {
@@ -163,6 +156,33 @@ void TwinHost::run() {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
   }
+  // One more step for commands queued since the last pass: a command the
+  // server accepted (an e-stop's stop, say) is applied and logged, not lost.
+  bool queued = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queued = !pending_.empty();
+  }
+  if (queued) {
+    takeCommands();
+    stepOnce(publishEvery);
+    logHealth();
+    publish();
+  }
+}
+
+bool TwinHost::stepOnce(int64_t publishEvery) {
+  if (!world_->step()) return false;
+  if (log_) log_->stepped(*world_);
+  if (world_->stepCount() % publishEvery == 0) publish();
+  return true;
+}
+
+void TwinHost::logHealth() {
+  if (!log_ || healthLogged_ || world_->health().healthy()) return;
+  const HealthReport& h = world_->health();
+  log_->writer().logEvent(h.step, h.time, "health", h.message());
+  healthLogged_ = true;
 }
 
 }  // namespace sp

@@ -41,7 +41,9 @@ class TwinHost : public net::RobotPort {
   /// Starts the physics thread. Once only.
   void start();
   /// Stops and joins the physics thread, then logs the last snapshot and
-  /// closes the log (the file is complete when this returns). Idempotent.
+  /// closes the log (the file is complete when this returns). Commands
+  /// queued since the thread's last pass are applied in one more step, so
+  /// none that apply() accepted is lost. Idempotent.
   void stop();
 
   /// Queues an event for the log (kind "link", "estop", "note", ...); the
@@ -71,6 +73,11 @@ class TwinHost : public net::RobotPort {
   // Logs the queued events, then submits the queued commands and logs those
   // the World took. Physics thread.
   void takeCommands();
+  // One step, logged and published (every `publishEvery` steps); false if
+  // the World has diverged. Physics thread.
+  bool stepOnce(int64_t publishEvery);
+  // The "health" event, once, when the World has diverged. Physics thread.
+  void logHealth();
 
   std::unique_ptr<World> world_;
   const RobotModel model_;  // a copy: read by the server thread

@@ -140,7 +140,13 @@ class TestStandIn : public QObject {
       QVERIFY(seen.waitFor([&] { return !seen.lease; }));
       client.stop();
     }
-    std::this_thread::sleep_for(100ms);  // the disconnection reaches the log
+    // The server notices the disconnection (its line goes to the log too).
+    auto disconnected = [&] {
+      std::lock_guard lock(linesMutex);
+      return std::find(lines.begin(), lines.end(), "client 1 disconnected") != lines.end();
+    };
+    for (int i = 0; i < 500 && !disconnected(); ++i) std::this_thread::sleep_for(10ms);
+    QVERIFY(disconnected());
     robot->stop();
     QVERIFY2(!robot->logFailed(), robot->logError().c_str());
     QCOMPARE(robot->logDropped(), int64_t{0});
@@ -163,7 +169,9 @@ class TestStandIn : public QObject {
     // The drive as the operator sent it, then the e-stop's and the
     // release's stops, all from the link.
     const std::vector<LogCommand> commands = reader->commands();
-    QVERIFY(commands.size() >= 3);
+    std::string commandList;
+    for (const LogCommand& c : commands) commandList += std::to_string(c.step) + " " + c.source + ": " + c.text + "\n";
+    QVERIFY2(commands.size() >= 3, (commandList + eventList(reader->events())).c_str());
     QCOMPARE(commands.front().text.rfind("drive 0.5", 0), size_t{0});
     for (const LogCommand& c : commands) QCOMPARE(c.source, std::string("operator"));
     QCOMPARE(commands[1].text, std::string("stop"));
