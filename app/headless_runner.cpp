@@ -119,7 +119,7 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
     std::string error;
     std::unique_ptr<SessionLogWriter> writer = openSessionLog(
         options.logFile,
-        {options.worldFile, robot.model.file, options.paramsFile, options.commandsFile, options.overrides}, error);
+        {options.worldFile, robot.model.file, options.paramsFile, options.commandsFile, options.overrides, {}}, error);
     if (!writer) {
       err << error << "\n";
       return std::nullopt;

@@ -84,7 +84,9 @@ std::optional<ResimReport> resimulate(const std::string& path, const ResimOption
     return std::nullopt;
   }
   const fs::path worldAbs = fs::absolute(worldName).lexically_normal();
-  const fs::path robotAbs = fs::absolute(robotName).lexically_normal();
+  // A robot opened in place of the world's own goes where the world looks.
+  const std::string replaced = get(meta, "replaced_robot_file");
+  const fs::path robotAbs = fs::absolute(replaced.empty() ? robotName : replaced).lexically_normal();
   fs::path robotRel = robotAbs.lexically_relative(worldAbs.parent_path());
   if (robotRel.empty()) robotRel = robotAbs.filename();
   int depth = 0;

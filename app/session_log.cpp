@@ -212,6 +212,7 @@ std::unique_ptr<SessionLogWriter> SessionLogWriter::open(const std::string& path
       put(f.role + "_contents", f.contents);
       put(f.role + "_fnv1a64", hex64(fnv1a64(f.contents)));
     }
+    for (const auto& [key, value] : info.extraMeta) put(key, value);
     if (!ok) sqlError = sqlite3_errmsg(w->db_);
   }
   ok = ok && execSql(w->db_, "COMMIT", sqlError);

@@ -51,6 +51,7 @@ struct SessionInfo {
   std::string programVersion;
   std::string startTime;  ///< ISO-8601 UTC; "" = now
   std::vector<SessionFile> files;
+  std::map<std::string, std::string> extraMeta;  ///< further meta keys (docs/session-format.md)
 };
 
 /// One state sample at the logging rate.

@@ -22,6 +22,10 @@ struct SessionSources {
   std::string paramsFile;              ///< "" = built-in defaults (not stored)
   std::string commandsFile;            ///< "" = none (not stored)
   std::vector<std::string> overrides;  ///< key=value, logged as param_override events at step 0
+  /// When the operator opened `robotFile` in place of the world's own robot:
+  /// the file the world refers to ("" = none). Re-simulation lays the logged
+  /// robot out under this name, so the logged world loads the robot used.
+  std::string replacedRobotFile;
 };
 
 /// Creates the session log at `path` (an existing file is an error): meta

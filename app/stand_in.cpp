@@ -35,19 +35,28 @@ std::unique_ptr<StandInRobot> StandInRobot::create(const StandInOptions& options
                "refusing to listen on " + options.bind + " without a token: only loopback may run with a generated one");
   std::optional<SimParams> params = loadRunParams(options.paramsFile, options.overrides, diag);
   std::optional<WorldModel> model;
+  std::string replacedRobotFile;
   if (!options.worldFile.empty()) model = loadWorld(options.worldFile, diag);
   if (model && model->robots.empty()) diag.error(options.worldFile, 0, "the world has no <robot>");
+  if (model && !model->robots.empty() && !options.robotFile.empty()) {
+    std::optional<RobotModel> robot = loadRobot(options.robotFile, diag);
+    if (robot) {
+      replacedRobotFile = model->robots[0].model.file;
+      model->robots[0].model = std::move(*robot);
+    }
+  }
   if (diag.hasErrors() || !params || !model) return nullptr;
   if (options.realTimeFactor) params->realTimeFactor = *options.realTimeFactor;
   std::unique_ptr<World> world = World::create(*model, *params, diag);
   if (!world) return nullptr;
   auto host = std::make_unique<TwinHost>(std::move(world), params->realTimeFactor);
-  return std::unique_ptr<StandInRobot>(new StandInRobot(options, std::move(*model), std::move(host), *params));
+  return std::unique_ptr<StandInRobot>(new StandInRobot(options, std::move(*model), std::move(host), *params, std::move(replacedRobotFile)));
 }
 
 StandInRobot::StandInRobot(StandInOptions options, WorldModel world, std::unique_ptr<TwinHost> host,
-                           SimParams params)
+                           SimParams params, std::string replacedRobotFile)
     : options_(std::move(options)),
+      replacedRobotFile_(std::move(replacedRobotFile)),
       world_(std::move(world)),
       params_(std::move(params)),
       token_(options_.token.empty() ? net::randomToken() : options_.token),
@@ -112,7 +121,8 @@ std::string StandInRobot::start() {
     std::unique_ptr<SessionLogWriter> writer;
     if (!path.empty())
       writer = openSessionLog(path,
-                              {options_.worldFile, world_.robots[0].model.file, options_.paramsFile, {}, options_.overrides},
+                              {options_.worldFile, world_.robots[0].model.file, options_.paramsFile, {}, options_.overrides,
+                               replacedRobotFile_},
                               error);
     if (!writer) {
       server->server->stop();

@@ -42,6 +42,9 @@ class SessionLogWriter;
 /// port.robot and realtime.factor, a generated token, a log in `sessions/`.
 struct StandInOptions {
   std::string worldFile;               ///< required
+  /// A robot file to run in place of the world's own robot (same name and
+  /// pose in the world); "" = the world's.
+  std::string robotFile;
   std::string paramsFile;              ///< "" = built-in defaults
   std::vector<std::string> overrides;  ///< key=value, applied after the file
   std::string bind = "127.0.0.1";      ///< any other address needs a token
@@ -118,11 +121,13 @@ class StandInRobot {
 
  private:
   struct Server;  // the io_context, RobotServer and its thread (Asio stays out of this header)
-  StandInRobot(StandInOptions options, WorldModel world, std::unique_ptr<TwinHost> host, SimParams params);
+  StandInRobot(StandInOptions options, WorldModel world, std::unique_ptr<TwinHost> host, SimParams params,
+               std::string replacedRobotFile);
   // The log file for this start; "" and `error` set if none can be made.
   std::string chooseLogPath(std::string& error) const;
 
   StandInOptions options_;
+  std::string replacedRobotFile_;  // the world's own robot file, when options_.robotFile replaced it
   const WorldModel world_;
   SimParams params_;
   std::string token_;

@@ -8,12 +8,14 @@
 #include <QTemporaryDir>
 #include <QtTest>
 
+
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 #include "app/resimulation.h"
@@ -211,6 +213,54 @@ class TestStandIn : public QObject {
     QCOMPARE(report->endStep, snapshots.back());
     QCOMPARE(report->hashesCompared, static_cast<int>(snapshots.size()));
     QCOMPARE(report->commandsApplied, static_cast<int>(commands.size()));
+  }
+
+  // A robot file opened in place of the world's own runs (a heavier rear
+  // body here), is logged as the robot, and the log re-simulates with it.
+  void robotOpenedInPlaceOfTheWorlds() {
+    QTemporaryDir dir;
+    std::ifstream in(sourcePath("robots/workpartner.xml"));
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string xml = text.str();
+    const std::string from = R"(<link name="rear_body" mass="62")";
+    QVERIFY(xml.find(from) != std::string::npos);
+    xml.replace(xml.find(from), from.size(), R"(<link name="rear_body" mass="92")");
+    const std::string robotFile = dir.filePath("heavy.xml").toStdString();
+    std::ofstream(robotFile) << xml;
+
+    const std::string path = dir.filePath("heavy.splog").toStdString();
+    StandInOptions o = options(path);
+    o.robotFile = robotFile;
+    Diagnostics diag;
+    auto robot = StandInRobot::create(o, diag);
+    QVERIFY2(robot, diag.format().c_str());
+    QCOMPARE(robot->world().robots[0].model.file, robotFile);
+    QVERIFY(std::abs(robot->world().robots[0].model.totalMass() - 261.2) < 0.01);
+    QCOMPARE(robot->start(), std::string());
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    robot->stop();
+
+    std::string error;
+    auto reader = SessionLogReader::open(path, error);
+    QVERIFY2(reader, error.c_str());
+    const auto meta = reader->meta();
+    QCOMPARE(meta.at("robot_file"), robotFile);
+    QCOMPARE(meta.at("robot_contents"), xml);
+    QCOMPARE(meta.at("replaced_robot_file"), sourcePath("robots/workpartner.xml"));
+    reader.reset();
+    auto report = resimulate(path, {}, error);
+    QVERIFY2(report, error.c_str());
+    QVERIFY(!report->divergence);
+    QVERIFY(report->hashesCompared >= 2);
+
+    // A broken robot file is refused by create(), naming the file and line.
+    const std::string broken = dir.filePath("broken.xml").toStdString();
+    std::ofstream(broken) << "<robot name=\"x\">\n  <link name=\"a\" mass=\"-1\"/>\n</robot>\n";
+    o.robotFile = broken;
+    Diagnostics bad;
+    QVERIFY(!StandInRobot::create(o, bad));
+    QVERIFY2(bad.format().find(broken + ":2:") != std::string::npos, bad.format().c_str());
   }
 
   // Without a file name the log is a new session-DATE-TIME.splog in the
