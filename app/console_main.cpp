@@ -1,0 +1,121 @@
+// simpartner: the operator console. Opens the main window on a world, starts
+// the stand-in robot on loopback (or connects to a robot with --connect) and
+// logs the session.
+
+#include <QApplication>
+#include <QCommandLineParser>
+#include <QDir>
+#include <QFileInfo>
+#include <QMessageBox>
+#include <QSurfaceFormat>
+#include <QTimer>
+
+#include <cstdio>
+#include <iostream>
+
+#include "ui/control_panel.h"
+#include "ui/link_panel.h"
+#include "ui/main_window.h"
+#include "ui/scene_view.h"
+
+namespace {
+
+/// A data file given relative to the project (terrains/..., robots/...) is
+/// found from the current folder, else from the source tree the program was
+/// built from, so the console starts from anywhere.
+QString findDataFile(const QString& path) {
+  if (path.isEmpty() || QFileInfo(path).isAbsolute() || QFileInfo::exists(path)) return path;
+  const QString inSource = QDir(QStringLiteral(SP_SOURCE_DIR)).filePath(path);
+  return QFileInfo::exists(inSource) ? inSource : path;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Debian's OpenSceneGraph is a fixed-function GL 2 build: it needs a
+  // compatibility context, requested before the application exists.
+  QSurfaceFormat format;
+  format.setVersion(2, 1);
+  format.setProfile(QSurfaceFormat::CompatibilityProfile);
+  format.setDepthBufferSize(24);
+  format.setSamples(0);
+  format.setSwapInterval(0);  // the view paces itself with a timer
+  QSurfaceFormat::setDefaultFormat(format);
+
+  QApplication app(argc, argv);
+  QApplication::setApplicationName(QStringLiteral("SimPartner"));
+  QApplication::setOrganizationName(QStringLiteral("SimPartner"));
+  QApplication::setApplicationVersion(QStringLiteral(SP_VERSION));
+
+  QCommandLineParser parser;
+  parser.setApplicationDescription(QStringLiteral(
+      "The SimPartner operator console. By default it starts the stand-in robot (the twin) on loopback "
+      "and connects to it; --connect reaches any robot that speaks the link protocol."));
+  parser.addHelpOption();
+  parser.addVersionOption();
+  const QCommandLineOption world({QStringLiteral("w"), QStringLiteral("world")}, QStringLiteral("World file (default terrains/flat.world.xml)."), QStringLiteral("FILE"), QStringLiteral("terrains/flat.world.xml"));
+  const QCommandLineOption params(QStringLiteral("params"), QStringLiteral("Parameters file for the stand-in."), QStringLiteral("FILE"));
+  const QCommandLineOption set(QStringLiteral("set"), QStringLiteral("Parameter override KEY=VALUE (repeatable)."), QStringLiteral("KEY=VALUE"));
+  const QCommandLineOption connectTo(QStringLiteral("connect"), QStringLiteral("Connect to the robot at HOST:PORT instead of starting the stand-in."), QStringLiteral("HOST:PORT"));
+  const QCommandLineOption token(QStringLiteral("token"), QStringLiteral("The robot's shared secret (32+ hex digits)."), QStringLiteral("HEX"));
+  const QCommandLineOption logDir(QStringLiteral("log-dir"), QStringLiteral("Folder for session logs (default: the user's data folder)."), QStringLiteral("DIR"));
+  const QCommandLineOption noLog(QStringLiteral("no-log"), QStringLiteral("Do not log the session."));
+  const QCommandLineOption rtf(QStringLiteral("rtf"), QStringLiteral("Stand-in real-time factor."), QStringLiteral("X"));
+  const QCommandLineOption monitor(QStringLiteral("monitor"), QStringLiteral("Do not take control on connecting."));
+  const QCommandLineOption screenshot(QStringLiteral("screenshot"), QStringLiteral("Save a picture of the window after --quit-after seconds, then quit."), QStringLiteral("PNG"));
+  const QCommandLineOption quitAfter(QStringLiteral("quit-after"), QStringLiteral("Quit after S seconds, printing the frame rate (for measurements)."), QStringLiteral("S"));
+  const QCommandLineOption drive(QStringLiteral("drive"), QStringLiteral("Drive at SPEED m/s once in control (for demonstrations)."), QStringLiteral("SPEED"));
+  parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, monitor, screenshot, quitAfter, drive});
+  parser.process(app);
+
+  sp::ConsoleOptions options;
+  options.world = findDataFile(parser.value(world));
+  options.params = findDataFile(parser.value(params));
+  options.overrides = parser.values(set);
+  options.connectTo = parser.value(connectTo);
+  options.token = parser.value(token);
+  options.logDir = parser.value(logDir);
+  options.log = !parser.isSet(noLog);
+  options.takeControl = !parser.isSet(monitor);
+  if (parser.isSet(rtf)) {
+    bool ok = false;
+    options.rtf = parser.value(rtf).toDouble(&ok);
+    if (!ok || options.rtf < 0) {
+      std::cerr << "<command line>: error: --rtf: expected a number >= 0, got '" << parser.value(rtf).toStdString() << "'\n";
+      return 2;
+    }
+  }
+
+  sp::MainWindow window(options);
+  if (const QString error = window.start(); !error.isEmpty()) {
+    std::cerr << error.toStdString() << "\n";
+    QMessageBox::critical(nullptr, QStringLiteral("SimPartner"), error);
+    return 1;
+  }
+  window.show();
+  if (!window.logPath().isEmpty()) std::cout << "logging to " << window.logPath().toStdString() << std::endl;
+
+  if (parser.isSet(drive)) {
+    const double speed = parser.value(drive).toDouble();
+    // Drive once the lease is ours; poll, since the lease arrives over the link.
+    auto* poll = new QTimer(&window);
+    QObject::connect(poll, &QTimer::timeout, &window, [&window, poll, speed] {
+      if (!window.linkPanel()->leaseHeld()) return;
+      window.controlPanel()->setDrive(speed, 0.0);
+      poll->stop();
+    });
+    poll->start(100);
+  }
+  if (parser.isSet(quitAfter) || parser.isSet(screenshot)) {
+    const double seconds = parser.isSet(quitAfter) ? parser.value(quitAfter).toDouble() : 5.0;
+ QTimer::singleShot(static_cast<int>(seconds * 1000), &window, [&] {
+      std::cout << "frames " << window.sceneView()->framesDrawn() << " in " << seconds << " s, "
+                << window.sceneView()->framesPerSecond() << " fps over the last second at "
+                << window.sceneView()->width() << "x" << window.sceneView()->height() << ", real-time factor "
+                << window.realTimeFactor() << ", telemetry " << window.telemetryReceived() << std::endl;
+      if (parser.isSet(screenshot)) window.grab().save(parser.value(screenshot));
+      window.close();
+    });
+  }
+  return app.exec();
+}

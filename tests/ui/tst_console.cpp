@@ -1,0 +1,217 @@
+// The operator console end to end under Xvfb: the window on the default
+// world with its stand-in robot on loopback, the 3D view, telemetry, drive,
+// e-stop, plots, file errors and remembered docks.
+
+#include <QDockWidget>
+#include <QDoubleSpinBox>
+#include <QSettings>
+#include <QStandardPaths>
+#include <QSurfaceFormat>
+#include <QTemporaryDir>
+#include <QtTest>
+
+#include <cmath>
+#include <fstream>
+
+#include "ui/control_panel.h"
+#include "ui/link_panel.h"
+#include "ui/live_plots.h"
+#include "ui/main_window.h"
+#include "ui/robot_connection.h"
+#include "ui/scene_view.h"
+
+using namespace sp;
+
+namespace {
+
+/// Share of pixels that differ from the image's top-left pixel (the sky).
+double nonBackgroundShare(const QImage& image) {
+  if (image.isNull()) return 0;
+  const QRgb background = image.pixel(0, 0);
+  int64_t differ = 0;
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x)
+      if (image.pixel(x, y) != background) ++differ;
+  return static_cast<double>(differ) / (static_cast<double>(image.width()) * image.height());
+}
+
+/// Share of pixels that differ between two images of one size.
+double changedShare(const QImage& a, const QImage& b) {
+  if (a.size() != b.size() || a.isNull()) return 1;
+  int64_t differ = 0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x)
+      if (a.pixel(x, y) != b.pixel(x, y)) ++differ;
+  return static_cast<double>(differ) / (static_cast<double>(a.width()) * a.height());
+}
+
+double planarSpeedOver(MainWindow& w, int millis) {
+  const Pose a = w.lastTelemetry()->pose;
+  const double t0 = w.lastTelemetry()->time;
+  QTest::qWait(millis);
+  const Pose b = w.lastTelemetry()->pose;
+  const double dt = w.lastTelemetry()->time - t0;
+  return dt > 0 ? std::hypot(b.p.x - a.p.x, b.p.y - a.p.y) / dt : 0;
+}
+
+}  // namespace
+
+class TestConsole : public QObject {
+  Q_OBJECT
+
+ private slots:
+  void initTestCase() {
+    if (QGuiApplication::platformName() == QLatin1String("offscreen"))
+      QSKIP("the 3D view needs an X server: run under xvfb-run");
+    QVERIFY(dir_.isValid());
+    // Settings and logs go to a temporary folder, not the user's.
+    QSettings::setDefaultFormat(QSettings::IniFormat);
+    QSettings::setPath(QSettings::IniFormat, QSettings::UserScope, dir_.filePath(QStringLiteral("settings")));
+    QSettings().clear();
+    options_.world = QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml");
+    options_.logDir = dir_.filePath(QStringLiteral("sessions"));
+    window_ = std::make_unique<MainWindow>(options_);
+    const QString error = window_->start();
+    QVERIFY2(error.isEmpty(), qPrintable(error));
+    window_->resize(1280, 800);
+    window_->show();
+    QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
+  }
+
+  void cleanupTestCase() { window_.reset(); }
+
+  // The window opens on the default world: connected to its stand-in,
+  // holding control, telemetry flowing, the session logged to a file.
+  void windowOpensOnDefaultWorld() {
+    MainWindow& w = *window_;
+    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld(), 5000);
+    QTRY_VERIFY_WITH_TIMEOUT(w.telemetryReceived() > 20, 5000);
+    QVERIFY(!w.logPath().isEmpty());
+    QVERIFY(QFileInfo::exists(w.logPath()));
+    QVERIFY(w.logPath().startsWith(options_.logDir));
+    QVERIFY(w.bannerText().isEmpty());
+    QTRY_VERIFY_WITH_TIMEOUT(w.realTimeFactor() > 0.5, 5000);
+  }
+
+  // The 3D view renders terrain and robot: a grab holds far more than sky.
+  void sceneRenders() {
+    SceneView* scene = window_->sceneView();
+    QTRY_VERIFY_WITH_TIMEOUT(scene->framesDrawn() > 10, 5000);
+    const QImage image = scene->grabFramebuffer();
+    image.save(QStringLiteral(SP_BINARY_DIR "/console_scene.png"));
+    const double share = nonBackgroundShare(image);
+    qInfo("non-background pixels: %.1f %%", share * 100);
+    QVERIFY(share > 0.2);
+  }
+
+  // The plots receive telemetry and laser scans and replot.
+  void plotsReceiveData() {
+    QTRY_VERIFY_WITH_TIMEOUT(window_->wheelForcePlot()->samplesReceived() > 20, 5000);
+    QTRY_VERIFY_WITH_TIMEOUT(window_->laserPlot()->scansReceived() > 2, 5000);
+    QTRY_VERIFY_WITH_TIMEOUT(window_->wheelForcePlot()->replots() > 0, 5000);
+    QTRY_VERIFY_WITH_TIMEOUT(window_->laserPlot()->replots() > 0, 5000);
+    // Standing on flat ground the four wheels carry the robot's weight.
+    const std::array<double, 4> f = window_->lastTelemetry()->wheelNormal;
+    const double total = f[0] + f[1] + f[2] + f[3];
+    QVERIFY2(total > 1500 && total < 3000, qPrintable(QString::number(total)));
+  }
+
+  // Keys over the 3D view drive: the robot rolls forward, and with the
+  // camera held still the drawn robot moves on the screen.
+  void driveMovesTheDrawnRobot() {
+    MainWindow& w = *window_;
+    SceneView* scene = w.sceneView();
+    scene->setFollow(false);
+    QTest::qWait(300);
+    const QImage before = scene->grabFramebuffer();
+    const Pose start = w.lastTelemetry()->pose;
+    scene->setFocus();
+    for (int i = 0; i < 10; ++i) QTest::keyClick(scene, Qt::Key_Up);  // 10 x 0.05 m/s
+    QCOMPARE(w.controlPanel()->speed(), 0.5);
+    QTRY_VERIFY_WITH_TIMEOUT(std::hypot(w.lastTelemetry()->pose.p.x - start.p.x,
+                                        w.lastTelemetry()->pose.p.y - start.p.y) > 0.5, 6000);
+    const double v = planarSpeedOver(w, 500);
+    qInfo("speed %.3f m/s", v);
+    QVERIFY(std::abs(v - 0.5) < 0.05);
+    QTest::qWait(100);
+    const double changed = changedShare(before, scene->grabFramebuffer());
+    qInfo("changed pixels: %.2f %%", changed * 100);
+    QVERIFY(changed > 0.002);
+    scene->setFollow(true);
+  }
+
+  // Esc stops the robot wherever the focus is (here a spin box), the
+  // latch shows, and re-arm clears it.
+  void estopStopsTheRobot() {
+    MainWindow& w = *window_;
+    QVERIFY(planarSpeedOver(w, 300) > 0.3);  // still driving from the test before
+    auto* spin = w.controlPanel()->findChild<QDoubleSpinBox*>();
+    QVERIFY(spin);
+    spin->setFocus();
+    QTest::keyClick(spin, Qt::Key_Escape);
+    QTRY_VERIFY_WITH_TIMEOUT(w.lastTelemetry()->estop, 3000);
+    QTRY_VERIFY_WITH_TIMEOUT(w.bannerText().contains(QLatin1String("E-STOP")), 3000);
+    QTest::qWait(1000);  // braking
+    QVERIFY2(planarSpeedOver(w, 500) < 0.02, "still moving after the e-stop");
+    w.linkPanel()->rearmRequested();
+    QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->estop, 3000);
+    QTRY_VERIFY(w.bannerText().isEmpty());
+    // Re-arming does not restart the motion.
+    QVERIFY(planarSpeedOver(w, 500) < 0.02);
+  }
+
+  // A broken world file is refused with its file:line error; the session
+  // (its log, its robot) carries on untouched.
+  void badWorldFileLeavesTheSession() {
+    MainWindow& w = *window_;
+    const QString log = w.logPath();
+    const QString bad = dir_.filePath(QStringLiteral("bad.world.xml"));
+    std::ofstream(bad.toStdString()) << "<world name=\"x\">\n  <terrain type=\"plane\"/>\n  <robot file=\"nowhere.xml\"/>\n</world>\n";
+    const QString error = w.openWorld(bad, true);
+    QVERIFY(error.contains(bad + QStringLiteral(":")));
+    QVERIFY(error.contains(QLatin1String("error")));
+    QCOMPARE(w.logPath(), log);
+    const QString badRobot = dir_.filePath(QStringLiteral("bad_robot.xml"));
+    std::ofstream(badRobot.toStdString()) << "<robot name=\"x\">\n  <link name=\"a\" mass=\"-1\"/>\n</robot>\n";
+    const QString robotError = w.openRobot(badRobot, true);
+    QVERIFY2(robotError.contains(badRobot + QStringLiteral(":2:")), qPrintable(robotError));
+    QCOMPARE(w.logPath(), log);
+    const int64_t count = w.telemetryReceived();
+    QTRY_VERIFY(w.telemetryReceived() > count + 5);
+  }
+
+  // Docks are remembered between runs: a hidden plots dock stays hidden.
+  void docksAreRemembered() {
+    auto* dock = window_->findChild<QDockWidget*>(QStringLiteral("plotsDock"));
+    QVERIFY(dock);
+    dock->hide();
+    window_->close();
+    MainWindow second(options_);
+    auto* again = second.findChild<QDockWidget*>(QStringLiteral("plotsDock"));
+    QVERIFY(again);
+    second.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&second));
+    QVERIFY(!again->isVisible());
+    again->show();
+    second.close();
+  }
+
+ private:
+  QTemporaryDir dir_;
+  ConsoleOptions options_;
+  std::unique_ptr<MainWindow> window_;
+};
+
+int main(int argc, char** argv) {
+  // OpenSceneGraph needs a GL 2.1 compatibility context (see STACK.md).
+  QSurfaceFormat format;
+  format.setVersion(2, 1);
+  format.setProfile(QSurfaceFormat::CompatibilityProfile);
+  format.setDepthBufferSize(24);
+  QSurfaceFormat::setDefaultFormat(format);
+  QApplication app(argc, argv);
+  TestConsole test;
+  return QTest::qExec(&test, argc, argv);
+}
+
+#include "tst_console.moc"

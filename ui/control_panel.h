@@ -1,0 +1,87 @@
+#pragma once
+// The operator's controls: drive (speed and articulation) by sliders and by
+// keyboard, each joint's target by slider and spin box, gait selection and
+// stop. The panel only emits commands; the console sends them over the link
+// and the robot drawn is the robot as telemetry reports it.
+//
+// Thread: GUI thread only.
+
+#include <QWidget>
+
+#include <vector>
+
+#include "sim/command.h"
+#include "sim/robot_model.h"
+
+class QComboBox;
+class QDoubleSpinBox;
+class QGroupBox;
+class QLabel;
+class QScrollArea;
+class QSlider;
+class QTimer;
+class QVBoxLayout;
+
+namespace sp {
+
+class ControlPanel : public QWidget {
+  Q_OBJECT
+
+ public:
+  explicit ControlPanel(QWidget* parent = nullptr);
+
+  /// Builds the controls for `robot`: the drive's limits come from its wheel
+  /// actuators and articulation joint, and one row per position-controlled
+  /// joint other than the drive's. Resets every control to zero.
+  void setRobot(const RobotModel& robot);
+
+  /// Keyboard driving, for keys pressed over the 3D view: Up/Down (W/S) step
+  /// the speed by 0.05 m/s, Left/Right (A/D) the articulation by 2 degrees,
+  /// Space stops. Returns whether the key was one of these.
+  bool handleKey(int key);
+
+  /// Shows the measured joint positions (robot.joints order) beside the targets.
+  void showMeasured(const std::vector<double>& jointPositions);
+
+  /// Moves the drive controls to `speed` [m/s] and `articulationDeg`
+  /// [degree] (clamped to the robot's limits) and sends one drive command.
+  void setDrive(double speed, double articulationDeg);
+
+  double speed() const;         ///< [m/s] the drive's set speed
+  double articulation() const;  ///< [rad] the drive's set articulation
+  double maxSpeed() const { return maxSpeed_; }
+
+ signals:
+  /// A command for the robot (drive, joint target, gait, stop).
+  void command(const sp::Command& command);
+
+ private:
+  struct JointRow {
+    int joint = -1;
+    double scale = 1;  // display unit per SI unit (degrees or millimetres)
+    QSlider* slider = nullptr;
+    QDoubleSpinBox* spin = nullptr;
+    QLabel* measured = nullptr;
+  };
+  void driveChanged();
+  void stop();
+  void gaitChanged(int index);
+
+  const RobotModel* robot_ = nullptr;
+  RobotModel model_;
+  double maxSpeed_ = 0, maxArticulationDeg_ = 0;
+  QSlider* speedSlider_ = nullptr;      // [cm/s]
+  QDoubleSpinBox* speedSpin_ = nullptr;  // [m/s]
+  QSlider* articulationSlider_ = nullptr;  // [0.1 degree]
+  QDoubleSpinBox* articulationSpin_ = nullptr;  // [degree]
+  QComboBox* gait_ = nullptr;
+  QGroupBox* driveBox_ = nullptr;
+  QVBoxLayout* jointsLayout_ = nullptr;
+  QWidget* jointsHost_ = nullptr;
+  QScrollArea* scroll_ = nullptr;
+  std::vector<JointRow> rows_;
+  QTimer* driveTimer_ = nullptr;  // coalesces slider drags into one drive command per 50 ms
+  bool updating_ = false;         // set while controls are moved programmatically
+};
+
+}  // namespace sp

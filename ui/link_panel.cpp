@@ -1,0 +1,137 @@
+#include "ui/link_panel.h"
+
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QPlainTextEdit>
+#include <QTime>
+#include <QPushButton>
+#include <QVBoxLayout>
+
+namespace sp {
+
+namespace {
+
+QString coloured(const QString& text, const char* colour) {
+  return QStringLiteral("<b style='color:%1'>%2</b>").arg(QLatin1String(colour), text.toHtmlEscaped());
+}
+
+}  // namespace
+
+LinkPanel::LinkPanel(QWidget* parent) : QWidget(parent) {
+  auto* layout = new QVBoxLayout(this);
+  auto* form = new QFormLayout;
+  endpoint_ = new QLabel;
+  state_ = new QLabel;
+  rtt_ = new QLabel;
+  rate_ = new QLabel;
+  loss_ = new QLabel;
+  lease_ = new QLabel;
+  latches_ = new QLabel;
+  for (QLabel* l : {endpoint_, state_, rtt_, rate_, loss_, lease_, latches_}) l->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  form->addRow(tr("robot"), endpoint_);
+  form->addRow(tr("link"), state_);
+  form->addRow(tr("round trip"), rtt_);
+  form->addRow(tr("telemetry"), rate_);
+  form->addRow(tr("lost"), loss_);
+  form->addRow(tr("control"), lease_);
+  form->addRow(tr("latches"), latches_);
+  layout->addLayout(form);
+
+  auto* row = new QHBoxLayout;
+  connect_ = new QPushButton(tr("Disconnect"));
+  control_ = new QPushButton(tr("Take control"));
+  control_->setToolTip(tr("Ask the robot for the control lease: only its holder may command it"));
+  row->addWidget(connect_);
+  row->addWidget(control_);
+  layout->addLayout(row);
+  auto* row2 = new QHBoxLayout;
+  estop_ = new QPushButton(tr("E-STOP (Esc)"));
+  estop_->setObjectName(QStringLiteral("estopButton"));
+  estop_->setMinimumHeight(40);
+  estop_->setStyleSheet(QStringLiteral("QPushButton { background: #c62828; color: white; font-weight: bold; }"));
+  estop_->setToolTip(tr("Emergency stop: the robot stops and stays stopped until re-armed. Key Esc works anywhere in the console."));
+  rearm_ = new QPushButton(tr("Re-arm"));
+  rearm_->setToolTip(tr("Clear a latched failsafe or e-stop (the lease holder only)"));
+  row2->addWidget(estop_, 2);
+  row2->addWidget(rearm_, 1);
+  layout->addLayout(row2);
+  events_ = new QPlainTextEdit;
+  events_->setReadOnly(true);
+  events_->setMaximumBlockCount(1000);  // a long session keeps its latest events
+  events_->setPlaceholderText(tr("link events"));
+  layout->addWidget(events_, 1);
+
+  connect(connect_, &QPushButton::clicked, this, [this] { emit open_ ? disconnectRequested() : connectRequested(); });
+  connect(control_, &QPushButton::clicked, this,
+          [this] { emit leaseHeld_ ? releaseControlRequested() : takeControlRequested(); });
+  connect(estop_, &QPushButton::clicked, this, &LinkPanel::estopRequested);
+  connect(rearm_, &QPushButton::clicked, this, &LinkPanel::rearmRequested);
+  showConnection(net::ConnectionState::Stopped, {});
+  showLease({});
+  showLatches(false, false);
+}
+
+void LinkPanel::setEndpoint(const QString& endpoint) { endpoint_->setText(endpoint); }
+
+void LinkPanel::appendEvent(const QString& text) {
+  events_->appendPlainText(QTime::currentTime().toString(QStringLiteral("HH:mm:ss.zzz  ")) + text);
+}
+
+QStringList LinkPanel::events() const { return events_->toPlainText().split(QLatin1Char('\n'), Qt::SkipEmptyParts); }
+
+void LinkPanel::showStats(const net::RobotClientStats& s) {
+  if (!s.connected) {
+    rtt_->setText(QStringLiteral("–"));
+    rate_->setText(QStringLiteral("–"));
+  } else {
+    rtt_->setText(tr("%1 ms (mean %2, max %3)")
+                      .arg(s.rttMs, 0, 'f', 1)
+                      .arg(s.rttMeanMs, 0, 'f', 1)
+                      .arg(s.rttMaxMs, 0, 'f', 1));
+    rate_->setText(tr("%1 Hz of %2").arg(s.telemetryRateHz, 0, 'f', 1).arg(s.telemetryRateAnnounced, 0, 'f', 0));
+  }
+  const uint64_t total = s.telemetryFrames + s.telemetryLost;
+  const double percent = total ? 100.0 * static_cast<double>(s.telemetryLost) / static_cast<double>(total) : 0.0;
+  loss_->setText(tr("%1 frames (%2 %), robot dropped %3, %4 reconnects")
+                     .arg(s.telemetryLost)
+                     .arg(percent, 0, 'f', 2)
+                     .arg(s.robotDropped)
+                     .arg(s.reconnects));
+}
+
+void LinkPanel::showConnection(net::ConnectionState state, const QString& detail) {
+  open_ = state != net::ConnectionState::Stopped;
+  const QString name = QString::fromLatin1(net::toString(state));
+  const QString text = detail.isEmpty() ? name : name + QStringLiteral(": ") + detail;
+  const char* colour = state == net::ConnectionState::Ready      ? "#2e7d32"
+                       : state == net::ConnectionState::Refused ? "#c62828"
+                       : state == net::ConnectionState::Stopped ? "#555555"
+                                                                 : "#ef6c00";
+  state_->setText(coloured(text, colour));
+  connect_->setText(open_ ? tr("Disconnect") : tr("Connect"));
+  control_->setEnabled(state == net::ConnectionState::Ready);
+  rearm_->setEnabled(state == net::ConnectionState::Ready);
+  if (state != net::ConnectionState::Ready) showLease({});
+}
+
+void LinkPanel::showLease(const net::LeaseStateMsg& lease) {
+  leaseHeld_ = lease.yours;
+  if (lease.yours) lease_->setText(coloured(tr("yours"), "#2e7d32"));
+  else if (!lease.holder.empty()) lease_->setText(coloured(tr("held by %1").arg(QString::fromStdString(lease.holder)), "#ef6c00"));
+  else lease_->setText(tr("free (monitoring)"));
+  control_->setText(lease.yours ? tr("Release control") : tr("Take control"));
+}
+
+void LinkPanel::showLatches(bool failsafe, bool estop) {
+  if (!failsafe && !estop) {
+    latches_->setText(coloured(tr("clear"), "#2e7d32"));
+    return;
+  }
+  QStringList on;
+  if (estop) on << tr("E-STOP");
+  if (failsafe) on << tr("FAILSAFE");
+  latches_->setText(coloured(on.join(QStringLiteral(" + ")) + tr(" latched: re-arm"), "#c62828"));
+}
+
+}  // namespace sp

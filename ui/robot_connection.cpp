@@ -1,0 +1,79 @@
+#include "ui/robot_connection.h"
+
+#include <QMetaObject>
+
+#include <utility>
+
+namespace sp {
+
+RobotConnection::RobotConnection(QObject* parent) : QObject(parent) {}
+
+RobotConnection::~RobotConnection() {
+  // Joins the worker: no callback runs after this, and queued calls to a
+  // destroyed context object are dropped by Qt.
+  client_.reset();
+}
+
+template <typename F>
+void RobotConnection::post(F&& emitIt) {
+  QMetaObject::invokeMethod(this, std::forward<F>(emitIt), Qt::QueuedConnection);
+}
+
+void RobotConnection::open(const net::RobotClientConfig& config) {
+  close();
+  config_ = config;
+  net::RobotClientCallbacks callbacks;
+  // Each callback copies its message into a queued call: the worker thread
+  // never waits on the GUI thread.
+  callbacks.telemetry = [this](const net::TelemetryMsg& m) { post([this, m] { emit telemetry(m); }); };
+  callbacks.laser = [this](const net::LaserMsg& m) { post([this, m] { emit laser(m); }); };
+  callbacks.reply = [this](const net::ReplyMsg& m) { post([this, m] { emit reply(m); }); };
+  callbacks.event = [this](const net::EventMsg& m) { post([this, m] { emit event(m); }); };
+  callbacks.lease = [this](const net::LeaseStateMsg& m) { post([this, m] { emit lease(m); }); };
+  callbacks.connection = [this](net::ConnectionState s, const std::string& detail) {
+    post([this, s, d = QString::fromStdString(detail)] { emit connectionChanged(s, d); });
+  };
+  callbacks.error = [this](const net::ErrorMsg& m) {
+    post([this, r = QString::fromStdString(m.reason)] { emit linkError(r); });
+  };
+  client_ = std::make_unique<net::RobotClient>(config_, std::move(callbacks));
+  client_->start();
+}
+
+void RobotConnection::close() {
+  if (!client_) return;
+  client_->releaseLease();
+  client_->stop();  // writes what is queued (the release) first
+  client_.reset();
+  emit connectionChanged(net::ConnectionState::Stopped, tr("disconnected"));
+}
+
+void RobotConnection::acquireLease() {
+  if (client_) client_->acquireLease();
+}
+
+void RobotConnection::releaseLease() {
+  if (client_) client_->releaseLease();
+}
+
+uint64_t RobotConnection::send(const Command& command, const RobotModel* robot) {
+  if (client_) return client_->sendCommand(command, 0, robot);
+  net::ReplyMsg local{0, net::ReplyStatus::Failed, "console: not connected, not sent"};
+  post([this, local] { emit reply(local); });
+  return 0;
+}
+
+void RobotConnection::estop(const QString& reason) {
+  if (client_) client_->estop(reason.toStdString());
+  else emit linkError(tr("console: not connected: the e-stop could not be sent"));
+}
+
+void RobotConnection::rearm() {
+  if (client_) client_->rearm();
+}
+
+net::RobotClientStats RobotConnection::stats() const {
+  return client_ ? client_->stats() : net::RobotClientStats{};
+}
+
+}  // namespace sp

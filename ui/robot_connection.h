@@ -1,0 +1,61 @@
+#pragma once
+// The console's end of the robot link, for Qt: a RobotClient whose callbacks
+// (on the client's worker thread) are re-posted to the GUI thread and
+// emitted as signals there, so widgets are only ever touched by the GUI
+// thread (STYLE.md habit 6).
+//
+// Thread: GUI thread only (construction, every method, every signal).
+
+#include <QObject>
+#include <QString>
+
+#include <memory>
+
+#include "net/robot_client.h"
+
+namespace sp {
+
+class RobotConnection : public QObject {
+  Q_OBJECT
+
+ public:
+  explicit RobotConnection(QObject* parent = nullptr);
+  /// Stops the client: no signal is emitted afterwards.
+  ~RobotConnection() override;
+
+  /// (Re)connects with `config`; drops a previous connection first.
+  void open(const net::RobotClientConfig& config);
+  /// Releases the lease if held, then closes the connection.
+  void close();
+  bool isOpen() const { return client_ != nullptr; }
+  /// The configuration of the current or last connection.
+  const net::RobotClientConfig& config() const { return config_; }
+
+  void acquireLease();
+  void releaseLease();
+  /// The COMMAND's sequence number (the `reply` signal carries it), or 0
+  /// when not open (then `reply` is emitted with status Failed at once).
+  uint64_t send(const Command& command, const RobotModel* robot);
+  void estop(const QString& reason);
+  void rearm();
+  net::RobotClientStats stats() const;
+
+ signals:
+  void telemetry(const sp::net::TelemetryMsg& message);
+  void laser(const sp::net::LaserMsg& message);
+  void reply(const sp::net::ReplyMsg& message);
+  void event(const sp::net::EventMsg& message);
+  void lease(const sp::net::LeaseStateMsg& message);
+  void connectionChanged(sp::net::ConnectionState state, const QString& detail);
+  void linkError(const QString& reason);
+
+ private:
+  /// Runs `emitIt` on the GUI thread, unless this object is gone by then.
+  template <typename F>
+  void post(F&& emitIt);
+
+  net::RobotClientConfig config_;
+  std::unique_ptr<net::RobotClient> client_;
+};
+
+}  // namespace sp
