@@ -595,6 +595,14 @@ void SceneView::setLaser(double angleMin, double angleStep, const std::vector<do
   m_->laserDirty = true;
 }
 
+Pose SceneView::drawnBasePose() const {
+  if (m_->links.empty()) return {};
+  const osg::Matrixd m = m_->links[0]->getMatrix();
+  const osg::Vec3d t = m.getTrans();
+  const osg::Quat q = m.getRotate();
+  return Pose{{t.x(), t.y(), t.z()}, Quat{q.w(), q.x(), q.y(), q.z()}};
+}
+
 void SceneView::setLaserVisible(bool visible) { m_->laserVisible = visible; }
 bool SceneView::laserVisible() const { return m_->laserVisible; }
 

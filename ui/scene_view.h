@@ -71,6 +71,10 @@ class SceneView : public QOpenGLWidget {
   /// origin without a robot). Follow mode is left as it is.
   void resetView();
 
+  /// Where the base link was drawn in the last frame (world frame): the
+  /// robot as the screen shows it, not as last set.
+  Pose drawnBasePose() const;
+
   /// Frames drawn since construction.
   int64_t framesDrawn() const;
   /// Frames drawn per second over the last completed second; 0 before the

@@ -130,6 +130,12 @@ class TestConsole : public QObject {
     QCOMPARE(w.controlPanel()->speed(), 0.5);
     QTRY_VERIFY_WITH_TIMEOUT(std::hypot(w.lastTelemetry()->pose.p.x - start.p.x,
                                         w.lastTelemetry()->pose.p.y - start.p.y) > 0.5, 6000);
+    // The drawn robot is where telemetry says (one telemetry period behind at most).
+    QTest::qWait(100);
+    const Pose drawn = scene->drawnBasePose(), reported = w.lastTelemetry()->pose;
+    qInfo("drawn %.3f %.3f, reported %.3f %.3f", drawn.p.x, drawn.p.y, reported.p.x, reported.p.y);
+    QVERIFY(std::hypot(drawn.p.x - reported.p.x, drawn.p.y - reported.p.y) < 0.5 * 0.05);
+    QVERIFY(std::hypot(drawn.p.x - start.p.x, drawn.p.y - start.p.y) > 0.5);
     const double v = planarSpeedOver(w, 500);
     qInfo("speed %.3f m/s", v);
     QVERIFY(std::abs(v - 0.5) < 0.05);
