@@ -119,7 +119,13 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
     std::string error;
     std::unique_ptr<SessionLogWriter> writer = openSessionLog(
         options.logFile,
-        {options.worldFile, robot.model.file, options.paramsFile, options.commandsFile, options.overrides, {}}, error);
+        {.worldFile = options.worldFile,
+         .robotFile = robot.model.file,
+         .paramsFile = options.paramsFile,
+         .commandsFile = options.commandsFile,
+         .overrides = options.overrides,
+         .replacedRobotFile = {}},
+        error);
     if (!writer) {
       err << error << "\n";
       return std::nullopt;

@@ -6,16 +6,12 @@
 #include <sstream>
 
 namespace sp {
-namespace {
-
 std::string readWholeFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
 }
-
-}  // namespace
 
 std::unique_ptr<SessionLogWriter> openSessionLog(const std::string& path, const SessionSources& sources,
                                                  std::string& error, const SessionLogOptions& options) {

@@ -28,6 +28,9 @@ struct SessionSources {
   std::string replacedRobotFile;
 };
 
+/// The bytes of the file at `path` ("" if it cannot be read), for the meta.
+std::string readWholeFile(const std::string& path);
+
 /// Creates the session log at `path` (an existing file is an error): meta
 /// with this program's version and each source file's name, whole contents
 /// and hash, and the overrides as events. Returns nullptr and sets `error`

@@ -121,8 +121,12 @@ std::string StandInRobot::start() {
     std::unique_ptr<SessionLogWriter> writer;
     if (!path.empty())
       writer = openSessionLog(path,
-                              {options_.worldFile, world_.robots[0].model.file, options_.paramsFile, {}, options_.overrides,
-                               replacedRobotFile_},
+                              {.worldFile = options_.worldFile,
+                               .robotFile = world_.robots[0].model.file,
+                               .paramsFile = options_.paramsFile,
+                               .commandsFile = {},
+                               .overrides = options_.overrides,
+                               .replacedRobotFile = replacedRobotFile_},
                               error);
     if (!writer) {
       server->server->stop();

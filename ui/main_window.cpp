@@ -26,6 +26,7 @@
 #include <cmath>
 
 #include "app/stand_in.h"
+#include "app/telemetry_recorder.h"
 #include "sim/model_loader.h"
 #include "ui/control_panel.h"
 #include "ui/link_panel.h"
@@ -78,9 +79,9 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
           [this](net::ConnectionState s, const QString& d) { onConnection(static_cast<int>(s), d); });
   connect(connection_, &RobotConnection::lease, this, [this](const net::LeaseStateMsg& lease) {
     link_->showLease(lease);
-    link_->appendEvent(lease.yours ? tr("control: yours")
-                       : lease.holder.empty() ? tr("control: free")
-                                              : tr("control: held by %1").arg(qs(lease.holder)));
+    linkEvent(QStringLiteral("link"), lease.yours ? tr("control: yours")
+                                      : lease.holder.empty() ? tr("control: free")
+                                                             : tr("control: held by %1").arg(qs(lease.holder)));
   });
   connect(connection_, &RobotConnection::linkError, this, [this](const QString& reason) {
     link_->appendEvent(tr("error: %1").arg(reason));
@@ -127,6 +128,7 @@ MainWindow::~MainWindow() {
   // The client first (it releases the lease), then the robot it talks to.
   delete connection_;
   connection_ = nullptr;
+  recorder_.reset();
   stopStandIn();
 }
 
@@ -254,6 +256,7 @@ QString MainWindow::start() {
     port_ = static_cast<uint16_t>(port);
     token_ = options_.token;
     link_->setEndpoint(QStringLiteral("%1:%2").arg(host_).arg(port_));
+    openRemoteLog();
   }
   connectToRobot();
   return {};
@@ -385,13 +388,14 @@ void MainWindow::showLoadErrors(const QString& title, const QString& text) {
 
 void MainWindow::addNote(const QString& text) {
   if (standIn_) standIn_->addNote(text.toStdString());
+  if (recorder_) recorder_->event("note", text.toStdString());
   link_->appendEvent(tr("note: %1").arg(text));
   statusBar()->showMessage(tr("note logged"), 3000);
 }
 
 void MainWindow::emergencyStop() {
   connection_->estop(tr("operator e-stop"));
-  link_->appendEvent(tr("E-STOP sent"));
+  linkEvent(QStringLiteral("estop"), tr("E-STOP sent"));
   statusBar()->showMessage(tr("E-STOP sent"), 5000);
 }
 
@@ -402,6 +406,7 @@ void MainWindow::sendCommand(const Command& command) {
     return;
   }
   connection_->send(command, robot);
+  if (recorder_) recorder_->command(command, robot);
 }
 
 bool MainWindow::eventFilter(QObject* watched, QEvent* event) {
@@ -439,6 +444,7 @@ void MainWindow::onTelemetry(const net::TelemetryMsg& t) {
   scene_->setRobotState(t.pose, modelPositions_);
   controls_->showMeasured(modelPositions_);
   wheelPlot_->addSample(t.time, t.wheelNormal);
+  if (recorder_) recorder_->telemetry(t, robot);
 
   const double now = wallSeconds();
   if (!timing_.empty() && t.time < timing_.back().second) timing_.clear();  // a new session restarted time
@@ -461,23 +467,24 @@ void MainWindow::onLaser(const net::LaserMsg& m) {
   ++laserCount_;
   scene_->setLaser(m.angleMin, m.angleStep, m.ranges);
   laserPlot_->setScan(m.angleMin, m.angleStep, m.ranges);
+  if (recorder_) recorder_->laser(m);
 }
 
 void MainWindow::onReply(const net::ReplyMsg& m) {
   if (m.status == net::ReplyStatus::Ok) return;
   const QString text = tr("command %1 %2: %3").arg(m.seq).arg(QLatin1String(net::toString(m.status)), qs(m.reason));
-  link_->appendEvent(text);
+  linkEvent(QStringLiteral("link"), text);
   statusBar()->showMessage(text, 5000);
 }
 
 void MainWindow::onEvent(const net::EventMsg& m) {
-  link_->appendEvent(tr("robot %1: %2").arg(QLatin1String(net::toString(m.kind)), qs(m.text)));
+  linkEvent(QLatin1String(net::toString(m.kind)), tr("robot %1: %2").arg(QLatin1String(net::toString(m.kind)), qs(m.text)));
 }
 
 void MainWindow::onConnection(int state, const QString& detail) {
   const auto s = static_cast<net::ConnectionState>(state);
   link_->showConnection(s, detail);
-  link_->appendEvent(tr("link %1%2").arg(QLatin1String(net::toString(s)), detail.isEmpty() ? QString() : QStringLiteral(": ") + detail));
+  linkEvent(QStringLiteral("link"), tr("link %1%2").arg(QLatin1String(net::toString(s)), detail.isEmpty() ? QString() : QStringLiteral(": ") + detail));
   updateBanner();
 }
 
@@ -498,8 +505,11 @@ void MainWindow::refreshStatus() {
   const QString log = logPath();
   logLabel_->setText(log.isEmpty() ? tr("log: off") : tr("log: %1").arg(QFileInfo(log).fileName()));
   logLabel_->setToolTip(log);
-  if (standIn_ && standIn_->logFailed())
-    logLabel_->setText(QStringLiteral("<b style='color:#c62828'>%1</b>").arg(tr("log failed: %1").arg(qs(standIn_->logError()).toHtmlEscaped())));
+  QString logError;
+  if (standIn_ && standIn_->logFailed()) logError = qs(standIn_->logError());
+  if (recorder_ && recorder_->writer().failed()) logError = qs(recorder_->writer().errorMessage());
+  if (!logError.isEmpty())
+    logLabel_->setText(QStringLiteral("<b style='color:#c62828'>%1</b>").arg(tr("log failed: %1").arg(logError.toHtmlEscaped())));
 }
 
 void MainWindow::updateBanner() {
@@ -513,7 +523,29 @@ void MainWindow::updateBanner() {
 
 QString MainWindow::bannerText() const { return banner_->isVisible() ? banner_->text() : QString(); }
 
-QString MainWindow::logPath() const { return standIn_ ? qs(standIn_->logPath()) : QString(); }
+QString MainWindow::logPath() const {
+  if (standIn_) return qs(standIn_->logPath());
+  return recorder_ ? qs(recorder_->path()) : QString();
+}
+
+void MainWindow::openRemoteLog() {
+  recorder_.reset();
+  if (!options_.log || !world_) return;
+  const QString dir = options_.logDir.isEmpty() ? sessionsDir() : options_.logDir;
+  QDir().mkpath(dir);
+  const QString stamp = QDateTime::currentDateTime().toString(QStringLiteral("yyyyMMdd-HHmmss"));
+  QString path;
+  for (int n = 1; n < 1000 && (path.isEmpty() || QFileInfo::exists(path)); ++n)
+    path = QDir(dir).filePath(QStringLiteral("session-%1%2.splog").arg(stamp, n > 1 ? QStringLiteral("-%1").arg(n) : QString()));
+  std::string error;
+  recorder_ = TelemetryRecorder::open(path.toStdString(), *world_, QStringLiteral("%1:%2").arg(host_).arg(port_).toStdString(), error);
+  if (!recorder_) statusBar()->showMessage(tr("session log: %1").arg(qs(error)));
+}
+
+void MainWindow::linkEvent(const QString& kind, const QString& text) {
+  link_->appendEvent(text);
+  if (recorder_) recorder_->event(kind.toStdString(), text.toStdString());
+}
 
 QString MainWindow::sessionsDir() const {
   return QStandardPaths::writableLocation(QStandardPaths::GenericDataLocation) + QStringLiteral("/SimPartner/sessions");

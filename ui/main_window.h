@@ -36,6 +36,7 @@ class LinkPanel;
 class RobotConnection;
 class SceneView;
 class StandInRobot;
+class TelemetryRecorder;
 class WheelForcePlot;
 
 /// What the console starts with (the `simpartner` command line).
@@ -115,11 +116,16 @@ class MainWindow : public QMainWindow {
   void updateBanner();
   QString sessionsDir() const;
   void showLoadErrors(const QString& title, const QString& text);
+  /// Starts the console's own log of a remote robot's session.
+  void openRemoteLog();
+  /// A link event, shown in the link dock and logged.
+  void linkEvent(const QString& kind, const QString& text);
 
   ConsoleOptions options_;
   std::optional<WorldModel> world_;  // what is drawn; its robots[0] is the one controlled
   QString worldFile_, robotFile_;    // the stand-in's files ("" robot = the world's own)
   std::unique_ptr<StandInRobot> standIn_;
+  std::unique_ptr<TelemetryRecorder> recorder_;  // the log when connected to a remote robot
   RobotConnection* connection_ = nullptr;
   QString host_;
   uint16_t port_ = 0;

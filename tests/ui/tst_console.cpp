@@ -10,9 +10,11 @@
 #include <QTemporaryDir>
 #include <QtTest>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
+#include "app/session_log.h"
 #include "ui/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/live_plots.h"
@@ -184,6 +186,42 @@ class TestConsole : public QObject {
     QCOMPARE(w.logPath(), log);
     const int64_t count = w.telemetryReceived();
     QTRY_VERIFY(w.telemetryReceived() > count + 5);
+  }
+
+  // A second console connected to the first's robot as a monitor (as to a
+  // remote robot) sees its telemetry and logs what it saw in its own file.
+  void remoteConsoleLogsWhatItSees() {
+    const net::RobotClientConfig& first = window_->connection()->config();
+    ConsoleOptions o = options_;
+    o.connectTo = QStringLiteral("127.0.0.1:%1").arg(first.port);
+    o.token = QString::fromStdString(first.token);
+    o.takeControl = false;
+    o.logDir = dir_.filePath(QStringLiteral("remote"));
+    QString logFile;
+    {
+      MainWindow remote(o);
+      QCOMPARE(remote.start(), QString());
+      logFile = remote.logPath();
+      QVERIFY(logFile.startsWith(o.logDir));
+      QTRY_VERIFY_WITH_TIMEOUT(remote.telemetryReceived() > 25, 5000);
+      QTRY_VERIFY_WITH_TIMEOUT(remote.laserReceived() > 1, 5000);
+      QVERIFY(!remote.linkPanel()->leaseHeld());
+      remote.addNote(QStringLiteral("seen from afar"));
+    }
+    std::string error;
+    auto reader = SessionLogReader::open(logFile.toStdString(), error);
+    QVERIFY2(reader, error.c_str());
+    const auto meta = reader->meta();
+    QCOMPARE(meta.at("log_source"), std::string("telemetry"));
+    QCOMPARE(meta.at("robot_endpoint"), o.connectTo.toStdString());
+    QVERIFY(meta.at("world_contents").find("<world") != std::string::npos);
+    const std::vector<LogSample> samples = reader->samplesBetween(0, 1e9);
+    QVERIFY(samples.size() > 20);
+    QCOMPARE(samples.back().joints.size(), 2 * size_t{27});  // WorkPartner: 27 joints, positions then rates
+    QVERIFY(!reader->laserBetween(0, 1e9).empty());
+    const std::vector<LogEvent> events = reader->events();
+    QVERIFY(std::any_of(events.begin(), events.end(), [](const LogEvent& e) { return e.kind == "note" && e.text == "seen from afar"; }));
+    QVERIFY(std::any_of(events.begin(), events.end(), [](const LogEvent& e) { return e.kind == "link"; }));
   }
 
   // Docks are remembered between runs: a hidden plots dock stays hidden.

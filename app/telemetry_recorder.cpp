@@ -1,0 +1,65 @@
+#include "app/telemetry_recorder.h"
+
+#include <cmath>
+
+#include "app/session_recorder.h"
+
+namespace sp {
+
+std::unique_ptr<TelemetryRecorder> TelemetryRecorder::open(const std::string& path, const WorldModel& world,
+                                                           const std::string& endpoint, std::string& error) {
+  SessionInfo info;
+#ifdef SP_VERSION
+  info.programVersion = SP_VERSION;
+#endif
+  info.files.push_back({"world", world.file, readWholeFile(world.file)});
+  if (!world.robots.empty())
+    info.files.push_back({"robot", world.robots[0].model.file, readWholeFile(world.robots[0].model.file)});
+  info.extraMeta["log_source"] = "telemetry";
+  info.extraMeta["robot_endpoint"] = endpoint;
+  std::unique_ptr<SessionLogWriter> writer = SessionLogWriter::open(path, info, error);
+  if (!writer) return nullptr;
+  return std::unique_ptr<TelemetryRecorder>(new TelemetryRecorder(std::move(writer)));
+}
+
+int64_t TelemetryRecorder::step() const { return std::llround(time_ * 1000); }
+
+void TelemetryRecorder::telemetry(const net::TelemetryMsg& t, const RobotModel& robot) {
+  time_ = t.time;
+  if (t.jointNames != names_) {
+    names_ = t.jointNames;
+    index_.clear();
+    for (const std::string& name : names_) index_.push_back(robot.findJoint(name));
+  }
+  LogSample s;
+  s.step = step();
+  s.time = t.time;
+  s.base = {t.pose.p.x, t.pose.p.y, t.pose.p.z};
+  s.quat = {t.pose.q.w, t.pose.q.x, t.pose.q.y, t.pose.q.z};
+  const size_t n = robot.joints.size();
+  s.joints.assign(2 * n, 0.0);  // positions, then velocities, as the twin logs them
+  for (size_t i = 0; i < index_.size(); ++i) {
+    if (index_[i] < 0) continue;
+    const auto j = static_cast<size_t>(index_[i]);
+    if (i < t.jointPositions.size()) s.joints[j] = t.jointPositions[i];
+    if (i < t.jointVelocities.size()) s.joints[n + j] = t.jointVelocities[i];
+  }
+  s.wheelNormal = t.wheelNormal;
+  s.roll = t.roll;
+  s.pitch = t.pitch;
+  writer_->logSample(std::move(s));
+}
+
+void TelemetryRecorder::laser(const net::LaserMsg& m) {
+  writer_->logLaser(LogLaser{std::llround(m.time * 1000), m.time, m.angleMin, m.angleStep, m.ranges});
+}
+
+void TelemetryRecorder::command(const Command& command, const RobotModel* robot) {
+  writer_->logCommand(step(), time_, "operator", command, robot);
+}
+
+void TelemetryRecorder::event(const std::string& kind, const std::string& text) {
+  writer_->logEvent(step(), time_, kind, text);
+}
+
+}  // namespace sp
