@@ -5,6 +5,7 @@
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QDir>
+#include <QElapsedTimer>
 #include <QFileInfo>
 #include <QMessageBox>
 #include <QSurfaceFormat>
@@ -12,9 +13,11 @@
 
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "ui/control_panel.h"
 #include "ui/link_panel.h"
+#include "ui/live_plots.h"
 #include "ui/main_window.h"
 #include "ui/scene_view.h"
 
@@ -108,11 +111,24 @@ int main(int argc, char** argv) {
   }
   if (parser.isSet(quitAfter) || parser.isSet(screenshot)) {
     const double seconds = parser.isSet(quitAfter) ? parser.value(quitAfter).toDouble() : 5.0;
- QTimer::singleShot(static_cast<int>(seconds * 1000), &window, [&] {
-      std::cout << "frames " << window.sceneView()->framesDrawn() << " in " << seconds << " s, "
-                << window.sceneView()->framesPerSecond() << " fps over the last second at "
-                << window.sceneView()->width() << "x" << window.sceneView()->height() << ", real-time factor "
-                << window.realTimeFactor() << ", telemetry " << window.telemetryReceived() << std::endl;
+    // The frame rate is measured after a warm-up (start, first telemetry,
+    // first layout): over the last `seconds - warmUp` seconds.
+    const double warmUp = seconds > 6 ? 3.0 : 0.0;
+    auto* measure = new QObject(&window);
+    auto framesAtWarmUp = std::make_shared<int64_t>(0);
+    auto wallAtWarmUp = std::make_shared<QElapsedTimer>();
+    QTimer::singleShot(static_cast<int>(warmUp * 1000), measure, [&window, framesAtWarmUp, wallAtWarmUp] {
+      *framesAtWarmUp = window.sceneView()->framesDrawn();
+      wallAtWarmUp->start();
+    });
+    QTimer::singleShot(static_cast<int>(seconds * 1000), measure, [&, framesAtWarmUp, wallAtWarmUp] {
+      const double wall = static_cast<double>(wallAtWarmUp->nsecsElapsed()) * 1e-9;
+      const int64_t frames = window.sceneView()->framesDrawn() - *framesAtWarmUp;
+      std::cout << "frames " << frames << " in " << wall << " s: " << static_cast<double>(frames) / wall
+                << " fps; 3D view " << window.sceneView()->width() << "x" << window.sceneView()->height()
+                << " in a " << window.width() << "x" << window.height() << " window; real-time factor "
+                << window.realTimeFactor() << "; telemetry frames " << window.telemetryReceived() << ", wheel-force replots "
+                << window.wheelForcePlot()->replots() << ", laser replots " << window.laserPlot()->replots() << std::endl;
       if (parser.isSet(screenshot)) window.grab().save(parser.value(screenshot));
       window.close();
     });

@@ -380,7 +380,8 @@ std::pair<double, double> WheelForcePlot::fittedYRange(const std::array<QList<QP
 void WheelForcePlot::setYAxis(double min, double max) {
   // Before the first layout the plot area is empty: assume a few hundred pixels.
   const double height = chart_->plotArea().height() >= 1 ? chart_->plotArea().height() : 300;
-  setAxis(yAxis_, min, max, tickSpacing(max - min, height / 50));
+  // A tick every ~35 px, and at least three intervals in a short dock.
+  setAxis(yAxis_, min, max, tickSpacing(max - min, std::max(3.0, height / 35)));
 }
 
 void WheelForcePlot::updateScrollBar() {

@@ -43,6 +43,7 @@ const osg::Vec4 kHitPointColor(1.0f, 0.10f, 0.05f, 1.0f);
 
 constexpr double kFovY = 40.0;            // [deg]
 constexpr double kPlaneHalfSize = 200.0;  // [m]; fogged out long before its edge
+constexpr double kMinDisplayCell = 0.1;   // [m] finest heightfield cell drawn
 constexpr double kPlaneCell = 10.0;       // [m]; coarse: software GL pays per vertex
 constexpr int kGridHalfSize = 50;         // [m] of 1 m grid around the origin
 constexpr double kGridLift = 0.005;       // [m] lines above the ground, with polygon offset
@@ -167,17 +168,30 @@ osg::ref_ptr<osg::Node> heightfieldNode(const TerrainSpec& t) {
   const int nx = grid.columns, ny = grid.rows;
   if (nx < 2 || ny < 2 || grid.heights.size() != static_cast<size_t>(nx) * static_cast<size_t>(ny)) return xf;
   const double sx = grid.spacingX(), sy = grid.spacingY();
+  // Drawn at no finer than kMinDisplayCell: software GL pays for every
+  // vertex every frame, and a finer mesh than that shows nothing more of
+  // the ground an operator drives on. The last row and column are always
+  // drawn, so the mesh covers the whole grid.
+  auto samples = [](int n, double spacing) {
+    const int stride = std::max(1, static_cast<int>(std::ceil(kMinDisplayCell / spacing - 1e-9)));
+    std::vector<int> at;
+    for (int i = 0; i < n - 1; i += stride) at.push_back(i);
+    at.push_back(n - 1);
+    return at;
+  };
+  const std::vector<int> cols = samples(nx, sx), rows = samples(ny, sy);
+  const int mx = static_cast<int>(cols.size()), my = static_cast<int>(rows.size());
   // The colour ramp spans at least 0.5 m, so gentle bumps stay gentle.
   const double lo = grid.minHeight(), span = std::max(grid.maxHeight() - lo, 0.5);
   osg::ref_ptr<osg::Geometry> g = newGeometry();
   auto* v = new osg::Vec3Array;
   auto* n = new osg::Vec3Array;
   auto* c = new osg::Vec4Array;
-  for (int j = 0; j < ny; ++j) {
-    for (int i = 0; i < nx; ++i) {
+  for (int j : rows) {
+    for (int i : cols) {
       const double h = grid.at(i, j);
       v->push_back({f(-grid.width / 2 + i * sx), f(-grid.depth / 2 + j * sy), f(h)});
-      // Central differences (one-sided at the edges).
+      // Central differences on the full grid (one-sided at the edges).
       const int i0 = std::max(i - 1, 0), i1 = std::min(i + 1, nx - 1);
       const int j0 = std::max(j - 1, 0), j1 = std::min(j + 1, ny - 1);
       const double dx = (grid.at(i1, j) - grid.at(i0, j)) / ((i1 - i0) * sx);
@@ -192,10 +206,10 @@ osg::ref_ptr<osg::Node> heightfieldNode(const TerrainSpec& t) {
   g->setNormalArray(n, osg::Array::BIND_PER_VERTEX);
   g->setColorArray(c, osg::Array::BIND_PER_VERTEX);
   auto* tris = new osg::DrawElementsUInt(GL_TRIANGLES);
-  tris->reserve(static_cast<size_t>(nx - 1) * static_cast<size_t>(ny - 1) * 6);
-  auto index = [nx](int i, int j) { return static_cast<unsigned>(j * nx + i); };
-  for (int j = 0; j + 1 < ny; ++j) {
-    for (int i = 0; i + 1 < nx; ++i) {
+  tris->reserve(static_cast<size_t>(mx - 1) * static_cast<size_t>(my - 1) * 6);
+  auto index = [mx](int i, int j) { return static_cast<unsigned>(j * mx + i); };
+  for (int j = 0; j + 1 < my; ++j) {
+    for (int i = 0; i + 1 < mx; ++i) {
       // Diagonal (i, j)-(i+1, j+1), counter-clockwise seen from above.
       for (unsigned k : {index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j), index(i + 1, j + 1),
                          index(i, j + 1)})
@@ -246,7 +260,7 @@ osg::ref_ptr<osg::Node> gridNode(const TerrainSpec& t) {
         ymin = std::min(ymin, w.y), ymax = std::max(ymax, w.y);
       }
     }
-    const double step = std::min(grid.spacingX(), grid.spacingY()) / 2;
+    const double step = std::max(std::min(grid.spacingX(), grid.spacingY()), kMinDisplayCell) / 2;
     const double lift = std::max(0.01, 0.01 * (grid.maxHeight() - grid.minHeight()));
     auto point = [&](double x, double y, osg::Vec3& out) {
       const Vec3 local = transformPoint(toGrid, {x, y, 0});
