@@ -72,6 +72,10 @@ void RobotConnection::rearm() {
   if (client_) client_->rearm();
 }
 
+void RobotConnection::dropConnection() {
+  if (client_) client_->dropConnection();
+}
+
 net::RobotClientStats RobotConnection::stats() const {
   return client_ ? client_->stats() : net::RobotClientStats{};
 }

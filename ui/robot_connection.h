@@ -38,6 +38,8 @@ class RobotConnection : public QObject {
   uint64_t send(const Command& command, const RobotModel* robot);
   void estop(const QString& reason);
   void rearm();
+  /// Drops the connection as a lost link would (the client reconnects).
+  void dropConnection();
   net::RobotClientStats stats() const;
 
  signals:

@@ -168,6 +168,23 @@ class TestConsole : public QObject {
     QVERIFY(planarSpeedOver(w, 500) < 0.02);
   }
 
+  // A lost link while in control: the robot's deadman latches the failsafe,
+  // the console says so in its banner after reconnecting, and taking
+  // control again and re-arming clears it.
+  void lostLinkShowsTheFailsafe() {
+    MainWindow& w = *window_;
+    QVERIFY(w.linkPanel()->leaseHeld());
+    w.connection()->dropConnection();
+    QTRY_VERIFY_WITH_TIMEOUT(!w.linkPanel()->leaseHeld(), 3000);
+    QTRY_VERIFY_WITH_TIMEOUT(w.bannerText().contains(QLatin1String("FAILSAFE")), 5000);
+    QVERIFY(w.lastTelemetry()->failsafe);
+    w.linkPanel()->takeControlRequested();
+    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld(), 3000);
+    w.linkPanel()->rearmRequested();
+    QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->failsafe, 3000);
+    QTRY_VERIFY(w.bannerText().isEmpty());
+  }
+
   // A broken world file is refused with its file:line error; the session
   // (its log, its robot) carries on untouched.
   void badWorldFileLeavesTheSession() {
