@@ -7,13 +7,13 @@
 #include <QDir>
 #include <QElapsedTimer>
 #include <QFileInfo>
-#include <QMessageBox>
 #include <QSurfaceFormat>
 #include <QTimer>
 
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "ui/control_panel.h"
 #include "ui/link_panel.h"
@@ -30,6 +30,19 @@ QString findDataFile(const QString& path) {
   if (path.isEmpty() || QFileInfo(path).isAbsolute() || QFileInfo::exists(path)) return path;
   const QString inSource = QDir(QStringLiteral(SP_SOURCE_DIR)).filePath(path);
   return QFileInfo::exists(inSource) ? inSource : path;
+}
+
+/// The value of a numeric option, or nullopt after saying on stderr what is
+/// wrong with it (`<command line>: error: --OPTION: ...`).
+std::optional<double> numberOption(const QCommandLineParser& parser, const QCommandLineOption& option, double min,
+                                   double max) {
+  bool ok = false;
+  const QString text = parser.value(option);
+  const double value = text.toDouble(&ok);
+  if (ok && value >= min && value <= max) return value;
+  std::cerr << "<command line>: error: --" << option.names().constLast().toStdString() << ": expected a number in ["
+            << min << ", " << max << "], got '" << text.toStdString() << "'\n";
+  return std::nullopt;
 }
 
 }  // namespace
@@ -80,26 +93,27 @@ int main(int argc, char** argv) {
   options.logDir = parser.value(logDir);
   options.log = !parser.isSet(noLog);
   options.takeControl = !parser.isSet(monitor);
+  std::optional<double> driveSpeed, quitSeconds;
   if (parser.isSet(rtf)) {
-    bool ok = false;
-    options.rtf = parser.value(rtf).toDouble(&ok);
-    if (!ok || options.rtf < 0) {
-      std::cerr << "<command line>: error: --rtf: expected a number >= 0, got '" << parser.value(rtf).toStdString() << "'\n";
-      return 2;
-    }
+    const std::optional<double> x = numberOption(parser, rtf, 0, 1000);
+    if (!x) return 2;
+    options.rtf = *x;
   }
+  if (parser.isSet(drive) && !(driveSpeed = numberOption(parser, drive, -10, 10))) return 2;
+  if (parser.isSet(quitAfter) && !(quitSeconds = numberOption(parser, quitAfter, 0.1, 1e6))) return 2;
 
   sp::MainWindow window(options);
   if (const QString error = window.start(); !error.isEmpty()) {
+    // Said where it was asked for: on the command line's stderr, as every
+    // SimPartner tool does (a dialog would hang a scripted start).
     std::cerr << error.toStdString() << "\n";
-    QMessageBox::critical(nullptr, QStringLiteral("SimPartner"), error);
     return 1;
   }
   window.show();
   if (!window.logPath().isEmpty()) std::cout << "logging to " << window.logPath().toStdString() << std::endl;
 
-  if (parser.isSet(drive)) {
-    const double speed = parser.value(drive).toDouble();
+  if (driveSpeed) {
+    const double speed = *driveSpeed;
     // Drive once the lease is ours; poll, since the lease arrives over the link.
     auto* poll = new QTimer(&window);
     QObject::connect(poll, &QTimer::timeout, &window, [&window, poll, speed] {
@@ -110,7 +124,7 @@ int main(int argc, char** argv) {
     poll->start(100);
   }
   if (parser.isSet(quitAfter) || parser.isSet(screenshot)) {
-    const double seconds = parser.isSet(quitAfter) ? parser.value(quitAfter).toDouble() : 5.0;
+    const double seconds = quitSeconds.value_or(5.0);
     // The frame rate is measured after a warm-up (start, first telemetry,
     // first layout): over the last `seconds - warmUp` seconds.
     const double warmUp = seconds > 6 ? 3.0 : 0.0;

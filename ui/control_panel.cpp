@@ -146,11 +146,15 @@ void ControlPanel::setRobot(const RobotModel& robot) {
       maxArticulationDeg_ = j.limited ? radToDeg(std::min(std::abs(j.lower), std::abs(j.upper))) : 45.0;
     }
   }
+  // Ranges in whole display steps inside the limits; the epsilon keeps a
+  // limit of 30 degrees (0.5236 rad = 29.99999 degrees) at 30.
+  const double speedCm = std::floor(maxSpeed_ * 100 + 1e-6);
+  const double articulationDeg = std::floor(maxArticulationDeg_ + 1e-6);
   updating_ = true;
-  speedSlider_->setRange(-static_cast<int>(std::floor(maxSpeed_ * 100)), static_cast<int>(std::floor(maxSpeed_ * 100)));
-  speedSpin_->setRange(-std::floor(maxSpeed_ * 100) / 100, std::floor(maxSpeed_ * 100) / 100);
-  articulationSlider_->setRange(-toTicks(std::floor(maxArticulationDeg_)), toTicks(std::floor(maxArticulationDeg_)));
-  articulationSpin_->setRange(-std::floor(maxArticulationDeg_), std::floor(maxArticulationDeg_));
+  speedSlider_->setRange(-static_cast<int>(speedCm), static_cast<int>(speedCm));
+  speedSpin_->setRange(-speedCm / 100, speedCm / 100);
+  articulationSlider_->setRange(-toTicks(articulationDeg), toTicks(articulationDeg));
+  articulationSpin_->setRange(-articulationDeg, articulationDeg);
   speedSlider_->setValue(0);
   speedSpin_->setValue(0);
   articulationSlider_->setValue(0);
@@ -193,7 +197,11 @@ void ControlPanel::setRobot(const RobotModel& robot) {
     const double initial = std::clamp(act.initialTarget * row.scale, lo, hi);
     row.slider->setValue(toTicks(initial));
     row.spin->setValue(initial);
+    // Named by joint, for tests and style sheets.
+    row.slider->setObjectName(QStringLiteral("slider_") + QString::fromStdString(joint.name));
+    row.spin->setObjectName(QStringLiteral("target_") + QString::fromStdString(joint.name));
     row.measured = new QLabel(QStringLiteral("–"));
+    row.measured->setObjectName(QStringLiteral("measured_") + QString::fromStdString(joint.name));
     row.measured->setMinimumWidth(row.measured->fontMetrics().horizontalAdvance(QStringLiteral("-000.0 mm")));
     row.measured->setToolTip(tr("Measured position (telemetry)"));
     auto* name = new QLabel(QString::fromStdString(joint.name));

@@ -540,6 +540,14 @@ SceneView::SceneView(QWidget* parent) : QOpenGLWidget(parent), m_(std::make_uniq
 
 SceneView::~SceneView() {
   m_->timer.stop();
+  if (!isValid()) {
+    // Never shown (a start that failed): no GL object exists, and closing
+    // the never-realised window would make OSG probe GL without a context
+    // ("OpenGL version test failed"): let the viewer go without it.
+    m_->viewer->getCamera()->setGraphicsContext(nullptr);
+    m_.reset();
+    return;
+  }
   // OSG deletes its GL objects as the viewer goes: in our context.
   makeCurrent();
   m_.reset();

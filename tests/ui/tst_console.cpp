@@ -4,6 +4,7 @@
 
 #include <QDockWidget>
 #include <QDoubleSpinBox>
+#include <QProcess>
 #include <QSettings>
 #include <QStandardPaths>
 #include <QSurfaceFormat>
@@ -239,6 +240,31 @@ class TestConsole : public QObject {
     const std::vector<LogEvent> events = reader->events();
     QVERIFY(std::any_of(events.begin(), events.end(), [](const LogEvent& e) { return e.kind == "note" && e.text == "seen from afar"; }));
     QVERIFY(std::any_of(events.begin(), events.end(), [](const LogEvent& e) { return e.kind == "link"; }));
+  }
+
+  // Bad command lines end the program with the reason on stderr, naming the
+  // option or file, and no window or dialog waiting for anyone.
+  void badCommandLines_data() {
+    QTest::addColumn<QStringList>("arguments");
+    QTest::addColumn<int>("exitCode");
+    QTest::addColumn<QString>("message");
+    QTest::newRow("rtf") << QStringList{"--rtf", "fast"} << 2 << "<command line>: error: --rtf: expected a number";
+    QTest::newRow("drive") << QStringList{"--drive", "99"} << 2 << "<command line>: error: --drive: expected a number in [-10, 10]";
+    QTest::newRow("connect") << QStringList{"--connect", "nowhere"} << 1 << "--connect: expected HOST:PORT, got 'nowhere'";
+    QTest::newRow("world") << QStringList{"--world", "missing.world.xml"} << 1 << "missing.world.xml: error: cannot open world file";
+  }
+  void badCommandLines() {
+    QFETCH(QStringList, arguments);
+    QFETCH(int, exitCode);
+    QFETCH(QString, message);
+    QProcess console;
+    console.start(QStringLiteral(SP_CONSOLE_EXE), arguments << QStringLiteral("--no-log"));
+    QVERIFY(console.waitForFinished(20000));
+    QCOMPARE(console.exitStatus(), QProcess::NormalExit);
+    QCOMPARE(console.exitCode(), exitCode);
+    const QString err = QString::fromUtf8(console.readAllStandardError());
+    QVERIFY2(err.contains(message), qPrintable(err));
+    QVERIFY2(!err.contains(QLatin1String("OpenGL")), qPrintable(err));
   }
 
   // Docks are remembered between runs: a hidden plots dock stays hidden.
