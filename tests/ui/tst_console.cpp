@@ -4,6 +4,8 @@
 
 #include <QDockWidget>
 #include <QDoubleSpinBox>
+#include <QMessageBox>
+#include <QTimer>
 #include <QProcess>
 #include <QSettings>
 #include <QStandardPaths>
@@ -201,6 +203,19 @@ class TestConsole : public QObject {
     std::ofstream(badRobot.toStdString()) << "<robot name=\"x\">\n  <link name=\"a\" mass=\"-1\"/>\n</robot>\n";
     const QString robotError = w.openRobot(badRobot, true);
     QVERIFY2(robotError.contains(badRobot + QStringLiteral(":2:")), qPrintable(robotError));
+    QCOMPARE(w.logPath(), log);
+
+    // From the menu the errors appear in a dialog, file and line included.
+    QString shown;
+    QTimer::singleShot(300, &w, [&shown] {
+      auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget());
+      if (!box) return;
+      shown = box->informativeText() + QLatin1Char('\n') + box->detailedText();
+      box->accept();
+    });
+    w.openWorld(bad);
+    QVERIFY2(shown.contains(bad + QStringLiteral(":")), qPrintable(shown));
+    QVERIFY(shown.contains(QLatin1String("error")));
     QCOMPARE(w.logPath(), log);
     const int64_t count = w.telemetryReceived();
     QTRY_VERIFY(w.telemetryReceived() > count + 5);
