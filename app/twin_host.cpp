@@ -95,6 +95,10 @@ void TwinHost::publish() {
     if (model_.sensors[i].type == SensorType::Laser && laser < 0) laser = static_cast<int>(i);
   }
   s.health = w.health().healthy() ? std::string() : w.health().message();
+  // Dynamic objects only, in model order: static ones never move.
+  const std::vector<ObjectSpec>& objects = w.model().objects;
+  for (size_t i = 0; i < objects.size(); ++i)
+    if (!objects[i].isStatic) s.objects.push_back({objects[i].name, w.objectPose(static_cast<int>(i))});
   std::optional<net::LaserScanState> scan;
   if (laser >= 0) {
     const SensorSample& sample = w.sensorSample(0, laser);

@@ -189,6 +189,7 @@ void forEachField(M& m, F& f) {
     f("failsafe", m.failsafe, R);
     f("estop", m.estop, R);
     f("health", m.health, Need::Optional);
+    f("objects", m.objects, Need::Optional);
   } else if constexpr (std::is_same_v<T, LaserMsg>) {
     f("seq", m.seq, R);
     f("time", m.time, R);
@@ -247,7 +248,13 @@ struct Validator {
              " numbers (one per joint name), got " + std::to_string(n);
     };
     if (std::string e = count("joint_positions", m.jointPositions.size()); !e.empty()) return e;
-    return count("joint_velocities", m.jointVelocities.size());
+    if (std::string e = count("joint_velocities", m.jointVelocities.size()); !e.empty()) return e;
+    for (size_t i = 0; i < m.objects.size(); ++i) {
+      const std::string& name = m.objects[i].name;
+      if (name.empty() || name.find(' ') != std::string::npos)
+        return "key 'objects': name " + std::to_string(i + 1) + " is empty or contains a space";
+    }
+    return {};
   }
   std::string operator()(const LaserMsg& m) const {
     if (!std::isfinite(m.angleMin)) return "key 'angle_min': must be finite";
@@ -308,6 +315,20 @@ struct Encoder {
       for (size_t i = 0; i < v.size(); ++i) {
         if (i > 0) out += ' ';
         text(key, v[i]);
+      }
+    });
+  }
+
+  // `name x y z qw qx qy qz` per object, all items space-separated.
+  void operator()(const char* key, const std::vector<ObjectPose>& v, Need) {
+    line(key, [&] {
+      for (size_t i = 0; i < v.size(); ++i) {
+        if (i > 0) out += ' ';
+        text(key, v[i].name);
+        const Pose& p = v[i].pose;
+        const double xs[7] = {p.p.x, p.p.y, p.p.z, p.q.w, p.q.x, p.q.y, p.q.z};
+        out += ' ';
+        numbers(xs, xs + 7);
       }
     });
   }
@@ -410,6 +431,26 @@ struct Decoder {
   static std::string parse(std::string_view s, std::vector<std::string>& v) {
     v.clear();
     for (std::string_view item : splitSpaces(s)) v.emplace_back(item);
+    return {};
+  }
+  static std::string parse(std::string_view s, std::vector<ObjectPose>& v) {
+    constexpr size_t kItems = 8;  // name x y z qw qx qy qz
+    const std::vector<std::string_view> items = splitSpaces(s);
+    if (items.size() % kItems != 0)
+      return "expected groups of 8 items (name x y z qw qx qy qz), got " + std::to_string(items.size()) +
+             " items";
+    v.assign(items.size() / kItems, ObjectPose{});
+    for (size_t i = 0; i < v.size(); ++i) {
+      const std::string_view* item = &items[i * kItems];
+      double xs[7];
+      for (size_t k = 0; k < 7; ++k)
+        if (!parseWhole(item[k + 1], xs[k]))
+          return "object " + std::to_string(i + 1) + " " + quote(item[0]) + ": number " + std::to_string(k + 1) +
+                 ": expected a number, got " + quote(item[k + 1]);
+      v[i].name.assign(item[0]);
+      v[i].pose.p = {xs[0], xs[1], xs[2]};
+      v[i].pose.q = {xs[3], xs[4], xs[5], xs[6]};
+    }
     return {};
   }
 };

@@ -117,9 +117,16 @@ struct ReplyMsg {
   std::string reason;  ///< why, when status is not ok
   friend bool operator==(const ReplyMsg&, const ReplyMsg&) = default;
 };
+/// A named pose in the world: a dynamic object of TELEMETRY's `objects`.
+struct ObjectPose {
+  std::string name;  ///< the object's name in the world file: not empty, without spaces
+  Pose pose;         ///< [m], unit quaternion
+  friend bool operator==(const ObjectPose&, const ObjectPose&) = default;
+};
 /// TELEMETRY: keys `seq`, `time`, `pose`, `joint_names`, `joint_positions`,
 /// `joint_velocities`, `wheel_normal`, `wheel_tangential`, `roll`, `pitch`,
-/// `rtt_ms`, `lost`, `failsafe`, `estop`, `health` (optional, default empty).
+/// `rtt_ms`, `lost`, `failsafe`, `estop`, `health` (optional, default empty),
+/// `objects` (optional, default none).
 /// The joint names come in every frame, so that any frame can be read alone.
 struct TelemetryMsg {
   uint64_t seq = 0;    ///< increasing per connection; gaps are lost frames
@@ -136,6 +143,9 @@ struct TelemetryMsg {
   bool failsafe = false;       ///< the deadman failsafe is latched
   bool estop = false;          ///< an e-stop is latched
   std::string health;          ///< empty when healthy, else why the twin stopped
+  /// The world's dynamic objects the robot knows of, each as `name x y z qw
+  /// qx qy qz` (groups of 8 list items); empty when there are none.
+  std::vector<ObjectPose> objects;
   friend bool operator==(const TelemetryMsg&, const TelemetryMsg&) = default;
 };
 /// LASER: keys `seq`, `time`, `angle_min`, `angle_step`, `ranges`.
@@ -183,7 +193,7 @@ using Message = std::variant<HelloMsg, WelcomeMsg, LeaseAcquireMsg, LeaseKeepali
 MessageType typeOf(const Message& message);
 
 /// The payload text of `message`. On error (a text value with a line feed
-/// or invalid UTF-8, a joint name that is empty or has a space, a value
+/// or invalid UTF-8, a joint or object name that is empty or has a space, a value
 /// that breaks a rule above) returns nullopt and sets `error`, e.g.
 /// `HELLO: key 'name': must not be empty`.
 std::optional<std::string> encodePayload(const Message& message, std::string& error);

@@ -302,6 +302,7 @@ void RobotServer::onTimer() {
       m.failsafe = link_.failsafeLatched();
       m.estop = link_.estopLatched();
       m.health = st.health;
+      m.objects = st.objects;
       frames.emplace_back(id, std::move(m));
     }
   }

@@ -37,6 +37,9 @@ struct RobotState {
   std::array<double, 4> wheelNormal{}, wheelTangential{};
   double roll = 0, pitch = 0;
   std::string health;  ///< empty when healthy
+  /// Poses of the world's dynamic objects the robot knows of (names without
+  /// spaces); empty when there are none.
+  std::vector<ObjectPose> objects;
 };
 
 struct LaserScanState {

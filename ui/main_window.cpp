@@ -442,6 +442,9 @@ void MainWindow::onTelemetry(const net::TelemetryMsg& t) {
   for (size_t i = 0; i < jointIndex_.size() && i < t.jointPositions.size(); ++i)
     if (jointIndex_[i] >= 0) modelPositions_[static_cast<size_t>(jointIndex_[i])] = t.jointPositions[i];
   scene_->setRobotState(t.pose, modelPositions_);
+  std::vector<NamedPose> objects;
+  for (const net::ObjectPose& o : t.objects) objects.push_back({o.name, o.pose});
+  scene_->setObjectPoses(objects);
   controls_->showMeasured(modelPositions_);
   wheelPlot_->addSample(t.time, t.wheelNormal);
   if (recorder_) recorder_->telemetry(t, robot);

@@ -26,6 +26,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <string>
 
 #include "sim/kinematics.h"
 
@@ -349,6 +351,14 @@ struct SceneView::Impl {
   std::vector<Pose> linkWorld;
   bool robotDirty = false;
 
+  // Dynamic objects by name: their transforms and poses as last set.
+  struct DynamicObject {
+    osg::ref_ptr<osg::MatrixTransform> transform;
+    Pose pose;
+  };
+  std::map<std::string, DynamicObject> objects;
+  bool objectsDirty = false;
+
   // Laser: robot.sensors index, or -1 without one.
   int laser = -1;
   double laserAngleMin = 0, laserAngleStep = 0;
@@ -502,6 +512,10 @@ void SceneView::Impl::sync() {
     robotDirty = false;
     laserDirty = true;  // the laser rides on the robot
   }
+  if (objectsDirty) {
+    for (auto& [name, o] : objects) o.transform->setMatrix(toMatrix(o.pose));
+    objectsDirty = false;
+  }
   if (laserDirty) {
     updateLaser();
     laserDirty = false;
@@ -559,6 +573,8 @@ void SceneView::setWorld(const WorldModel& world) {
   m.worldNode->removeChildren(0, m.worldNode->getNumChildren());
   m.robotNode->removeChildren(0, m.robotNode->getNumChildren());
   m.links.clear();
+  m.objects.clear();
+  m.objectsDirty = false;
 
   const TerrainSpec& t = world.terrain;
   osg::ref_ptr<osg::Node> terrain = t.kind == TerrainSpec::Kind::Plane ? planeNode(t.pose.p.z) : heightfieldNode(t);
@@ -571,11 +587,15 @@ void SceneView::setWorld(const WorldModel& world) {
   m.worldNode->addChild(terrain);
   m.worldNode->addChild(gridNode(t));
   m.worldNode->addChild(axesNode(groundHeight(t, 0, 0)));
-  // Dynamic objects stay where the file puts them: telemetry does not carry them.
+  // Objects start where the file puts them; dynamic ones move with setObjectPoses.
   for (const ObjectSpec& o : world.objects) {
     osg::ref_ptr<osg::MatrixTransform> xf = new osg::MatrixTransform(toMatrix(o.pose));
     xf->addChild(geomsNode(o.geoms));
     m.worldNode->addChild(xf);
+    if (!o.isStatic) {
+      xf->setDataVariance(osg::Object::DYNAMIC);
+      m.objects[o.name] = {xf, o.pose};
+    }
   }
 
   m.hasRobot = !world.robots.empty() && !world.robots[0].model.links.empty();
@@ -608,6 +628,15 @@ void SceneView::setRobotState(const Pose& base, const std::vector<double>& joint
   m_->base = base;
   m_->joints = jointPositions;
   m_->robotDirty = true;
+}
+
+void SceneView::setObjectPoses(const std::vector<NamedPose>& objects) {
+  for (const NamedPose& o : objects) {
+    const auto it = m_->objects.find(o.name);
+    if (it == m_->objects.end()) continue;  // not a dynamic object of this world
+    it->second.pose = o.pose;
+    m_->objectsDirty = true;
+  }
 }
 
 void SceneView::setLaser(double angleMin, double angleStep, const std::vector<double>& ranges) {

@@ -1,8 +1,8 @@
 #pragma once
 // The console's 3D view: the world (terrain, objects, a 1 m ground grid, axes
-// at the origin), the robot as telemetry reports it (base pose + joint
-// positions through sp::linkPoses) and the latest laser scan, drawn with
-// OpenSceneGraph inside a QOpenGLWidget.
+// at the origin), the robot and the dynamic objects as telemetry reports them
+// (base pose + joint positions through sp::linkPoses; object poses by name)
+// and the latest laser scan, drawn with OpenSceneGraph inside a QOpenGLWidget.
 //
 // OSG is built for fixed-function GL 2: the application must set a default
 // QSurfaceFormat of OpenGL 2.1 CompatibilityProfile before creating its
@@ -13,12 +13,19 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "sim/math.h"
 #include "sim/robot_model.h"
 
 namespace sp {
+
+/// Where a world object is, by its name in the world file.
+struct NamedPose {
+  std::string name;
+  Pose pose;  ///< in the world frame [m]
+};
 
 /// An orbit-camera 3D view of one world and its first robot.
 ///
@@ -51,6 +58,12 @@ class SceneView : public QOpenGLWidget {
   /// one value per joint in robot.joints order ([rad] or [m]; missing values
   /// count as zero). Cheap: the link transforms are updated on the next paint.
   void setRobotState(const Pose& base, const std::vector<double>& jointPositions);
+
+  /// Places dynamic objects of the world by name (world frame). Names that
+  /// are no dynamic object of the world are ignored; objects not named keep
+  /// their last pose (the world file's until set). Cheap: the transforms are
+  /// updated on the next paint.
+  void setObjectPoses(const std::vector<NamedPose>& objects);
 
   /// The latest laser scan of robots[0]'s first laser sensor, drawn from the
   /// sensor's pose under the robot's current state (link pose * mounting

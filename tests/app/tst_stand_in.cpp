@@ -1,8 +1,8 @@
 // The stand-in robot as one object (app/stand_in.h): a console client drives
 // it over loopback, and its session log then holds the files, the operator's
 // commands, samples, link and e-stop events and snapshots, and re-simulates
-// without divergence. Also: where logs go, and what create() and start()
-// refuse.
+// without divergence. Also: telemetry carries the world's dynamic objects,
+// where logs go, and what create() and start() refuse.
 
 #include <QRegularExpression>
 #include <QTemporaryDir>
@@ -11,10 +11,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -287,6 +289,43 @@ class TestStandIn : public QObject {
       QVERIFY(std::filesystem::exists(path));
     }
     QVERIFY(first->logPath() != second->logPath());
+  }
+
+  // A client of the pick-and-place world receives the pole, its one dynamic
+  // object (the static cubes are not sent), in TELEMETRY `objects`, lying
+  // where the world file puts it (2.5 0 0.94, rolled 90 degrees).
+  void telemetryCarriesDynamicObjects() {
+    StandInOptions o = options("");
+    o.worldFile = sourcePath("terrains/pick_place.world.xml");
+    Diagnostics diag;
+    auto robot = StandInRobot::create(o, diag);
+    QVERIFY2(robot, diag.format().c_str());
+    QCOMPARE(robot->start(), std::string());
+
+    Seen seen;
+    std::optional<TelemetryMsg> telemetry;
+    RobotClientCallbacks callbacks = seen.callbacks();
+    callbacks.telemetry = [&](const TelemetryMsg& t) { seen.add([&] { telemetry = t; }); };
+    RobotClientConfig config;
+    config.port = robot->port();
+    config.token = robot->token();
+    config.name = "tester";
+    config.role = Role::Monitor;
+    RobotClient client(config, callbacks);
+    client.start();
+    QVERIFY(seen.waitFor([&] { return telemetry.has_value(); }));
+    client.stop();
+    robot->stop();
+
+    QCOMPARE(telemetry->objects.size(), size_t{1});
+    const ObjectPose& pole = telemetry->objects[0];
+    QCOMPARE(pole.name, std::string("pole"));
+    QVERIFY2(norm(pole.pose.p - Vec3{2.5, 0, 0.94}) < 0.02,
+             qPrintable(QStringLiteral("pole at %1 %2 %3").arg(pole.pose.p.x).arg(pole.pose.p.y).arg(pole.pose.p.z)));
+    // Rolled 90 degrees about x: q = (cos 45, sin 45, 0, 0), up to sign.
+    const Quat& q = pole.pose.q;
+    const double alignment = std::abs(q.w * std::sqrt(0.5) + q.x * std::sqrt(0.5));
+    QVERIFY2(alignment > 0.999, qPrintable(QStringLiteral("q = %1 %2 %3 %4").arg(q.w).arg(q.x).arg(q.y).arg(q.z)));
   }
 
   // With logging off no file is written anywhere.

@@ -73,7 +73,8 @@ const char* kTelemetryText =
     "lost=3\n"
     "failsafe=0\n"
     "estop=1\n"
-    "health=\n";
+    "health=\n"
+    "objects=\n";
 
 // kTelemetryText with the line of `key` replaced by `line`.
 QByteArray telemetryWith(const char* key, const char* line) {
@@ -122,6 +123,10 @@ void TestMessage::roundTrip_data() {
   empty.health = "angular speed 512 rad/s exceeds 200";
   empty.failsafe = true;
   QTest::newRow("TELEMETRY no joints") << Message(empty);
+  TelemetryMsg withObjects = telemetry();
+  withObjects.objects = {{"pole", Pose{{2.5, 0, 0.94}, {0.7071067811865476, 0.7071067811865475, 0, 0}}},
+                         {"crate.2", Pose{{-1e-300, 1.5, -0.25}, {1, 0, 0, 0}}}};
+  QTest::newRow("TELEMETRY with objects") << Message(withObjects);
   QTest::newRow("LASER") << Message(LaserMsg{3, 1.25, -2.356194490192345, 0.004363323129985824, {1.5, 0.25, 30}});
   QTest::newRow("HEARTBEAT") << Message(HeartbeatMsg{9, 1234.000001});
   QTest::newRow("ESTOP") << Message(EstopMsg{"operator pressed e-stop"});
@@ -219,6 +224,12 @@ void TestMessage::decodeAccepts_data() {
       << 1 << QByteArray("name=c\ntoken=00112233445566778899AABBCCDDEEFF\nrole=monitor\n")
       << Message(HelloMsg{"c", "00112233445566778899AABBCCDDEEFF", Role::Monitor});
   QTest::newRow("keys on a message without keys") << 3 << QByteArray("later=1\n") << Message(LeaseAcquireMsg{});
+  QTest::newRow("objects absent") << 9 << telemetryWith("objects", "") << Message(telemetry());
+  TelemetryMsg withPole = telemetry();
+  withPole.objects = {{"pole", Pose{{2.5, 0, 0.94}, {0.5, 0.5, -0.5, 0.5}}}, {"box", Pose{}}};
+  QTest::newRow("objects, 8 items each, extra spaces")
+      << 9 << telemetryWith("objects", "objects=pole 2.5 0 0.94 0.5 0.5 -0.5 0.5  box 0 0 0 1 0 0 0 ")
+      << Message(withPole);
 }
 
 // Receivers accept what a later or looser sender may write: unknown keys,
@@ -275,6 +286,12 @@ void TestMessage::decodeErrors_data() {
       "TELEMETRY: key 'wheel_normal': expected 4 numbers (FL FR RL RR), got 3");
   row("joint count", 9, telemetryWith("joint_velocities", "joint_velocities=1"),
       "TELEMETRY: key 'joint_velocities': expected 2 numbers (one per joint name), got 1");
+  row("object count", 9, telemetryWith("objects", "objects=pole 2.5 0 0.94 1 0 0"),
+      "TELEMETRY: key 'objects': expected groups of 8 items (name x y z qw qx qy qz), got 7 items");
+  row("object without a name", 9, telemetryWith("objects", "objects=2.5 0 0.94 1 0 0 0"),
+      "TELEMETRY: key 'objects': expected groups of 8 items (name x y z qw qx qy qz), got 7 items");
+  row("object item", 9, telemetryWith("objects", "objects=box 0 0 0 1 0 0 0 pole 2.5 0 0.94 1 0 0 +0"),
+      "TELEMETRY: key 'objects': object 2 'pole': number 7: expected a number, got '+0'");
   row("short token", 1, hello + QByteArray::fromStdString(kToken.substr(1)),
       "HELLO: key 'token': expected at least 32 hex digits (128 bits), got 31");
   row("non-hex token", 1, hello + QByteArray::fromStdString(kToken + "g"),
@@ -334,6 +351,15 @@ void TestMessage::encodeErrors_data() {
   t.jointNames[1] = "knee fl";
   QTest::newRow("joint name with space") << Message(t)
                                          << "TELEMETRY: key 'joint_names': name 2 is empty or contains a space";
+  t = telemetry();
+  t.objects = {{"pole", Pose{}}, {"the box", Pose{}}};
+  QTest::newRow("object name with space") << Message(t)
+                                          << "TELEMETRY: key 'objects': name 2 is empty or contains a space";
+  t.objects = {{"", Pose{}}};
+  QTest::newRow("empty object name") << Message(t)
+                                     << "TELEMETRY: key 'objects': name 1 is empty or contains a space";
+  t.objects = {{"pole\n", Pose{}}};
+  QTest::newRow("object name with line feed") << Message(t) << "TELEMETRY: key 'objects': contains a line feed";
   QTest::newRow("short token") << Message(HelloMsg{"c", "abc", Role::Monitor})
                                << "HELLO: key 'token': expected at least 32 hex digits (128 bits), got 3";
   QTest::newRow("zero expiry") << Message(CommandMsg{1, 0, "stop"}) << "COMMAND: key 'expires_ms': must be > 0";

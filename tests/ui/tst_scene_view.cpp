@@ -1,5 +1,5 @@
-// Tests of sp::SceneView (ui/scene_view.h): the world, the robot and the
-// laser reach the pixels, the camera modes behave, frames are counted.
+// Tests of sp::SceneView (ui/scene_view.h): the world, the robot, dynamic
+// objects and the laser reach the pixels, the camera modes behave, frames are counted.
 // Needs real GL: run under `xvfb-run -a` (ctest label gl). Skips on the
 // offscreen platform, where Qt cannot show a GL widget (shared/STACK.md).
 
@@ -11,6 +11,7 @@
 #include <QSurfaceFormat>
 #include <QWheelEvent>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -179,6 +180,35 @@ class TstSceneView : public QObject {
     QVERIFY(waitFrames(*view, 2));
     const int changed = countDiffering(before, frame(*view), centre(before));
     QVERIFY2(changed > 500, qPrintable(QString::number(changed)));
+  }
+
+  // Placing pick_place's pole (its one dynamic object) 0.6 m higher and along
+  // x changes the image, and placing it back restores it; an unknown name
+  // and a static object's name change nothing.
+  void objectsMoveImage() {
+    auto world = loadTestWorld("terrains/pick_place.world.xml");
+    QVERIFY(world);
+    const auto pole = std::find_if(world->objects.begin(), world->objects.end(),
+                                   [](const sp::ObjectSpec& o) { return o.name == "pole"; });
+    QVERIFY(pole != world->objects.end() && !pole->isStatic);
+    auto view = shownView(*world);
+    QVERIFY(view);
+    const QImage before = frame(*view);
+    const QRect all = before.rect();
+    sp::Pose moved{pole->pose.p + sp::Vec3{0, 0, 0.6}, sp::Quat{1, 0, 0, 0}};
+
+    view->setObjectPoses({{"no_such_object", moved}, {"cube_pick_left", moved}});
+    QVERIFY(waitFrames(*view, 2));
+    QVERIFY(countDiffering(before, frame(*view), all) < 50);
+
+    view->setObjectPoses({{"pole", moved}});
+    QVERIFY(waitFrames(*view, 2));
+    const int changed = countDiffering(before, frame(*view), all);
+    QVERIFY2(changed > 500, qPrintable(QString::number(changed)));
+
+    view->setObjectPoses({{"pole", pole->pose}});
+    QVERIFY(waitFrames(*view, 2));
+    QVERIFY(countDiffering(before, frame(*view), all) < 50);
   }
 
   // In follow mode the camera moves with the robot: a 5 m move (a whole
