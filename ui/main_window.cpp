@@ -244,7 +244,7 @@ QString MainWindow::start() {
     // A remote robot: the world file only tells what to draw.
     Diagnostics diag;
     auto world = loadWorld(options_.world.toStdString(), diag);
-    if (!world) return qs(diag.format());
+    if (!world) return qs(diag.format()).trimmed();
     if (world->robots.empty()) return tr("%1: error: the world has no <robot>").arg(options_.world);
     worldFile_ = options_.world;
     showWorld(*world);
