@@ -114,7 +114,7 @@ LivePlot::LivePlot(QWidget* parent) : QWidget(parent) {
   layout->addWidget(view, 1);
 
   timer_.setInterval(100);
-  connect(&timer_, &QTimer::timeout, this, &LivePlot::onTimer);
+  connect(&timer_, &QTimer::timeout, this, &LivePlot::tick);
   timer_.start();
 }
 
@@ -127,7 +127,12 @@ void LivePlot::replotNow() {
   if (replot(true)) ++replots_;
 }
 
-void LivePlot::onTimer() {
+void LivePlot::setOwnTimer(bool on) {
+  if (on) timer_.start();
+  else timer_.stop();
+}
+
+void LivePlot::tick() {
   // A hidden plot (another tab, a closed dock) stays dirty and costs nothing
   // until it is shown again.
   if (!dirty_ || !isVisible()) return;

@@ -48,6 +48,14 @@ class LivePlot : public QWidget {
   /// Redraws now, dirty or not, visible or not (e.g. before grab()).
   void replotNow();
 
+  /// One replot tick: redraws if the data changed and the plot is visible.
+  /// The plot's own timer calls it; an owner that drives several plots from
+  /// one timer (so their repaints reach the screen in one window update,
+  /// which software GL composites whole) calls it after setOwnTimer(false).
+  void tick();
+  /// Whether the plot runs its own replot timer (default) or waits for tick().
+  void setOwnTimer(bool on);
+
   /// Times the chart's contents were updated since construction; each update
   /// is one data pass plus one repaint of the view.
   int64_t replots() const { return replots_; }
@@ -69,8 +77,6 @@ class LivePlot : public QWidget {
   QChart* chart_ = nullptr;  ///< owned by the view, a child of this widget first in its layout
 
  private:
-  void onTimer();
-
   QTimer timer_;
   bool dirty_ = false;
   int64_t replots_ = 0;

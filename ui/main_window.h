@@ -152,6 +152,8 @@ class MainWindow : public QMainWindow {
   int64_t telemetryCount_ = 0, laserCount_ = 0;
   std::deque<std::pair<double, double>> timing_;  // (wall [s], robot time [s]) over the last second
   double rtf_ = 0;
+  bool measuredDirty_ = false;  // modelPositions_ changed since the controls showed them
+  int64_t panelTicks_ = 0;
   bool failsafe_ = false, estop_ = false;
   QString healthText_;
 };

@@ -279,6 +279,24 @@ class TestLivePlots : public QObject {
              qPrintable(QString("%1 replots in %2 ms").arg(plot->replots()).arg(elapsed)));
   }
 
+  // Without its own timer a plot replots only when its owner ticks it, and
+  // a tick without new data redraws nothing.
+  void ownerDrivenTicks() {
+    auto plot = shownWheelPlot();
+    plot->setOwnTimer(false);
+    feed(*plot, 0, 100);
+    QTest::qWait(3 * plot->replotInterval());
+    QCOMPARE(plot->replots(), 0);
+    plot->tick();
+    QCOMPARE(plot->replots(), 1);
+    QCOMPARE(plot->shownPoints(1).size(), 100);
+    plot->tick();
+    QCOMPARE(plot->replots(), 1);
+    plot->setOwnTimer(true);
+    feed(*plot, 100, 110);
+    QVERIFY(waitForReplot(*plot, 1));
+  }
+
   // A hidden plot keeps its samples but does not replot until shown.
   void hiddenPlotWaits() {
     auto plot = shownWheelPlot();
