@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "headless_default.h"
 #include "sim/model_loader.h"
 #include "ui/control_panel.h"
 

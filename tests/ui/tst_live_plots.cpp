@@ -27,6 +27,7 @@
 #include <numbers>
 #include <vector>
 
+#include "headless_default.h"
 #include "ui/live_plots.h"
 #include "ui/plot_renderer.h"
 
@@ -36,16 +37,6 @@ using sp::WheelForcePlot;
 
 namespace {
 
-// As tst_plot_renderer: with no display and no platform chosen, use offscreen
-// rather than let xcb abort, so a plain `ctest` in a headless container runs.
-const bool kHeadlessDefault = [] {
-  if (qEnvironmentVariableIsEmpty("DISPLAY") && qEnvironmentVariableIsEmpty("WAYLAND_DISPLAY") &&
-      !qEnvironmentVariableIsSet("QT_QPA_PLATFORM")) {
-    qputenv("QT_QPA_PLATFORM", QByteArrayLiteral("offscreen"));
-    return true;
-  }
-  return false;
-}();
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -170,7 +161,7 @@ class TestLivePlots : public QObject {
  private slots:
   void initTestCase() {
     qInfo("platform plugin: %s%s", qPrintable(QGuiApplication::platformName()),
-          kHeadlessDefault ? " (no display: chosen by this test)" : "");
+          sp::test::kHeadlessDefault ? " (no display: chosen by this test)" : "");
   }
 
   // addSample only stores: nothing is drawn until the timer fires, then the

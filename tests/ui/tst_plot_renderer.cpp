@@ -17,6 +17,7 @@
 #include <string>
 #include <thread>
 
+#include "headless_default.h"
 #include "app/plot.h"
 #include "ui/plot_renderer.h"
 
@@ -29,18 +30,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Before QTEST_MAIN's QApplication, by the renderer's own rule: with no
-// display and no platform chosen, use offscreen rather than let xcb abort, so
-// a plain `ctest` in a headless container runs this test too. An explicit
-// QT_QPA_PLATFORM, or xvfb-run's DISPLAY, is left alone.
-const bool kHeadlessDefault = [] {
-  if (qEnvironmentVariableIsEmpty("DISPLAY") && qEnvironmentVariableIsEmpty("WAYLAND_DISPLAY") &&
-      !qEnvironmentVariableIsSet("QT_QPA_PLATFORM")) {
-    qputenv("QT_QPA_PLATFORM", QByteArrayLiteral("offscreen"));
-    return true;
-  }
-  return false;
-}();
 
 /// Two line series, a rising parabola and a falling line, 640 x 360.
 PlotSpec twoSeriesPlot() {
@@ -99,7 +88,7 @@ class TestPlotRenderer : public QObject {
   void initTestCase() {
     QVERIFY(dir_.isValid());
     qInfo("platform plugin: %s%s", qPrintable(QGuiApplication::platformName()),
-          kHeadlessDefault ? " (no display: chosen by this test)" : "");
+          sp::test::kHeadlessDefault ? " (no display: chosen by this test)" : "");
   }
 
   // A two-series plot becomes a PNG of the requested size with the plot drawn
