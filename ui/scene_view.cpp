@@ -132,6 +132,21 @@ osg::Vec4 heightColor(double t) {
   return t < 0.5 ? low + (mid - low) * f(2 * t) : mid + (high - mid) * f(2 * t - 1);
 }
 
+/// Two triangles per cell of a row-major grid of `columns` x `rows`
+/// vertices, split along the diagonal (i, j)-(i+1, j+1) as ODE's
+/// heightfield is, counter-clockwise seen from above.
+osg::ref_ptr<osg::DrawElementsUInt> gridTriangles(int columns, int rows) {
+  osg::ref_ptr<osg::DrawElementsUInt> tris = new osg::DrawElementsUInt(GL_TRIANGLES);
+  tris->reserve(static_cast<size_t>(columns - 1) * static_cast<size_t>(rows - 1) * 6);
+  auto index = [columns](int i, int j) { return static_cast<unsigned>(j * columns + i); };
+  for (int j = 0; j + 1 < rows; ++j)
+    for (int i = 0; i + 1 < columns; ++i)
+      for (unsigned k : {index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j), index(i + 1, j + 1),
+                         index(i, j + 1)})
+        tris->push_back(k);
+  return tris;
+}
+
 /// The plane as a grid of cells rather than one quad: fixed-function fog is
 /// computed per vertex, and a quad whose corners lie far away (or behind the
 /// camera) would be fogged all over.
@@ -149,14 +164,7 @@ osg::ref_ptr<osg::Node> planeNode(double z) {
   auto* c = new osg::Vec4Array;
   c->push_back(kEarthColor);
   g->setColorArray(c, osg::Array::BIND_OVERALL);
-  auto* tris = new osg::DrawElementsUInt(GL_TRIANGLES);
-  auto index = [n](int i, int j) { return static_cast<unsigned>(j * (n + 1) + i); };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-      for (unsigned k : {index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j), index(i + 1, j + 1),
-                         index(i, j + 1)})
-        tris->push_back(k);
-  g->addPrimitiveSet(tris);
+  g->addPrimitiveSet(gridTriangles(n + 1, n + 1));
   osg::ref_ptr<osg::Geode> geode = new osg::Geode;
   geode->addDrawable(g);
   return geode;
@@ -207,18 +215,7 @@ osg::ref_ptr<osg::Node> heightfieldNode(const TerrainSpec& t) {
   g->setVertexArray(v);
   g->setNormalArray(n, osg::Array::BIND_PER_VERTEX);
   g->setColorArray(c, osg::Array::BIND_PER_VERTEX);
-  auto* tris = new osg::DrawElementsUInt(GL_TRIANGLES);
-  tris->reserve(static_cast<size_t>(mx - 1) * static_cast<size_t>(my - 1) * 6);
-  auto index = [mx](int i, int j) { return static_cast<unsigned>(j * mx + i); };
-  for (int j = 0; j + 1 < my; ++j) {
-    for (int i = 0; i + 1 < mx; ++i) {
-      // Diagonal (i, j)-(i+1, j+1), counter-clockwise seen from above.
-      for (unsigned k : {index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j), index(i + 1, j + 1),
-                         index(i, j + 1)})
-        tris->push_back(k);
-    }
-  }
-  g->addPrimitiveSet(tris);
+  g->addPrimitiveSet(gridTriangles(mx, my));
   osg::ref_ptr<osg::Geode> geode = new osg::Geode;
   geode->addDrawable(g);
   xf->addChild(geode);
