@@ -528,7 +528,9 @@ class TestRobotClient : public QObject {
   }
 
   // Nothing listening: attempts at 0.2, 0.4, 0.8, 1.6 s intervals (doubling
-  // up to 2 s).
+  // up to 2 s). A gap is never shorter than its step, and shorter than
+  // 1.9 steps, so a skipped doubling shows; the slack absorbs a stalled VM
+  // (a gap of 0.69 s for the 0.4 s step was seen once).
   void backoffWithoutRobot() {
     uint16_t port = 0;
     {
@@ -552,7 +554,7 @@ class TestRobotClient : public QObject {
     const double expected[] = {0.2, 0.4, 0.8, 1.6};
     for (size_t i = 0; i < 4; ++i) {
       const double gap = std::chrono::duration<double>(attempts[i + 1] - attempts[i]).count();
-      QVERIFY2(gap >= expected[i] - 0.01 && gap < expected[i] + 0.1,
+      QVERIFY2(gap >= expected[i] - 0.01 && gap < 1.9 * expected[i],
                qPrintable(QString("attempt %1: %2 s").arg(i + 1).arg(gap)));
     }
     QCOMPARE(c.client.stats().reconnects, uint64_t{0});
