@@ -22,7 +22,7 @@ std::unique_ptr<TelemetryRecorder> TelemetryRecorder::open(const std::string& pa
   return std::unique_ptr<TelemetryRecorder>(new TelemetryRecorder(std::move(writer)));
 }
 
-int64_t TelemetryRecorder::step() const { return std::llround(time_ * 1000); }
+int64_t TelemetryRecorder::rowKey() const { return std::llround(time_ * 1000); }
 
 void TelemetryRecorder::telemetry(const net::TelemetryMsg& t, const RobotModel& robot) {
   time_ = t.time;
@@ -32,7 +32,7 @@ void TelemetryRecorder::telemetry(const net::TelemetryMsg& t, const RobotModel& 
     for (const std::string& name : names_) index_.push_back(robot.findJoint(name));
   }
   LogSample s;
-  s.step = step();
+  s.step = rowKey();
   s.time = t.time;
   s.base = {t.pose.p.x, t.pose.p.y, t.pose.p.z};
   s.quat = {t.pose.q.w, t.pose.q.x, t.pose.q.y, t.pose.q.z};
@@ -55,11 +55,11 @@ void TelemetryRecorder::laser(const net::LaserMsg& m) {
 }
 
 void TelemetryRecorder::command(const Command& command, const RobotModel* robot) {
-  writer_->logCommand(step(), time_, "operator", command, robot);
+  writer_->logCommand(rowKey(), time_, "operator", command, robot);
 }
 
 void TelemetryRecorder::event(const std::string& kind, const std::string& text) {
-  writer_->logEvent(step(), time_, kind, text);
+  writer_->logEvent(rowKey(), time_, kind, text);
 }
 
 }  // namespace sp

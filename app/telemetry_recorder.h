@@ -44,7 +44,9 @@ class TelemetryRecorder {
 
  private:
   explicit TelemetryRecorder(std::unique_ptr<SessionLogWriter> writer) : writer_(std::move(writer)) {}
-  int64_t step() const;
+  /// The row key of the latest telemetry: robot time in whole milliseconds
+  /// (the robot's own step count is not on the link).
+  int64_t rowKey() const;
 
   std::unique_ptr<SessionLogWriter> writer_;
   double time_ = 0;  // robot time of the latest telemetry [s]

@@ -2,7 +2,7 @@
 
 #include <chrono>
 
-#include "sim/command_file.h"
+#include "sim/command_check.h"
 #include "sim/pacer.h"
 
 namespace sp {
@@ -52,7 +52,7 @@ void TwinHost::logEvent(std::string kind, std::string text) {
   events_.push_back({std::move(kind), std::move(text)});
 }
 
-std::string TwinHost::check(const Command& command) const { return checkCommand(command, model_); }
+CommandCheck TwinHost::check(const Command& command) const { return checkCommand(command, model_); }
 
 void TwinHost::apply(const std::vector<Command>& commands) {
   std::lock_guard<std::mutex> lock(mutex_);

@@ -56,7 +56,7 @@ class TwinHost : public net::RobotPort {
   const SessionLogWriter* log() const { return log_ ? &log_->writer() : nullptr; }
 
   const RobotModel* model() const override { return &model_; }
-  std::string check(const Command& command) const override;
+  CommandCheck check(const Command& command) const override;
   void apply(const std::vector<Command>& commands) override;
   net::RobotState state() const override;
   std::optional<net::LaserScanState> laserAfter(uint64_t afterCount) const override;

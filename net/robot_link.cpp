@@ -18,7 +18,7 @@ bool equalConstantTime(const std::string& a, const std::string& b) {
 }
 
 RobotLink::RobotLink(RobotLinkConfig config, const RobotModel* robot,
-                     std::function<std::string(const Command&)> check)
+                     std::function<CommandCheck(const Command&)> check)
     : config_(std::move(config)), robot_(robot), check_(std::move(check)) {}
 
 void RobotLink::connected(ClientId client, double) { clients_[client] = Client{}; }
@@ -173,10 +173,10 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
           std::string error;
           const std::optional<Command> command = parseCommandMsg(m, robot_, error);
           if (!command) return refuse(client, m.seq, ReplyStatus::Invalid, error);
-          if (std::string why = check_ ? check_(*command) : std::string(); !why.empty()) {
+          if (CommandCheck verdict = check_ ? check_(*command) : CommandCheck{}; !verdict.ok()) {
             // Limits are refused, never clipped.
-            const bool limit = why.find("outside") != std::string::npos || why.find("exceeds") != std::string::npos;
-            return refuse(client, m.seq, limit ? ReplyStatus::OutOfLimits : ReplyStatus::Invalid, why);
+            const bool limit = verdict.kind == CommandCheck::Kind::OutOfLimits;
+            return refuse(client, m.seq, limit ? ReplyStatus::OutOfLimits : ReplyStatus::Invalid, verdict.message);
           }
           lastFromHolder_ = now;
           deadmanArmed_ = true;

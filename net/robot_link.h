@@ -17,6 +17,7 @@
 
 #include "net/message.h"
 #include "sim/command.h"
+#include "sim/command_check.h"
 
 namespace sp {
 struct RobotModel;
@@ -39,9 +40,9 @@ bool equalConstantTime(const std::string& a, const std::string& b);
 class RobotLink {
  public:
   /// `robot` (may be null) parses command text; `check` validates a parsed
-  /// command against the robot's limits ("" = fine), e.g. World::submit's
-  /// checks via sp::checkCommand.
-  RobotLink(RobotLinkConfig config, const RobotModel* robot, std::function<std::string(const Command&)> check);
+  /// command against the robot's limits, e.g. sp::checkCommand; its kind
+  /// picks the reply (out_of_limits or invalid).
+  RobotLink(RobotLinkConfig config, const RobotModel* robot, std::function<CommandCheck(const Command&)> check);
 
   void connected(ClientId client, double now);
   /// Drops the client; a lease holder's lease is released (the deadman
@@ -121,7 +122,7 @@ class RobotLink {
 
   RobotLinkConfig config_;
   const RobotModel* robot_;
-  std::function<std::string(const Command&)> check_;
+  std::function<CommandCheck(const Command&)> check_;
   std::map<ClientId, Client> clients_;
   ClientId holder_ = 0;
   double lastFromHolder_ = 0;

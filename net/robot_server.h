@@ -54,8 +54,8 @@ class RobotPort {
  public:
   virtual ~RobotPort() = default;
   virtual const RobotModel* model() const = 0;
-  /// "" if the command is within limits, else why not.
-  virtual std::string check(const Command& command) const = 0;
+  /// Whether the robot would take the command, and if not, why.
+  virtual CommandCheck check(const Command& command) const = 0;
   /// Carries out checked commands, in order, at the next step boundary.
   virtual void apply(const std::vector<Command>& commands) = 0;
   virtual RobotState state() const = 0;

@@ -33,16 +33,6 @@ std::string formatDegrees(double rad) {
 
 }  // namespace
 
-const char* toString(JointMode mode) {
-  switch (mode) {
-    case JointMode::Velocity: return "velocity";
-    case JointMode::Position: return "position";
-    case JointMode::Torque: return "torque";
-    case JointMode::Free: return "free";
-  }
-  return "?";
-}
-
 const char* toString(Gait gait) {
   switch (gait) {
     case Gait::Off: return "off";

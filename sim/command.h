@@ -7,16 +7,9 @@
 #include <string>
 #include <variant>
 
-namespace sp {
+#include "sim/joint_mode.h"
 
-/// How a joint's actuator drives it.
-enum class JointMode {
-  Velocity,  ///< ODE motor holds a velocity with the actuator's torque limit
-  Position,  ///< PID on the angle gives the motor velocity (see actuator.h)
-  Torque,    ///< a commanded torque (force for sliders) is applied directly
-  Free,      ///< no drive: the joint turns freely (damping still applies)
-};
-const char* toString(JointMode mode);
+namespace sp {
 
 /// Joint velocity [rad/s or m/s]; switches the joint to Velocity mode.
 struct JointVelocityCmd {

@@ -35,14 +35,10 @@ std::optional<std::vector<TimedCommand>> loadCommandSequence(const std::string& 
                                                              Diagnostics& diag,
                                                              const RobotModel* robot = nullptr);
 
-/// Checks commands (parsed with the same robot) against a robot: joints exist and are actuated, the
-/// actuator supports the mode, targets lie within joint limits, wheel and
-/// drive commands need the robot's <drive>. Returns false on any error;
+/// Checks commands (parsed with the same robot) against a robot, each as
+/// checkCommand() does (sim/command_check.h). Returns false on any error;
 /// diagnostics carry `file` and each command's line.
 bool checkCommands(const std::vector<TimedCommand>& commands, const RobotModel& robot,
                    std::string_view file, Diagnostics& diag);
-
-/// Checks one command against a robot; returns an empty string when valid.
-std::string checkCommand(const Command& command, const RobotModel& robot);
 
 }  // namespace sp

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/command.h"
 #include "sim/height_grid.h"
+#include "sim/joint_mode.h"
 #include "sim/math.h"
 
 namespace sp {

@@ -10,7 +10,7 @@
 #include <deque>
 #include <mutex>
 
-#include "sim/command_file.h"
+#include "sim/command_check.h"
 #include "sim/height_grid_ray.h"
 #include "sim/random.h"
 
@@ -624,8 +624,8 @@ bool World::build(Diagnostics& diag) {
 
 std::string World::submit(const Command& command, int robot) {
   if (robot < 0 || robot >= robotCount()) return "no robot " + std::to_string(robot);
-  std::string error = checkCommand(command, robotModel(robot));
-  if (!error.empty()) return error;
+  CommandCheck check = checkCommand(command, robotModel(robot));
+  if (!check.ok()) return std::move(check.message);
   impl_->queue.emplace_back(robot, command);
   return {};
 }

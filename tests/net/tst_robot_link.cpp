@@ -16,10 +16,11 @@ namespace {
 const std::string kToken = "00112233445566778899aabbccddeeff";
 
 // A check standing in for the twin's: knee targets within [-40, 80] deg.
-std::string check(const Command& c) {
+CommandCheck check(const Command& c) {
   if (const auto* t = std::get_if<JointTargetCmd>(&c)) {
-    if (t->joint != "knee_fl") return "unknown joint '" + t->joint + "'";
-    if (t->position < degToRad(-40) || t->position > degToRad(80)) return "target is outside joint 'knee_fl' limits";
+    if (t->joint != "knee_fl") return {CommandCheck::Kind::Invalid, "unknown joint '" + t->joint + "'"};
+    if (t->position < degToRad(-40) || t->position > degToRad(80))
+      return {CommandCheck::Kind::OutOfLimits, "target is outside joint 'knee_fl' limits"};
   }
   return {};
 }

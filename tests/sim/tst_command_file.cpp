@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "tests/test_files.h"
+#include "sim/command_check.h"
 #include "sim/command_file.h"
 #include "sim/math.h"
 #include "sim/robot_model.h"
@@ -20,6 +21,7 @@ Q_DECLARE_METATYPE(sp::Command)
 namespace {
 
 QString q(const std::string& s) { return QString::fromStdString(s); }
+QString q(const CommandCheck& c) { return QString::fromStdString(c.message); }
 
 /// A small articulated robot, built by hand (no XML loader):
 ///   articulation  hinge [-35, 35] deg, PID, 30 deg/s, 5000 N m
@@ -412,6 +414,9 @@ void TestCommandFile::checkCommandsWithoutDrive() {
   QCOMPARE(q(checkCommand(DriveCmd{1, 0}, robot)), QString("robot 'bare' has no <drive>"));
   QCOMPARE(q(checkCommand(WheelsCmd{{0, 0, 0, 0}}, robot)), QString("robot 'bare' has no <drive>"));
   QCOMPARE(q(checkCommand(JointTargetCmd{"knee_fl", 0.5}, robot)), QString());
+  // Not a limit: the robot link answers `invalid`, not `out_of_limits`.
+  QVERIFY(checkCommand(DriveCmd{1, 0}, robot).kind == CommandCheck::Kind::Invalid);
+  QVERIFY(checkCommand(JointTargetCmd{"knee_fl", 0.5}, robot).ok());
 }
 
 // A wheel joint of the <drive> without an actuator cannot take wheel speeds.
@@ -433,6 +438,10 @@ void TestCommandFile::checkCommandTakesSliderValuesInMetres() {
   QCOMPARE(q(checkCommand(JointVelocityCmd{"lift", -0.2}, robot)), QString());
   QCOMPARE(q(checkCommand(JointVelocityCmd{"lift", 0.3}, robot)),
            QString("velocity 0.3 m/s exceeds joint 'lift' max_velocity 0.2 m/s"));
+  // Limits are a kind of their own (the link refuses them as out_of_limits).
+  QVERIFY(checkCommand(JointTargetCmd{"lift", 0.5}, robot).kind == CommandCheck::Kind::OutOfLimits);
+  QVERIFY(checkCommand(JointVelocityCmd{"lift", 0.3}, robot).kind == CommandCheck::Kind::OutOfLimits);
+  QVERIFY(checkCommand(JointTargetCmd{"nope", 0.1}, robot).kind == CommandCheck::Kind::Invalid);
 }
 
 // A parsed file with several bad commands: checkCommands() reports every
