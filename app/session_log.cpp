@@ -120,15 +120,6 @@ bool execSql(sqlite3* db, const std::string& sql, std::string& error) {
 
 }  // namespace
 
-uint64_t fnv1a64(const std::string& data) {
-  uint64_t h = 0xcbf29ce484222325ull;
-  for (unsigned char c : data) {
-    h ^= c;
-    h *= 0x100000001b3ull;
-  }
-  return h;
-}
-
 LogSample makeLogSample(const World& world, int robot) {
   LogSample s;
   s.step = world.stepCount();

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "sim/command.h"
+#include "sim/hash.h"  // fnv1a64: the hash of each logged file's contents
 #include "sim/world.h"
 
 struct sqlite3;
@@ -36,8 +37,6 @@ namespace sp {
 
 inline constexpr int kSessionLogFormatVersion = 1;
 
-/// 64-bit FNV-1a of `data` (the hash of each logged file's contents).
-uint64_t fnv1a64(const std::string& data);
 
 /// A file the session was built from, stored whole in the log's meta table.
 struct SessionFile {

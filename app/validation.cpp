@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "sim/command_file.h"
+#include "sim/hash.h"
 #include "sim/model_loader.h"
 #include "sim/world.h"
 
@@ -550,8 +551,7 @@ std::string validationReport(const std::vector<ExperimentResult>& results, const
   std::ifstream robotFile(o.sourceDir + "/robots/workpartner.xml", std::ios::binary);
   std::ostringstream robotText;
   robotText << robotFile.rdbuf();
-  uint64_t hash = 0xcbf29ce484222325ULL;
-  for (unsigned char c : robotText.str()) hash = (hash ^ c) * 0x100000001b3ULL;
+  const uint64_t hash = fnv1a64(robotText.str());
   char version[24];
   std::snprintf(version, sizeof version, "%016llx", static_cast<unsigned long long>(hash));
   md << "# SimPartner validation report\n\n"

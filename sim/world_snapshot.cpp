@@ -1,0 +1,150 @@
+// Snapshots: the dynamic state as a plain value, restored bit for bit; the
+// state hash that compares runs; the model key a snapshot must fit.
+
+#include "sim/world_impl.h"
+
+#include "sim/hash.h"
+
+namespace sp {
+using namespace world_detail;
+
+void World::canonicalizeQuaternions() {
+  // dBodySetQuaternion normalises what it is given, and normalising a unit
+  // quaternion again can change its last bit (and repeating it may cycle),
+  // so a quaternion read out of ODE does not restore to itself. Instead,
+  // after every step each body's quaternion q is set once more: ODE then
+  // holds N(q), and q is remembered as its preimage. Snapshots store the
+  // preimage; restoring it gives N(q) again, bit for bit.
+  Impl& m = *impl_;
+  for (size_t b = 0; b < m.allBodies.size(); ++b) {
+    std::memcpy(m.preimage[b].data(), dBodyGetQuaternion(m.allBodies[b]), sizeof(dQuaternion));
+    dBodySetQuaternion(m.allBodies[b], m.preimage[b].data());
+  }
+}
+
+Snapshot World::snapshot() const {
+  const Impl& m = *impl_;
+  Snapshot s;
+  s.modelKey = modelKey();
+  s.step = steps_;
+  s.stepSize = params_.step;
+  s.bodies.reserve(m.allBodies.size());
+  for (size_t b = 0; b < m.allBodies.size(); ++b) {
+    s.bodies.push_back(readBody(m.allBodies[b]));
+    s.bodies.back().quaternion = m.preimage[b];  // restores to the exact orientation
+  }
+  for (const Impl::Robot& rt : m.robots) {
+    s.robots.push_back(rt.control);
+    s.sensors.push_back(rt.sensors);
+  }
+  s.odeRandom = m.randState;
+  s.random = m.random.state();
+  s.terrain = m.grid;
+  s.pending = m.queue;
+  return s;
+}
+
+std::string World::restore(const Snapshot& s) {
+  Impl& m = *impl_;
+  if (m.broken)
+    return "the physics engine failed in this world (" + health_.where +
+           "); build a new world and restore into that";
+  if (s.modelKey != modelKey() || s.bodies.size() != m.allBodies.size() || s.robots.size() != m.robots.size() ||
+      s.sensors.size() != m.robots.size())
+    return "the snapshot is of another model (its bodies, joints or sensors differ)";
+  for (size_t i = 0; i < s.bodies.size(); ++i) {
+    const BodyState& b = s.bodies[i];
+    if (!finite(b.position.data(), 3) || !finite(b.quaternion.data(), 4) || !finite(b.linearVelocity.data(), 3) ||
+        !finite(b.angularVelocity.data(), 3))
+      return "the snapshot's state of " + m.bodyNames[i] + " is not finite";
+  }
+  // A coarser or finer step keeps the time; the step count must land on it.
+  const double steps = static_cast<double>(s.step) * s.stepSize / params_.step;
+  const auto newSteps = std::llround(steps);
+  if (std::abs(steps - static_cast<double>(newSteps)) > 1e-6)
+    return "the snapshot's time is not a whole number of this world's steps";
+  const double scale = s.stepSize / params_.step;
+  ensureOdeThread();
+  for (size_t i = 0; i < m.allBodies.size(); ++i) {
+    const BodyState& b = s.bodies[i];
+    dBodySetPosition(m.allBodies[i], b.position[0], b.position[1], b.position[2]);
+    dBodySetQuaternion(m.allBodies[i], b.quaternion.data());
+    m.preimage[i] = b.quaternion;
+    dBodySetLinearVel(m.allBodies[i], b.linearVelocity[0], b.linearVelocity[1], b.linearVelocity[2]);
+    dBodySetAngularVel(m.allBodies[i], b.angularVelocity[0], b.angularVelocity[1], b.angularVelocity[2]);
+    m.previous[i] = readBody(m.allBodies[i]);
+  }
+  for (size_t r = 0; r < m.robots.size(); ++r) {
+    m.robots[r].control = s.robots[r];
+    m.robots[r].sensors = s.sensors[r];
+    if (scale != 1.0)
+      for (SensorState& st : m.robots[r].sensors)
+        st.nextStep = std::llround(static_cast<double>(st.nextStep) * scale);
+  }
+  m.randState = static_cast<unsigned long>(s.odeRandom);
+  m.random.setState(s.random);
+  if (m.heightData && s.terrain && s.terrain != m.grid) {
+    m.grid = std::const_pointer_cast<HeightGrid>(s.terrain);
+    // Shared with the snapshot from now on: the next edit copies it first.
+    dGeomHeightfieldDataSetBounds(m.heightData, m.grid->minHeight(), m.grid->maxHeight());
+    const dReal* pos = dGeomGetPosition(m.terrainGeom);
+    dGeomSetPosition(m.terrainGeom, pos[0], pos[1], pos[2]);
+  }
+  m.queue = s.pending;
+  steps_ = newSteps;
+  health_ = {};
+  return {};
+}
+
+uint64_t World::stateHash() const {
+  const Impl& m = *impl_;
+  Fnv1a64 h;
+  h.value(steps_);
+  for (dBodyID b : m.allBodies) {
+    const BodyState s = readBody(b);
+    h.value(s);
+  }
+  for (const Impl::Robot& rt : m.robots) {
+    for (const ActuatorState& a : rt.control.actuators) {
+      h.value(a.mode);
+      h.value(a.velocity);
+      h.value(a.target);
+      h.value(a.torque);
+      h.value(a.integral);
+    }
+    h.value(rt.control.driveActive);
+    h.value(rt.control.driveSpeed);
+    h.value(rt.control.driveArticulation);
+    h.value(rt.control.driveByYawRate);
+    h.value(rt.control.driveYawRate);
+    h.value(rt.control.gaitActive);
+    h.value(rt.control.gait);
+    for (const SensorState& st : rt.sensors) {
+      h.value(st.nextStep);
+      h.value(st.forceSum);
+      h.value(st.stepsSummed);
+    }
+  }
+  h.value(m.randState);
+  h.value(m.random.state());
+  return h.digest();
+}
+
+uint64_t World::modelKey() const {
+  // The layout a snapshot must fit: names and kinds of bodies, joints,
+  // actuators and sensors (not masses or gains: a snapshot may be restored
+  // into a world with other parameters on purpose, e.g. a coarser step).
+  Fnv1a64 h;
+  for (const std::string& n : impl_->bodyNames) h.bytes(n.data(), n.size());
+  for (const RobotInstance& r : model_.robots) {
+    for (const JointSpec& j : r.model.joints) {
+      h.bytes(j.name.data(), j.name.size());
+      h.value(j.type);
+    }
+    for (const ActuatorSpec& a : r.model.actuators) h.value(a.joint);
+    for (const SensorSpec& sp : r.model.sensors) h.value(sp.type);
+  }
+  return h.digest();
+}
+
+}  // namespace sp
