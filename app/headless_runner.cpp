@@ -11,6 +11,7 @@
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/pacer.h"
+#include "sim/runner.h"
 
 namespace sp {
 namespace {
@@ -139,7 +140,21 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
   Pacer pacer({params->step, params->realTimeFactor, 0.1, 100});
   RunReport report;
   report.requestedFactor = params->realTimeFactor;
-  size_t nextCommand = 0;
+  Runner runner(*world);
+  runner.schedule(commands);
+  runner.setSubmitHook([&](const ScheduledCommand& c, const std::string& why) {
+    if (!why.empty()) err << options.commandsFile << ":" << c.line << ": error: " << why << "\n";
+    else if (log) log->writer().logCommand(world->stepCount(), world->time(), "sequence", c.command, &robot.model);
+  });
+  runner.setMonitor([&](const World& w) {
+    if (csv && w.stepCount() % csvEvery == 0) csv->sample(w);
+    if (log) {
+      log->stepped(w);
+      if (log->newlyFailed())
+        err << "error: " << log->writer().errorMessage() << "; the run goes on without logging\n";
+    }
+    return true;
+  });
   const double wallStart = clock();
   double nextProgress = wallStart + options.progressInterval;
   pacer.start(wallStart);
@@ -151,26 +166,7 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
       break;
     }
     const int64_t due = std::min(pacer.stepsDue(clock()), totalSteps - world->stepCount());
-    for (int64_t i = 0; i < due; ++i) {
-      // A command applies at the first step boundary at or after its time.
-      while (nextCommand < commands.size() && commands[nextCommand].time <= world->time() + 1e-9) {
-        const TimedCommand& c = commands[nextCommand++];
-        const std::string why = world->submit(c.command, 0);
-        if (!why.empty()) err << options.commandsFile << ":" << c.line << ": error: " << why << "\n";
-        else {
-          ++report.commandsApplied;
-          if (log)
-            log->writer().logCommand(world->stepCount(), world->time(), "sequence", c.command, &robot.model);
-        }
-      }
-      if (!world->step()) break;
-      if (csv && world->stepCount() % csvEvery == 0) csv->sample(*world);
-      if (log) {
-        log->stepped(*world);
-        if (log->newlyFailed())
-          err << "error: " << log->writer().errorMessage() << "; the run goes on without logging\n";
-      }
-    }
+    runner.advanceBy(due);
     pacer.stepped(due);
     if (!world->health().healthy()) break;
     const double now = clock();
@@ -192,6 +188,7 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
   report.resyncs = pacer.resyncCount();
   report.slipped = pacer.slippedTime();
   report.steps = world->stepCount();
+  report.commandsApplied = runner.commandsApplied();
   report.stateHash = world->stateHash();
   report.health = world->health();
   if (log) {

@@ -13,6 +13,7 @@
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/params.h"
+#include "sim/runner.h"
 #include "sim/world.h"
 
 namespace sp {
@@ -148,12 +149,9 @@ std::optional<ResimReport> resimulate(const std::string& path, const ResimOption
   }
   const RobotModel& robot = model->robots[0].model;
 
-  // The commands as applied, parsed back against the robot.
-  struct StepCommand {
-    int64_t step;
-    Command command;
-  };
-  std::vector<StepCommand> commands;
+  // The commands as applied, parsed back against the robot, each due at
+  // the step it was logged at.
+  Runner runner(*world);
   for (const LogCommand& c : reader->commands()) {
     std::string why;
     std::optional<Command> command = parseCommand(c.text, why, &robot);
@@ -161,7 +159,7 @@ std::optional<ResimReport> resimulate(const std::string& path, const ResimOption
       error = path + ": logged command at step " + std::to_string(c.step) + " ('" + c.text + "'): " + why;
       return std::nullopt;
     }
-    commands.push_back({c.step, std::move(*command)});
+    if (c.step >= 0) runner.schedule(ScheduledCommand{std::move(*command), 0, c.step});
   }
 
   // The latest snapshot at or before the requested start.
@@ -189,8 +187,6 @@ std::optional<ResimReport> resimulate(const std::string& path, const ResimOption
 
   size_t nextHash = 0;
   while (nextHash < hashes.size() && hashes[nextHash].first < start) ++nextHash;
-  size_t nextCommand = 0;
-  while (nextCommand < commands.size() && commands[nextCommand].step < start) ++nextCommand;
 
   // Compares the hash logged at the current step, if any; true to go on.
   auto compare = [&]() {
@@ -207,19 +203,13 @@ std::optional<ResimReport> resimulate(const std::string& path, const ResimOption
     return true;
   };
 
-  bool going = compare();
-  while (going && world->stepCount() < end) {
-    // A command logged at step s was submitted before the step from s.
-    while (nextCommand < commands.size() && commands[nextCommand].step <= world->stepCount()) {
-      const std::string why = world->submit(commands[nextCommand++].command, 0);
-      if (why.empty()) ++report.commandsApplied;
-    }
-    if (!world->step()) {
-      report.healthMessage = world->health().message();
-      break;
-    }
-    going = compare();
-  }
+  // A command logged at step s was submitted before the step from s; those
+  // before the snapshot are in it (applied, or pending in its queue).
+  runner.skipBefore(start);
+  runner.setMonitor([&](const World&) { return compare(); });
+  if (compare() && runner.advanceTo(end).stop == RunOutcome::Stop::Diverged)
+    report.healthMessage = world->health().message();
+  report.commandsApplied = runner.commandsApplied();
   // A physical divergence before the end is a divergence from the log too.
   if (!report.divergence && !report.healthMessage.empty() && nextHash < hashes.size()) {
     const auto [step, expected] = hashes[nextHash];

@@ -120,32 +120,20 @@ bool execSql(sqlite3* db, const std::string& sql, std::string& error) {
 
 }  // namespace
 
-LogSample makeLogSample(const World& world, int robot) {
+LogSample makeLogSample(const World& world, int robot) { return toLogSample(readRobot(world, robot)); }
+
+LogSample toLogSample(const RobotReadout& r) {
   LogSample s;
-  s.step = world.stepCount();
-  s.time = world.time();
-  Pose base = world.linkPose(robot, 0);
-  s.base = {base.p.x, base.p.y, base.p.z};
-  s.quat = {base.q.w, base.q.x, base.q.y, base.q.z};
-  const RobotModel& model = world.robotModel(robot);
-  const int joints = static_cast<int>(model.joints.size());
-  s.joints.reserve(2 * model.joints.size());
-  for (int j = 0; j < joints; ++j) s.joints.push_back(world.jointPosition(robot, j));
-  for (int j = 0; j < joints; ++j) s.joints.push_back(world.jointRate(robot, j));
-  std::size_t wheel = 0;
-  bool imuSeen = false;
-  for (int i = 0; i < static_cast<int>(model.sensors.size()); ++i) {
-    const SensorValue& value = world.sensorSample(robot, i).value;
-    if (const auto* f = std::get_if<WheelForceReading>(&value);
-        f && model.sensors[static_cast<std::size_t>(i)].type == SensorType::WheelForce && wheel < 4) {
-      s.wheelNormal[wheel++] = f->normal;
-    } else if (const auto* imu = std::get_if<ImuReading>(&value);
-               imu && model.sensors[static_cast<std::size_t>(i)].type == SensorType::Imu && !imuSeen) {
-      imuSeen = true;
-      s.roll = imu->roll;
-      s.pitch = imu->pitch;
-    }
-  }
+  s.step = r.step;
+  s.time = r.time;
+  s.base = {r.base.p.x, r.base.p.y, r.base.p.z};
+  s.quat = {r.base.q.w, r.base.q.x, r.base.q.y, r.base.q.z};
+  s.joints.reserve(r.jointPositions.size() + r.jointRates.size());
+  s.joints.insert(s.joints.end(), r.jointPositions.begin(), r.jointPositions.end());
+  s.joints.insert(s.joints.end(), r.jointRates.begin(), r.jointRates.end());
+  s.wheelNormal = r.wheelNormal;
+  s.roll = r.roll;
+  s.pitch = r.pitch;
   return s;
 }
 

@@ -28,7 +28,8 @@
 #include <vector>
 
 #include "sim/command.h"
-#include "sim/hash.h"  // fnv1a64: the hash of each logged file's contents
+#include "sim/hash.h"
+#include "sim/readout.h"  // fnv1a64: the hash of each logged file's contents
 #include "sim/world.h"
 
 struct sqlite3;
@@ -94,10 +95,10 @@ struct LogEvent {
   friend bool operator==(const LogEvent&, const LogEvent&) = default;
 };
 
-/// The sample of robot `robot` now: its first link's pose, every joint's
-/// position then rate, the latest normal force of its first four wheel_force
-/// sensors and roll/pitch of its first imu (zeros where it has none).
-/// Thread: the World's.
+/// A read-out as logged: the base pose, every joint's position then rate,
+/// the wheel normal forces, roll and pitch (sim/readout.h).
+LogSample toLogSample(const RobotReadout& readout);
+/// toLogSample(readRobot(world, robot)). Thread: the World's.
 LogSample makeLogSample(const World& world, int robot = 0);
 
 /// A laser reading as logged; nullopt if `sample` is not a laser scan.

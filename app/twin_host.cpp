@@ -4,6 +4,8 @@
 
 #include "sim/command_check.h"
 #include "sim/pacer.h"
+#include "sim/readout.h"
+#include "sim/runner.h"
 
 namespace sp {
 
@@ -15,6 +17,7 @@ double monotonic() {
 
 TwinHost::TwinHost(std::unique_ptr<World> world, double realTimeFactor)
     : world_(std::move(world)), model_(world_->robotModel(0)), realTimeFactor_(realTimeFactor) {
+  for (const JointSpec& j : model_.joints) jointNames_.push_back(j.name);
   publish();
 }
 
@@ -73,32 +76,22 @@ std::optional<net::LaserScanState> TwinHost::laserAfter(uint64_t afterCount) con
 void TwinHost::publish() {
   // Built outside the lock; the lock only swaps values in.
   const World& w = *world_;
+  const RobotReadout r = readRobot(w, 0);
   net::RobotState s;
-  s.time = w.time();
-  s.pose = w.linkPose(0, 0);
-  for (size_t j = 0; j < model_.joints.size(); ++j) {
-    s.jointNames.push_back(model_.joints[j].name);
-    s.jointPositions.push_back(w.jointPosition(0, static_cast<int>(j)));
-    s.jointVelocities.push_back(w.jointRate(0, static_cast<int>(j)));
-  }
-  int wheel = 0, laser = -1;
-  for (size_t i = 0; i < model_.sensors.size(); ++i) {
-    const SensorSample& sample = w.sensorSample(0, static_cast<int>(i));
-    if (const auto* f = std::get_if<WheelForceReading>(&sample.value); f && wheel < 4) {
-      s.wheelNormal[static_cast<size_t>(wheel)] = f->normal;
-      s.wheelTangential[static_cast<size_t>(wheel++)] = f->tangential;
-    }
-    if (const auto* imu = std::get_if<ImuReading>(&sample.value)) {
-      s.roll = imu->roll;
-      s.pitch = imu->pitch;
-    }
-    if (model_.sensors[i].type == SensorType::Laser && laser < 0) laser = static_cast<int>(i);
-  }
-  s.health = w.health().healthy() ? std::string() : w.health().message();
-  // Dynamic objects only, in model order: static ones never move.
-  const std::vector<ObjectSpec>& objects = w.model().objects;
-  for (size_t i = 0; i < objects.size(); ++i)
-    if (!objects[i].isStatic) s.objects.push_back({objects[i].name, w.objectPose(static_cast<int>(i))});
+  s.time = r.time;
+  s.pose = r.base;
+  s.jointNames = jointNames_;
+  s.jointPositions = r.jointPositions;
+  s.jointVelocities = r.jointRates;
+  s.wheelNormal = r.wheelNormal;
+  s.wheelTangential = r.wheelTangential;
+  s.roll = r.roll;
+  s.pitch = r.pitch;
+  s.health = r.health;
+  for (const ObjectReadout& o : r.objects) s.objects.push_back({o.name, o.pose});
+  int laser = -1;
+  for (size_t i = 0; i < model_.sensors.size() && laser < 0; ++i)
+    if (model_.sensors[i].type == SensorType::Laser) laser = static_cast<int>(i);
   std::optional<net::LaserScanState> scan;
   if (laser >= 0) {
     const SensorSample& sample = w.sensorSample(0, laser);
@@ -140,13 +133,19 @@ void TwinHost::run() {
   pacer.start(monotonic());
   const int64_t publishEvery = std::max<int64_t>(1, std::llround(0.01 / world_->params().step));  // 100 Hz
   if (log_) log_->start(*world_);
+  // Commands reach the World from takeCommands(), not from a schedule.
+  Runner runner(*world_);
+  runner.setMonitor([&](const World& w) {
+    if (log_) log_->stepped(w);
+    if (w.stepCount() % publishEvery == 0) publish();
+    return true;
+  });
   while (!stop_) {
     const int64_t due = pacer.stepsDue(monotonic());
     // Commands only when a step follows: none is left pending in the last
     // snapshot when the loop stops.
     if (due > 0) takeCommands();
-    for (int64_t i = 0; i < due; ++i)
-      if (!stepOnce(publishEvery)) break;  // a diverged twin says so in state().health
+    runner.advanceBy(due);  // a diverged twin stops there and says so in state().health
     logHealth();
     pacer.stepped(due);
     if (due == 0) {
@@ -169,17 +168,10 @@ void TwinHost::run() {
   }
   if (queued) {
     takeCommands();
-    stepOnce(publishEvery);
+    runner.advanceBy(1);
     logHealth();
     publish();
   }
-}
-
-bool TwinHost::stepOnce(int64_t publishEvery) {
-  if (!world_->step()) return false;
-  if (log_) log_->stepped(*world_);
-  if (world_->stepCount() % publishEvery == 0) publish();
-  return true;
 }
 
 void TwinHost::logHealth() {

@@ -73,14 +73,12 @@ class TwinHost : public net::RobotPort {
   // Logs the queued events, then submits the queued commands and logs those
   // the World took. Physics thread.
   void takeCommands();
-  // One step, logged and published (every `publishEvery` steps); false if
-  // the World has diverged. Physics thread.
-  bool stepOnce(int64_t publishEvery);
   // The "health" event, once, when the World has diverged. Physics thread.
   void logHealth();
 
   std::unique_ptr<World> world_;
   const RobotModel model_;  // a copy: read by the server thread
+  std::vector<std::string> jointNames_;  // model order, sent in every state
   double realTimeFactor_;
   std::unique_ptr<SessionRecorder> log_;  // fed by the physics thread only
   bool healthLogged_ = false;             // physics thread

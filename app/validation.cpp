@@ -13,6 +13,8 @@
 #include "sim/command_file.h"
 #include "sim/hash.h"
 #include "sim/model_loader.h"
+#include "sim/readout.h"
+#include "sim/runner.h"
 #include "sim/world.h"
 
 namespace sp {
@@ -40,11 +42,7 @@ std::unique_ptr<World> makeWorld(const WorldModel& model, const SimParams& param
   return w;
 }
 
-void stepFor(World& w, double seconds) {
-  const auto n = std::llround(seconds / w.params().step);
-  for (int64_t i = 0; i < n && w.step(); ++i) {
-  }
-}
+void stepFor(World& w, double seconds) { Runner(w).advanceBy(std::llround(seconds / w.params().step)); }
 
 void requireHealthy(const World& w, const std::string& experiment) {
   if (!w.health().healthy())
@@ -60,18 +58,7 @@ Vec3 hingePoint(const World& w) {
 }
 
 /// Mean normal forces of the four wheel_force sensors (FL, FR, RL, RR).
-std::array<double, 4> wheelNormals(const World& w) {
-  const RobotModel& robot = w.robotModel(0);
-  std::array<double, 4> out{};
-  int k = 0;
-  for (size_t s = 0; s < robot.sensors.size() && k < 4; ++s)
-    if (robot.sensors[s].type == SensorType::WheelForce) {
-      const SensorSample& sample = w.sensorSample(0, static_cast<int>(s));
-      if (const auto* f = std::get_if<WheelForceReading>(&sample.value)) out[static_cast<size_t>(k)] = f->normal;
-      ++k;
-    }
-  return out;
-}
+std::array<double, 4> wheelNormals(const World& w) { return readRobot(w).wheelNormal; }
 
 /// Least-squares circle through points (Kasa): centre and radius.
 std::pair<Vec3, double> fitCircle(const std::vector<Vec3>& p) {
@@ -222,8 +209,9 @@ ExperimentResult laserSweep(const ValidationOptions& o) {
   const double t0 = w->time(), angle0 = w->jointPosition(0, waist);
   std::vector<double> times, distances, trueError, commandError, angleError;
   int64_t lastStep = -1;
+  Runner runner(*w);
   while (w->time() < t0 + sweep - 1e-9) {
-    w->step();
+    runner.advanceBy(1);
     const SensorSample& s = w->sensorSample(0, laser);
     if (s.step == lastStep) continue;
     lastStep = s.step;
@@ -308,19 +296,19 @@ ExperimentResult pickAndPlace(const ValidationOptions& o) {
                  " kg; wheel forces from the 100 Hz wheel_force sensors";
   auto w = makeWorld(model, o.params);
   const double z0 = w->objectPose(pole).p.z;
-  size_t next = 0;
   std::vector<double> t, fl, fr, rl, rr, poleZ;
   std::vector<std::array<double, 4>> before, holding;
   double firstGrip = -1;
+  Runner runner(*w);
+  runner.schedule(*seq);
+  runner.setSubmitHook([&](const ScheduledCommand& c, const std::string&) {
+    if (firstGrip < 0)
+      if (const auto* target = std::get_if<JointTargetCmd>(&c.command); target && target->joint.rfind("finger", 0) == 0)
+        firstGrip = w->time();
+  });
+  const int64_t sampleSteps = std::llround(0.01 / w->params().step);
   while (w->time() < end - 1e-9 && w->health().healthy()) {
-    while (next < seq->size() && (*seq)[next].time <= w->time() + 1e-9) {
-      const Command& c = (*seq)[next++].command;
-      if (firstGrip < 0)
-        if (const auto* target = std::get_if<JointTargetCmd>(&c); target && target->joint.rfind("finger", 0) == 0)
-          firstGrip = w->time();
-      w->submit(c);
-    }
-    stepFor(*w, 0.01);
+    runner.advanceBy(sampleSteps);
     const std::array<double, 4> f = wheelNormals(*w);
     const Pose pp = w->objectPose(pole);
     t.push_back(w->time());
