@@ -1,12 +1,14 @@
 #pragma once
 // A plot described as plain data (no Qt), for the validation report of
-// `simpartner-sim validate`: the validator fills a PlotSpec, ui/plot_renderer
-// draws it to PNG and toCsv() writes the same numbers for pandas.
+// `simpartner-sim validate`: the validator fills a PlotSpec, app/plot_svg
+// draws it and toCsv() writes the same numbers for pandas.
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <system_error>
@@ -31,6 +33,15 @@ struct PlotSpec {
   /// Axis ranges (min, max). Default: fit the finite data with a margin.
   std::optional<std::pair<double, double>> xRange, yRange;
 };
+
+/// The colour of series `index` as 0xRRGGBB, shared by the report's plots
+/// and the console's live plots: Okabe-Ito without black (it would look like
+/// the axes), safe for colour-blind readers; it repeats after 8 series.
+inline std::uint32_t plotSeriesColor(std::size_t index) {
+  static constexpr std::array<std::uint32_t, 8> kPalette = {0x0072B2, 0xD55E00, 0x009E73, 0xE69F00,
+                                                            0xCC79A7, 0x56B4E9, 0xF0E442, 0x666666};
+  return kPalette[index % kPalette.size()];
+}
 
 /// `text` as a CSV column name: lower case, every run of characters outside
 /// [a-z0-9] becomes one '_', no '_' at either end ("Time [s]" -> "time_s",

@@ -14,9 +14,9 @@
 
 #include "app/headless_runner.h"
 #include "app/log_export.h"
+#include "app/plot_svg.h"
 #include "app/resimulation.h"
 #include "app/validation.h"
-#include "ui/plot_renderer.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/params.h"
@@ -43,7 +43,7 @@ constexpr const char* kUsage = R"(usage:
       (the report names what, where and when).
   simpartner-sim validate [--out DIR] [--quick] [--params FILE] [--set KEY=VALUE]...
       Runs the founding paper's five validation experiments headless and
-      writes DIR/report.md (default DIR: validation), a PNG plot and the CSV
+      writes DIR/report.md (default DIR: validation), an SVG plot and the CSV
       data behind each. --quick runs short versions. Exits 0 when every
       experiment passes its target, 4 when some fail.
   simpartner-sim params
@@ -157,7 +157,7 @@ int validate(const std::vector<std::string>& args, const char* argv0) {
     for (const sp::ExperimentPlot& p : r.plots) {
       std::ofstream(out + "/" + p.file + ".csv") << sp::toCsv(p.spec);
       std::string error;
-      if (!sp::renderPlotPng(p.spec, out + "/" + p.file + ".png", error)) {
+      if (!sp::writePlotSvg(p.spec, out + "/" + p.file + ".svg", error)) {
         std::cerr << "error: " << error << "\n";
         return 1;
       }

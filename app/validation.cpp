@@ -562,7 +562,7 @@ std::string validationReport(const std::vector<ExperimentResult>& results, const
        << num(r.wallSeconds, 1) << " s.\n\n"
        << r.discussion << "\n\n";
     for (const ExperimentPlot& p : r.plots)
-      md << "![" << p.spec.title << "](" << p.file << ".png) (data: [" << p.file << ".csv](" << p.file
+      md << "![" << p.spec.title << "](" << p.file << ".svg) (data: [" << p.file << ".csv](" << p.file
          << ".csv))\n\n";
   }
   return md.str();

@@ -23,7 +23,7 @@
 #include <cmath>
 #include <limits>
 
-#include "ui/plot_renderer.h"  // plotSeriesColor: the report plots' palette
+#include "app/plot.h"  // plotSeriesColor: the report plots' palette
 
 namespace sp {
 

@@ -10,6 +10,7 @@
 
 #include <osg/BlendFunc>
 #include <osg/Fog>
+#include <osg/Depth>
 #include <osg/Geode>
 #include <osg/Geometry>
 #include <osg/Light>
@@ -336,6 +337,10 @@ struct SceneView::Impl {
   osg::ref_ptr<osg::Group> worldNode;  // terrain, grid, axes, objects
   osg::ref_ptr<osg::Group> robotNode;
   std::vector<osg::ref_ptr<osg::MatrixTransform>> links;
+  // A second robot, translucent (the predictive ghost): the same link
+  // geometry, shared, under transforms of its own.
+  osg::ref_ptr<osg::Group> ghostNode;
+  std::vector<osg::ref_ptr<osg::MatrixTransform>> ghostLinks;
   osg::ref_ptr<osg::Geode> laserNode;
   osg::ref_ptr<osg::Geometry> beams, hits;
   osg::ref_ptr<osg::Fog> fog;
@@ -347,6 +352,10 @@ struct SceneView::Impl {
   std::vector<double> joints;
   std::vector<Pose> linkWorld;
   bool robotDirty = false;
+  Pose ghostBase;
+  std::vector<double> ghostJoints;
+  bool ghostDirty = false;
+  bool ghostVisible = false;
 
   // Dynamic objects by name: their transforms and poses as last set.
   struct DynamicObject {
@@ -391,8 +400,26 @@ SceneView::Impl::Impl() {
   root = new osg::Group;
   worldNode = new osg::Group;
   robotNode = new osg::Group;
+  ghostNode = new osg::Group;
   root->addChild(worldNode);
   root->addChild(robotNode);
+  root->addChild(ghostNode);
+  {
+    // The ghost: one translucent tint over every link, drawn after the
+    // opaque scene (transparent bin) without writing depth, so the reported
+    // robot shows through it and it never hides itself.
+    osg::StateSet* g = ghostNode->getOrCreateStateSet();
+    auto* tint = new osg::Material;
+    tint->setColorMode(osg::Material::OFF);
+    tint->setDiffuse(osg::Material::FRONT_AND_BACK, {0.30f, 0.80f, 1.00f, 0.38f});
+    tint->setAmbient(osg::Material::FRONT_AND_BACK, {0.10f, 0.30f, 0.40f, 0.38f});
+    tint->setSpecular(osg::Material::FRONT_AND_BACK, {0, 0, 0, 0.38f});
+    g->setAttributeAndModes(tint, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+    g->setAttributeAndModes(new osg::BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA), osg::StateAttribute::ON);
+    g->setAttributeAndModes(new osg::Depth(osg::Depth::LESS, 0.0, 1.0, false), osg::StateAttribute::ON);
+    g->setRenderingHint(osg::StateSet::TRANSPARENT_BIN);
+    ghostNode->setNodeMask(0);
+  }
   buildLaser();
   root->addChild(laserNode);
 
@@ -509,6 +536,12 @@ void SceneView::Impl::sync() {
     robotDirty = false;
     laserDirty = true;  // the laser rides on the robot
   }
+  if (ghostDirty) {
+    const std::vector<Pose> poses = linkPoses(robot, ghostBase, ghostJoints);
+    for (size_t i = 0; i < ghostLinks.size() && i < poses.size(); ++i) ghostLinks[i]->setMatrix(toMatrix(poses[i]));
+    ghostDirty = false;
+  }
+  ghostNode->setNodeMask(ghostVisible && hasRobot ? ~0u : 0u);
   if (objectsDirty) {
     for (auto& [name, o] : objects) o.transform->setMatrix(toMatrix(o.pose));
     objectsDirty = false;
@@ -569,7 +602,9 @@ void SceneView::setWorld(const WorldModel& world) {
   Impl& m = *m_;
   m.worldNode->removeChildren(0, m.worldNode->getNumChildren());
   m.robotNode->removeChildren(0, m.robotNode->getNumChildren());
+  m.ghostNode->removeChildren(0, m.ghostNode->getNumChildren());
   m.links.clear();
+  m.ghostLinks.clear();
   m.objects.clear();
   m.objectsDirty = false;
 
@@ -608,14 +643,23 @@ void SceneView::setWorld(const WorldModel& world) {
   for (const LinkSpec& link : m.robot.links) {
     osg::ref_ptr<osg::MatrixTransform> xf = new osg::MatrixTransform;
     xf->setDataVariance(osg::Object::DYNAMIC);
-    xf->addChild(geomsNode(link.geoms));
+    osg::ref_ptr<osg::Geode> shape = geomsNode(link.geoms);
+    xf->addChild(shape);
     m.robotNode->addChild(xf);
     m.links.push_back(xf);
+    osg::ref_ptr<osg::MatrixTransform> ghost = new osg::MatrixTransform;
+    ghost->setDataVariance(osg::Object::DYNAMIC);
+    ghost->addChild(shape);
+    m.ghostNode->addChild(ghost);
+    m.ghostLinks.push_back(ghost);
   }
   m.base = m.hasRobot ? world.robots[0].pose * m.robot.links[0].pose : Pose{};
   m.joints.assign(m.robot.joints.size(), 0.0);
   m.linkWorld.clear();
   m.robotDirty = true;
+  m.ghostBase = m.base;
+  m.ghostJoints = m.joints;
+  m.ghostDirty = true;
   m.laserRanges.clear();
   m.laserDirty = true;
   if (!m.hasRobot) m.centre = {};
@@ -625,6 +669,23 @@ void SceneView::setRobotState(const Pose& base, const std::vector<double>& joint
   m_->base = base;
   m_->joints = jointPositions;
   m_->robotDirty = true;
+}
+
+void SceneView::setGhostState(const Pose& base, const std::vector<double>& jointPositions) {
+  m_->ghostBase = base;
+  m_->ghostJoints = jointPositions;
+  m_->ghostDirty = true;
+}
+
+void SceneView::setGhostVisible(bool visible) { m_->ghostVisible = visible; }
+bool SceneView::ghostVisible() const { return m_->ghostVisible; }
+
+Pose SceneView::drawnGhostBasePose() const {
+  if (m_->ghostLinks.empty() || !m_->ghostVisible) return {};
+  const osg::Matrixd m = m_->ghostLinks[0]->getMatrix();
+  const osg::Vec3d t = m.getTrans();
+  const osg::Quat q = m.getRotate();
+  return Pose{{t.x(), t.y(), t.z()}, Quat{q.w(), q.x(), q.y(), q.z()}};
 }
 
 void SceneView::setObjectPoses(const std::vector<NamedPose>& objects) {

@@ -59,6 +59,17 @@ class SceneView : public QOpenGLWidget {
   /// count as zero). Cheap: the link transforms are updated on the next paint.
   void setRobotState(const Pose& base, const std::vector<double>& jointPositions);
 
+  /// A second, translucent robot (the predictive ghost, a replay cursor):
+  /// the same links as the robot, tinted light blue and see-through, placed
+  /// as setRobotState() places the robot. Hidden until setGhostVisible(true);
+  /// setWorld() puts it at the robot's initial pose.
+  void setGhostState(const Pose& base, const std::vector<double>& jointPositions);
+  void setGhostVisible(bool visible);
+  bool ghostVisible() const;
+  /// Where the ghost's base link was drawn in the last frame; the identity
+  /// while it is hidden.
+  Pose drawnGhostBasePose() const;
+
   /// Places dynamic objects of the world by name (world frame). Names that
   /// are no dynamic object of the world are ignored; objects not named keep
   /// their last pose (the world file's until set). Cheap: the transforms are

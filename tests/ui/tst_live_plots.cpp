@@ -29,7 +29,7 @@
 
 #include "headless_default.h"
 #include "ui/live_plots.h"
-#include "ui/plot_renderer.h"
+#include "app/plot.h"
 
 using sp::LaserPlot;
 using sp::LivePlot;

@@ -166,6 +166,39 @@ class TstSceneView : public QObject {
     QVERIFY(countDiffering(before, frame(*view), region) < region.width() * region.height() / 2000);
   }
 
+  // The ghost is a second robot: hidden by default; shown 1 m beside the
+  // robot it adds translucent pixels there (the robot stays visible through
+  // and beside it), follows its own joints, and hiding it restores the image.
+  void ghostDrawsASecondRobot() {
+    auto view = shownView(flat_);
+    QVERIFY(view);
+    view->setFollow(false);
+    const sp::RobotModel& robot = flat_.robots[0].model;
+    const sp::Pose base = flat_.robots[0].pose * robot.links[0].pose;
+    const std::vector<double> joints(robot.joints.size(), 0.0);
+    view->setRobotState(base, joints);
+    QVERIFY(waitFrames(*view, 2));
+    const QImage alone = frame(*view);
+    QVERIFY(!view->ghostVisible());
+    sp::Pose ahead = base;
+    ahead.p.y += 1.2;
+    view->setGhostState(ahead, joints);
+    QVERIFY(waitFrames(*view, 2));
+    QCOMPARE(countDiffering(alone, frame(*view), centre(alone)), 0);  // still hidden
+    view->setGhostVisible(true);
+    QVERIFY(waitFrames(*view, 2));
+    const QImage withGhost = frame(*view);
+    const QRect region = centre(alone);
+    const int changed = countDiffering(alone, withGhost, region);
+    QVERIFY2(changed > region.width() * region.height() / 50, qPrintable(QString::number(changed)));
+    QVERIFY(std::abs(view->drawnGhostBasePose().p.y - ahead.p.y) < 1e-6);
+    QVERIFY(std::abs(view->drawnBasePose().p.y - base.p.y) < 1e-6);
+    QVERIFY(withGhost.save(QStringLiteral(SP_BINARY_DIR "/scene_view_ghost.png")));
+    view->setGhostVisible(false);
+    QVERIFY(waitFrames(*view, 2));
+    QVERIFY(countDiffering(alone, frame(*view), region) < region.width() * region.height() / 2000);
+  }
+
   // Bending joints changes the image too: the links follow linkPoses.
   void jointsMoveLinks() {
     auto view = shownView(flat_);
