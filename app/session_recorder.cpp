@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -30,6 +32,30 @@ std::unique_ptr<SessionLogWriter> openSessionLog(const std::string& path, const 
   if (writer)
     for (const std::string& o : sources.overrides) writer->logEvent(0, 0, "param_override", o);
   return writer;
+}
+
+std::string newSessionLogPath(const std::string& dir, std::string& error) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) {
+    error = dir + ": cannot create the session log folder: " + ec.message();
+    return {};
+  }
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "session-%Y%m%d-%H%M%S", &local);
+  // Two starts within a second get -2, -3, ...; the writer refuses to
+  // replace a file, so a race with another process fails loudly instead.
+  for (int n = 1; n < 1000; ++n) {
+    const fs::path candidate =
+        fs::path(dir) / (std::string(stamp) + (n > 1 ? "-" + std::to_string(n) : "") + ".splog");
+    if (!fs::exists(candidate, ec)) return candidate.string();
+  }
+  error = dir + ": no free session log name for " + stamp;
+  return {};
 }
 
 SessionRecorder::SessionRecorder(std::unique_ptr<SessionLogWriter> writer, const World& world)

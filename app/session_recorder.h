@@ -38,6 +38,12 @@ std::string readWholeFile(const std::string& path);
 std::unique_ptr<SessionLogWriter> openSessionLog(const std::string& path, const SessionSources& sources,
                                                  std::string& error, const SessionLogOptions& options = {});
 
+/// A new log file name in `dir` (created if missing):
+/// `session-YYYYMMDD-HHMMSS.splog` in local time, `-2`, `-3`, ... appended
+/// when taken. "" and `error` set when the folder cannot be made. The stand-in
+/// robot and the console's log of a remote robot name their files so.
+std::string newSessionLogPath(const std::string& dir, std::string& error);
+
 /// Feeds a session log from a physics loop: start() once before the first
 /// step, stepped() after every step. Owns the writer.
 ///

@@ -195,9 +195,13 @@ void writeCommand(Writer& w, const Command& command) {
         } else if constexpr (std::is_same_v<T, StopCmd>) {
         } else if constexpr (std::is_same_v<T, GaitCmd>) {
           w.u8(static_cast<uint8_t>(c.gait));
-        } else {
-          static_assert(std::is_same_v<T, TurnCmd>);
+        } else if constexpr (std::is_same_v<T, TurnCmd>) {
           w.f64(c.speed); w.f64(c.yawRate);
+        } else {
+          static_assert(std::is_same_v<T, TerrainPatchCmd>);
+          w.i32(c.column); w.i32(c.row); w.i32(c.columns); w.i32(c.rows);
+          w.u64(c.heights.size());
+          for (double h : c.heights) w.f64(h);
         }
       },
       command);
@@ -225,6 +229,13 @@ Command readCommand(Reader& r) {
       return GaitCmd{static_cast<Gait>(g)};
     }
     case 8: { TurnCmd c; c.speed = r.f64(); c.yawRate = r.f64(); return c; }
+    case 9: {
+      TerrainPatchCmd c;
+      c.column = r.i32(); c.row = r.i32(); c.columns = r.i32(); c.rows = r.i32();
+      c.heights.resize(r.count(8));
+      for (double& h : c.heights) h = r.f64();
+      return c;
+    }
     default: throw BadData("unknown command type");
   }
 }
@@ -232,7 +243,7 @@ Command readCommand(Reader& r) {
 }  // namespace
 
 std::vector<uint8_t> encodeSnapshot(const Snapshot& s) {
-  static_assert(std::variant_size_v<Command> == 9, "update the snapshot codec");
+  static_assert(std::variant_size_v<Command> == 10, "update the snapshot codec");
   static_assert(std::variant_size_v<SensorValue> == 6, "update the snapshot codec");
   Writer w;
   for (char c : std::string("SPSN")) w.u8(static_cast<uint8_t>(c));

@@ -2,8 +2,6 @@
 
 #include <asio.hpp>
 
-#include <ctime>
-#include <filesystem>
 #include <thread>
 
 #include "app/headless_runner.h"
@@ -66,27 +64,7 @@ StandInRobot::~StandInRobot() { stop(); }
 
 std::string StandInRobot::chooseLogPath(std::string& error) const {
   if (!options_.logPath.empty()) return options_.logPath;
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(options_.logDir, ec);
-  if (ec) {
-    error = options_.logDir + ": cannot create the session log folder: " + ec.message();
-    return {};
-  }
-  const std::time_t now = std::time(nullptr);
-  std::tm local{};
-  localtime_r(&now, &local);
-  char stamp[32];
-  std::strftime(stamp, sizeof stamp, "session-%Y%m%d-%H%M%S", &local);
-  // Two starts within a second get -2, -3, ...; the writer refuses to
-  // replace a file, so a race with another process fails loudly instead.
-  for (int n = 1; n < 1000; ++n) {
-    const fs::path candidate =
-        fs::path(options_.logDir) / (std::string(stamp) + (n > 1 ? "-" + std::to_string(n) : "") + ".splog");
-    if (!fs::exists(candidate, ec)) return candidate.string();
-  }
-  error = options_.logDir + ": no free session log name for " + stamp;
-  return {};
+  return newSessionLogPath(options_.logDir, error);
 }
 
 std::string StandInRobot::start() {

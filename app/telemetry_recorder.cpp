@@ -26,24 +26,15 @@ int64_t TelemetryRecorder::rowKey() const { return std::llround(time_ * 1000); }
 
 void TelemetryRecorder::telemetry(const net::TelemetryMsg& t, const RobotModel& robot) {
   time_ = t.time;
-  if (t.jointNames != names_) {
-    names_ = t.jointNames;
-    index_.clear();
-    for (const std::string& name : names_) index_.push_back(robot.findJoint(name));
-  }
   LogSample s;
   s.step = rowKey();
   s.time = t.time;
   s.base = {t.pose.p.x, t.pose.p.y, t.pose.p.z};
   s.quat = {t.pose.q.w, t.pose.q.x, t.pose.q.y, t.pose.q.z};
-  const size_t n = robot.joints.size();
-  s.joints.assign(2 * n, 0.0);  // positions, then velocities, as the twin logs them
-  for (size_t i = 0; i < index_.size(); ++i) {
-    if (index_[i] < 0) continue;
-    const auto j = static_cast<size_t>(index_[i]);
-    if (i < t.jointPositions.size()) s.joints[j] = t.jointPositions[i];
-    if (i < t.jointVelocities.size()) s.joints[n + j] = t.jointVelocities[i];
-  }
+  // Positions, then velocities, in the model's order, as the twin logs them.
+  s.joints = joints_.toModelOrder(t.jointNames, t.jointPositions, robot);
+  const std::vector<double> rates = joints_.toModelOrder(t.jointNames, t.jointVelocities, robot);
+  s.joints.insert(s.joints.end(), rates.begin(), rates.end());
   s.wheelNormal = t.wheelNormal;
   s.roll = t.roll;
   s.pitch = t.pitch;

@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 
+#include "app/robot_frame.h"
 #include "app/session_log.h"
 #include "net/message.h"
 #include "sim/robot_model.h"
@@ -50,8 +51,7 @@ class TelemetryRecorder {
 
   std::unique_ptr<SessionLogWriter> writer_;
   double time_ = 0;  // robot time of the latest telemetry [s]
-  std::vector<std::string> names_;  // joint names of the last telemetry
-  std::vector<int> index_;          // telemetry joint -> robot joint
+  JointNameMap joints_;  // telemetry joint names -> the robot's order
 };
 
 }  // namespace sp

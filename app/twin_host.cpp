@@ -55,7 +55,13 @@ void TwinHost::logEvent(std::string kind, std::string text) {
   events_.push_back({std::move(kind), std::move(text)});
 }
 
-CommandCheck TwinHost::check(const Command& command) const { return checkCommand(command, model_); }
+CommandCheck TwinHost::check(const Command& command) const {
+  // The robot's side of the link takes robot commands only: a terrain edit
+  // is the simulator's, and a real robot could not carry it out.
+  if (std::holds_alternative<TerrainPatchCmd>(command))
+    return {CommandCheck::Kind::Invalid, "terrain: a simulator edit, not a robot command"};
+  return checkCommand(command, model_);
+}
 
 void TwinHost::apply(const std::vector<Command>& commands) {
   std::lock_guard<std::mutex> lock(mutex_);

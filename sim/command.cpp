@@ -76,6 +76,14 @@ std::string toText(const Command& command, const RobotModel* robot) {
     std::string operator()(const TurnCmd& c) const {
       return "turn " + formatShortest(c.speed) + " " + formatDegrees(c.yawRate);
     }
+    // Heights in their shortest exact form, so the text reads back to the
+    // same bits (a logged edit re-simulates exactly).
+    std::string operator()(const TerrainPatchCmd& c) const {
+      std::string out = "terrain " + std::to_string(c.column) + " " + std::to_string(c.row) + " " +
+                        std::to_string(c.columns) + " " + std::to_string(c.rows);
+      for (double h : c.heights) out += " " + formatShortest(h);
+      return out;
+    }
   };
   return std::visit(Writer{robot}, command);
 }

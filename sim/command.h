@@ -6,6 +6,7 @@
 #include <array>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "sim/joint_mode.h"
 
@@ -74,8 +75,20 @@ struct StopCmd {
   friend bool operator==(const StopCmd&, const StopCmd&) = default;
 };
 
+/// A terrain edit: new heights [m] for a rectangle of the heightfield's
+/// samples, `columns` x `rows` of them from sample (column, row) (grid axes
+/// as in sim/height_grid.h), row by row. Applied at a step boundary like
+/// every command, so it is logged, re-simulated and part of snapshots.
+/// A world command: the robot it is submitted for does not matter.
+struct TerrainPatchCmd {
+  int column = 0, row = 0;
+  int columns = 0, rows = 0;
+  std::vector<double> heights;  ///< rows x columns, index r * columns + c
+  friend bool operator==(const TerrainPatchCmd&, const TerrainPatchCmd&) = default;
+};
+
 using Command = std::variant<JointVelocityCmd, JointTargetCmd, JointTorqueCmd, JointModeCmd,
-                             WheelsCmd, DriveCmd, StopCmd, GaitCmd, TurnCmd>;
+                             WheelsCmd, DriveCmd, StopCmd, GaitCmd, TurnCmd, TerrainPatchCmd>;
 
 /// A command with the sim time [s] at which it applies.
 struct TimedCommand {

@@ -129,6 +129,17 @@ struct Checker {
 
   CommandCheck operator()(const StopCmd&) const { return {}; }
 
+  // Whether the patch fits the terrain is the World's to say (it knows the
+  // grid); here only its own consistency.
+  CommandCheck operator()(const TerrainPatchCmd& c) const {
+    if (c.columns <= 0 || c.rows <= 0 ||
+        c.heights.size() != static_cast<size_t>(c.columns) * static_cast<size_t>(c.rows))
+      return invalid("terrain: the patch's size and its heights disagree");
+    for (double h : c.heights)
+      if (!std::isfinite(h)) return invalid("terrain: a height is not finite");
+    return {};
+  }
+
   CommandCheck operator()(const TurnCmd&) const { return needDrive(); }
 
   CommandCheck operator()(const GaitCmd&) const {

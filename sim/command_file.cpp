@@ -89,6 +89,46 @@ const Syntax kSyntax[] = {
     {"gait", 1, "off|caterpillar|rolking", [](ArgReader& a) -> Command { return GaitCmd{a.gait(0)}; }},
 };
 
+/// `terrain COLUMN ROW COLUMNS ROWS HEIGHT...`: a patch of heights [m],
+/// row by row; the count must be COLUMNS x ROWS.
+std::optional<Command> parseTerrainPatch(const std::vector<std::string_view>& words, std::string& error) {
+  if (words.size() < 6) {
+    error = "terrain: expected column, row, columns, rows and columns x rows heights in m, got " +
+            std::to_string(words.size() - 1) + " arguments";
+    return std::nullopt;
+  }
+  TerrainPatchCmd c;
+  int* fields[4] = {&c.column, &c.row, &c.columns, &c.rows};
+  const char* names[4] = {"column", "row", "columns", "rows"};
+  for (int i = 0; i < 4; ++i) {
+    const std::string_view w = words[static_cast<size_t>(i) + 1];
+    int value = 0;
+    const auto [end, ec] = std::from_chars(w.data(), w.data() + w.size(), value);
+    if (ec != std::errc() || end != w.data() + w.size() || value < 0 || (i >= 2 && value == 0)) {
+      error = std::string("terrain: bad ") + names[i] + " '" + std::string(w) + "' (expected a whole number" +
+              (i >= 2 ? " > 0)" : " >= 0)");
+      return std::nullopt;
+    }
+    *fields[i] = value;
+  }
+  const size_t expected = static_cast<size_t>(c.columns) * static_cast<size_t>(c.rows);
+  if (words.size() - 5 != expected) {
+    error = "terrain: " + std::to_string(c.columns) + " x " + std::to_string(c.rows) + " patch needs " +
+            std::to_string(expected) + " heights, got " + std::to_string(words.size() - 5);
+    return std::nullopt;
+  }
+  c.heights.reserve(expected);
+  for (size_t i = 5; i < words.size(); ++i) {
+    const std::optional<double> h = parseReal(words[i]);
+    if (!h || !std::isfinite(*h)) {
+      error = "terrain: bad height '" + std::string(words[i]) + "'";
+      return std::nullopt;
+    }
+    c.heights.push_back(*h);
+  }
+  return Command{std::move(c)};
+}
+
 }  // namespace
 
 std::optional<Command> parseCommand(std::string_view text, std::string& error, const RobotModel* robot) {
@@ -97,6 +137,7 @@ std::optional<Command> parseCommand(std::string_view text, std::string& error, c
     error = "empty command";
     return std::nullopt;
   }
+  if (words[0] == "terrain") return parseTerrainPatch(words, error);
   for (const Syntax& s : kSyntax) {
     if (words[0] != s.name) continue;
     ArgReader reader{s.name, {words.begin() + 1, words.end()}, {}, robot};

@@ -80,6 +80,12 @@ World::World(const WorldModel& model, const SimParams& params, WorldOptions opti
     : model_(model), params_(params), options_(options), impl_(std::make_unique<Impl>()) {}
 
 std::string World::submit(const Command& command, int robot) {
+  // A terrain edit is the world's, with or without robots.
+  if (const auto* patch = std::get_if<TerrainPatchCmd>(&command)) {
+    if (std::string why = checkTerrainPatch(*patch); !why.empty()) return why;
+    impl_->queue.emplace_back(-1, command);
+    return {};
+  }
   if (robot < 0 || robot >= robotCount()) return "no robot " + std::to_string(robot);
   CommandCheck check = checkCommand(command, robotModel(robot));
   if (!check.ok()) return std::move(check.message);
@@ -200,18 +206,34 @@ double World::terrainHeight(double x, double y) const {
   return m.grid->heightAt(local.x, local.y) + p.p.z;
 }
 
-bool World::setTerrainHeights(const std::vector<double>& heights) {
+std::string World::checkTerrainPatch(const TerrainPatchCmd& c) const {
+  const Impl& m = *impl_;
+  if (c.columns <= 0 || c.rows <= 0 || c.column < 0 || c.row < 0 ||
+      c.heights.size() != static_cast<size_t>(c.columns) * static_cast<size_t>(c.rows))
+    return "terrain: the patch's position, size and heights disagree";
+  for (double h : c.heights)
+    if (!std::isfinite(h)) return "terrain: a height is not finite";
+  if (!m.heightData) return "terrain: the world's terrain is a plane, not a heightfield";
+  const HeightGrid& g = *m.grid;
+  if (c.column + c.columns > g.columns || c.row + c.rows > g.rows)
+    return "terrain: the patch (columns " + std::to_string(c.column) + ".." + std::to_string(c.column + c.columns - 1) +
+           ", rows " + std::to_string(c.row) + ".." + std::to_string(c.row + c.rows - 1) +
+           ") lies outside the " + std::to_string(g.columns) + " x " + std::to_string(g.rows) + " heightfield";
+  return {};
+}
+
+void World::applyTerrainPatch(const TerrainPatchCmd& c) {
   Impl& m = *impl_;
-  if (!m.heightData || heights.size() != m.grid->heights.size()) return false;
   if (m.grid.use_count() > 1) m.grid = std::make_shared<HeightGrid>(*m.grid);  // a snapshot shares it
-  m.grid->heights = heights;
+  for (int r = 0; r < c.rows; ++r)
+    for (int k = 0; k < c.columns; ++k)
+      m.grid->at(c.column + k, c.row + r) = c.heights[static_cast<size_t>(r) * static_cast<size_t>(c.columns) + k];
   dGeomHeightfieldDataSetBounds(m.heightData, m.grid->minHeight(), m.grid->maxHeight());
   // The bounds feed the geom's AABB, which ODE recomputes only for a moved
   // geom: setting the same position marks it dirty.
   const dReal* pos = dGeomGetPosition(m.terrainGeom);
   dGeomSetPosition(m.terrainGeom, pos[0], pos[1], pos[2]);
   m.penetrationCheckFrom = steps_ + std::llround(1.0 / params_.step);
-  return true;
 }
 
 bool odeRandomIsPerThread() {

@@ -197,20 +197,22 @@ class World {
   /// Number of contact points in the last step.
   int contactCount() const { return lastContactCount_; }
 
-  // Terrain. Edits reach the physics at the next collision: ODE reads the
-  // heights through a callback, so no geom is rebuilt.
+  // Terrain. Edits are commands (TerrainPatchCmd, through submit()): they
+  // apply at a step boundary, are logged and re-simulated like any other,
+  // and snapshots carry the heights. They reach the physics at the next
+  // collision: ODE reads the heights through a callback, no geom is rebuilt.
   const HeightGrid* terrainGrid() const;
   /// Terrain height at world (x, y): the plane's or the heightfield's.
   double terrainHeight(double x, double y) const;
-  /// Replaces heights of the heightfield (same size). Returns false if the
-  /// terrain is a plane or the size differs.
-  bool setTerrainHeights(const std::vector<double>& heights);
 
  private:
   struct Impl;
   World(const WorldModel& model, const SimParams& params, WorldOptions options);
   bool build(Diagnostics& diag);
   void applyCommand(const Command& command, int robot);
+  // "" if the patch fits this world's heightfield, else why not.
+  std::string checkTerrainPatch(const TerrainPatchCmd& patch) const;
+  void applyTerrainPatch(const TerrainPatchCmd& patch);
   void runActuators();
   void collide();
   void canonicalizeQuaternions();

@@ -50,6 +50,10 @@ double articulationForTurn(const DriveGeometry& g, double speed, double yawRate,
 }
 
 void World::applyCommand(const Command& command, int robot) {
+  if (const auto* patch = std::get_if<TerrainPatchCmd>(&command)) {
+    applyTerrainPatch(*patch);
+    return;
+  }
   Impl::Robot& rt = impl_->robots[robot];
   const RobotModel& model = robotModel(robot);
   auto actuatorOf = [&](const std::string& joint) { return model.findActuator(joint); };
@@ -115,6 +119,8 @@ void World::applyCommand(const Command& command, int robot) {
           rt.control.driveActive = false;
           rt.control.gaitActive = true;
           rt.control.gait = GaitState{c.gait, 0, steps_};
+        } else if constexpr (std::is_same_v<T, TerrainPatchCmd>) {
+          // Applied above: it belongs to no robot.
         } else if constexpr (std::is_same_v<T, StopCmd>) {
           // Wheels and speed-driven joints brake; joints with a position
           // controller hold where they are now; free joints stay free.

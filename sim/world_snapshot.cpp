@@ -127,6 +127,10 @@ uint64_t World::stateHash() const {
   }
   h.value(m.randState);
   h.value(m.random.state());
+  // Edited terrain is state too. Heights as loaded add nothing, so runs
+  // without edits keep the hashes they always had.
+  if (m.grid && m.grid->heights != model_.terrain.grid.heights)
+    h.bytes(m.grid->heights.data(), m.grid->heights.size() * sizeof(double));
   return h.digest();
 }
 

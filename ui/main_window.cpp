@@ -2,11 +2,9 @@
 
 #include <QApplication>
 #include <QCloseEvent>
-#include <QDateTime>
 #include <QDesktopServices>
 #include <QDir>
 #include <QDockWidget>
-#include <QElapsedTimer>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QInputDialog>
@@ -22,33 +20,43 @@
 #include <QUrl>
 #include <QVBoxLayout>
 
-#include <chrono>
 #include <cmath>
 
-#include "app/stand_in.h"
-#include "app/telemetry_recorder.h"
-#include "sim/model_loader.h"
+#include "app/console_session.h"
 #include "ui/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/live_plots.h"
 #include "ui/robot_connection.h"
+#include "ui/robot_feed.h"
 #include "ui/scene_view.h"
 
 namespace sp {
 
 namespace {
 
-double wallSeconds() {
-  using namespace std::chrono;
-  return duration<double>(steady_clock::now().time_since_epoch()).count();
+QString qs(const std::string& s) { return QString::fromStdString(s); }
+
+QString defaultSessionsDir() {
+  return QStandardPaths::writableLocation(QStandardPaths::GenericDataLocation) + QStringLiteral("/SimPartner/sessions");
 }
 
-QString qs(const std::string& s) { return QString::fromStdString(s); }
+ConsoleSessionOptions toSessionOptions(const ConsoleOptions& o) {
+  ConsoleSessionOptions s;
+  s.world = o.world.toStdString();
+  s.params = o.params.toStdString();
+  for (const QString& v : o.overrides) s.overrides.push_back(v.toStdString());
+  s.connectTo = o.connectTo.toStdString();
+  s.token = o.token.toStdString();
+  s.log = o.log;
+  s.logDir = (o.logDir.isEmpty() ? defaultSessionsDir() : o.logDir).toStdString();
+  s.rtf = o.rtf;
+  return s;
+}
 
 }  // namespace
 
 MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
-    : QMainWindow(parent), options_(std::move(options)) {
+    : QMainWindow(parent), options_(std::move(options)), session_(std::make_unique<ConsoleSession>(toSessionOptions(options_))) {
   setWindowTitle(tr("SimPartner"));
   // Object names let QSettings restore the docks and toolbars by name.
   setObjectName(QStringLiteral("SimPartnerMainWindow"));
@@ -70,23 +78,20 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   layout->addWidget(scene_, 1);
   setCentralWidget(central);
 
+  // The views draw what the feed gives; the link dock also talks to the
+  // connection itself (it is the live link's control panel).
   connection_ = new RobotConnection(this);
-  connect(connection_, &RobotConnection::telemetry, this, &MainWindow::onTelemetry);
-  connect(connection_, &RobotConnection::laser, this, &MainWindow::onLaser);
-  connect(connection_, &RobotConnection::reply, this, &MainWindow::onReply);
-  connect(connection_, &RobotConnection::event, this, &MainWindow::onEvent);
+  feed_ = new LiveLinkFeed(connection_, session_.get(), this);
+  connect(feed_, &RobotFeed::frame, this, &MainWindow::onFrame);
+  connect(feed_, &RobotFeed::laser, this, &MainWindow::onLaser);
+  connect(feed_, &RobotFeed::event, this, [this](const QString& kind, const QString& text) {
+    link_->appendEvent(text);
+    if (kind == QLatin1String("refused") || kind == QLatin1String("error")) statusBar()->showMessage(text, 5000);
+  });
+  connect(feed_, &RobotFeed::stateChanged, this, [this] { updateBanner(); });
+  connect(connection_, &RobotConnection::lease, this, [this](const net::LeaseStateMsg& lease) { link_->showLease(lease); });
   connect(connection_, &RobotConnection::connectionChanged, this,
-          [this](net::ConnectionState s, const QString& d) { onConnection(static_cast<int>(s), d); });
-  connect(connection_, &RobotConnection::lease, this, [this](const net::LeaseStateMsg& lease) {
-    link_->showLease(lease);
-    linkEvent(QStringLiteral("link"), lease.yours ? tr("control: yours")
-                                      : lease.holder.empty() ? tr("control: free")
-                                                             : tr("control: held by %1").arg(qs(lease.holder)));
-  });
-  connect(connection_, &RobotConnection::linkError, this, [this](const QString& reason) {
-    link_->appendEvent(tr("error: %1").arg(reason));
-    statusBar()->showMessage(reason, 5000);
-  });
+          [this](net::ConnectionState s, const QString& d) { link_->showConnection(s, d); });
 
   buildDocks();
   buildMenus();
@@ -140,10 +145,11 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
 MainWindow::~MainWindow() {
   qApp->removeEventFilter(this);
   // The client first (it releases the lease), then the robot it talks to.
+  delete feed_;
+  feed_ = nullptr;
   delete connection_;
   connection_ = nullptr;
-  recorder_.reset();
-  stopStandIn();
+  session_.reset();
 }
 
 void MainWindow::buildDocks() {
@@ -189,7 +195,7 @@ void MainWindow::buildDocks() {
 void MainWindow::buildMenus() {
   QMenu* file = menuBar()->addMenu(tr("&File"));
   file->addAction(tr("Open &world…"), QKeySequence::Open, this, [this] {
-    const QString path = QFileDialog::getOpenFileName(this, tr("Open world"), QFileInfo(worldFile_).path(),
+    const QString path = QFileDialog::getOpenFileName(this, tr("Open world"), QFileInfo(options_.world).path(),
                                                       tr("World files (*.world.xml);;XML files (*.xml)"));
     if (!path.isEmpty()) openWorld(path);
   });
@@ -205,7 +211,7 @@ void MainWindow::buildMenus() {
     if (ok && !text.trimmed().isEmpty()) addNote(text.trimmed());
   });
   file->addAction(tr("Open &log folder"), this, [this] {
-    const QString dir = logPath().isEmpty() ? sessionsDir() : QFileInfo(logPath()).absolutePath();
+    const QString dir = logPath().isEmpty() ? qs(toSessionOptions(options_).logDir) : QFileInfo(logPath()).absolutePath();
     QDir().mkpath(dir);
     if (!QDesktopServices::openUrl(QUrl::fromLocalFile(dir)))
       QMessageBox::information(this, tr("Log folder"), tr("The session logs are in\n%1").arg(dir));
@@ -255,83 +261,37 @@ void MainWindow::buildMenus() {
 }
 
 QString MainWindow::start() {
-  if (options_.connectTo.isEmpty()) {
-    if (QString error = startStandIn(options_.world, {}); !error.isEmpty()) return error;
-  } else {
-    // A remote robot: the world file only tells what to draw.
-    Diagnostics diag;
-    auto world = loadWorld(options_.world.toStdString(), diag);
-    if (!world) return qs(diag.format()).trimmed();
-    if (world->robots.empty()) return tr("%1: error: the world has no <robot>").arg(options_.world);
-    worldFile_ = options_.world;
-    showWorld(*world);
-    const int colon = static_cast<int>(options_.connectTo.lastIndexOf(QLatin1Char(':')));
-    bool ok = false;
-    const uint port = colon > 0 ? options_.connectTo.mid(colon + 1).toUInt(&ok) : 0;
-    if (!ok || port == 0 || port > 65535) return tr("--connect: expected HOST:PORT, got '%1'").arg(options_.connectTo);
-    host_ = options_.connectTo.left(colon);
-    port_ = static_cast<uint16_t>(port);
-    token_ = options_.token;
-    link_->setEndpoint(QStringLiteral("%1:%2").arg(host_).arg(port_));
-    openRemoteLog();
-  }
+  if (const std::string error = session_->start(); !error.empty()) return qs(error);
+  sessionChanged();
+  return {};
+}
+
+void MainWindow::sessionChanged() {
+  const RobotEndpoint& e = session_->endpoint();
+  link_->setEndpoint(qs(e.label));
+  if (session_->worldVersion() != shownWorld_) showWorld(*session_->world());
+  const std::string error = session_->logError();
+  if (!error.empty()) statusBar()->showMessage(tr("session log: %1").arg(qs(error)));
   connectToRobot();
-  return {};
-}
-
-QString MainWindow::startStandIn(const QString& worldFile, const QString& robotFile) {
-  StandInOptions o;
-  o.worldFile = worldFile.toStdString();
-  o.robotFile = robotFile.toStdString();
-  o.paramsFile = options_.params.toStdString();
-  for (const QString& s : options_.overrides) o.overrides.push_back(s.toStdString());
-  o.port = uint16_t{0};  // any free port: several consoles may run on one machine
-  o.token = options_.token.toStdString();
-  if (options_.rtf >= 0) o.realTimeFactor = options_.rtf;
-  o.log = options_.log;
-  o.logDir = (options_.logDir.isEmpty() ? sessionsDir() : options_.logDir).toStdString();
-  Diagnostics diag;
-  std::unique_ptr<StandInRobot> standIn = StandInRobot::create(o, diag);
-  if (!standIn) return qs(diag.format()).trimmed();
-  if (const std::string error = standIn->start(); !error.empty()) return qs(error);
-
-  // Only now that the new robot runs is the old one replaced.
-  connection_->close();
-  stopStandIn();
-  standIn_ = std::move(standIn);
-  worldFile_ = worldFile;
-  robotFile_ = robotFile;
-  host_ = QStringLiteral("127.0.0.1");
-  port_ = standIn_->port();
-  token_ = qs(standIn_->token());
-  showWorld(standIn_->world());
-  link_->setEndpoint(tr("%1:%2 (stand-in, %3)").arg(host_).arg(port_).arg(QFileInfo(worldFile).fileName()));
-  if (standIn_->logFailed()) statusBar()->showMessage(tr("session log: %1").arg(qs(standIn_->logError())));
-  return {};
-}
-
-void MainWindow::stopStandIn() {
-  if (!standIn_) return;
-  standIn_->stop();
-  standIn_.reset();
 }
 
 void MainWindow::connectToRobot() {
-  if (port_ == 0) return;
+  const RobotEndpoint& e = session_->endpoint();
+  if (e.port == 0) return;
   net::RobotClientConfig config;
-  config.host = host_.toStdString();
-  config.port = port_;
-  config.token = token_.toStdString();
+  config.host = e.host;
+  config.port = e.port;
+  config.token = e.token;
   config.name = QStringLiteral("console@%1").arg(QCoreApplication::applicationPid()).toStdString();
   connection_->open(config);
   if (options_.takeControl) connection_->acquireLease();
 }
 
 void MainWindow::showWorld(const WorldModel& world) {
-  world_ = world;
-  scene_->setWorld(*world_);
-  if (!world_->robots.empty()) {
-    const RobotModel& robot = world_->robots[0].model;
+  shownWorld_ = session_->worldVersion();
+  scene_->setWorld(world);
+  if (!world.robots.empty()) {
+    const RobotModel& robot = world.robots[0].model;
     controls_->setRobot(robot);
     for (const SensorSpec& sensor : robot.sensors)
       if (sensor.type == SensorType::Laser) {
@@ -340,58 +300,33 @@ void MainWindow::showWorld(const WorldModel& world) {
         break;
       }
   }
-  jointNames_.clear();
-  jointIndex_.clear();
   wheelPlot_->clear();
-  lastTelemetry_.reset();
-  timing_.clear();
-  QString title = tr("SimPartner — %1").arg(QFileInfo(qs(world_->file)).fileName());
+  feed_->clear();
+  QString title = tr("SimPartner — %1").arg(QFileInfo(qs(world.file)).fileName());
   if (!options_.connectTo.isEmpty()) title += tr(" — robot at %1").arg(options_.connectTo);
   setWindowTitle(title);
 }
 
 QString MainWindow::openWorld(const QString& path, bool quiet) {
-  Diagnostics diag;
-  auto world = loadWorld(path.toStdString(), diag);
-  if (!world || world->robots.empty()) {
-    QString text = qs(diag.format()).trimmed();
-    if (world) text = tr("%1: error: the world has no <robot> to control").arg(path);
-    if (!quiet) showLoadErrors(tr("Cannot open the world"), text);
-    return text;
+  const bool remote = session_->remote();
+  if (const std::string error = session_->openWorld(path.toStdString()); !error.empty()) {
+    if (!quiet) showLoadErrors(remote ? tr("Cannot open the world") : tr("Cannot open the world or start the stand-in on it"), qs(error));
+    return qs(error);
   }
-  if (options_.connectTo.isEmpty()) {
-    if (QString error = startStandIn(path, {}); !error.isEmpty()) {
-      if (!quiet) showLoadErrors(tr("Cannot start the stand-in on this world"), error);
-      return error;
-    }
-    connectToRobot();
-  } else {
-    worldFile_ = path;
-    showWorld(*world);  // the remote robot runs in its own world: this only changes what is drawn
-  }
+  if (remote) showWorld(*session_->world());  // the remote robot runs in its own world: only the drawing changes
+  else sessionChanged();
   statusBar()->showMessage(tr("opened %1").arg(path), 5000);
   return {};
 }
 
 QString MainWindow::openRobot(const QString& path, bool quiet) {
-  Diagnostics diag;
-  auto robot = loadRobot(path.toStdString(), diag);
-  if (!robot) {
-    const QString text = qs(diag.format()).trimmed();
-    if (!quiet) showLoadErrors(tr("Cannot open the robot"), text);
-    return text;
+  const bool remote = session_->remote();
+  if (const std::string error = session_->openRobot(path.toStdString()); !error.empty()) {
+    if (!quiet) showLoadErrors(tr("Cannot open the robot"), qs(error));
+    return qs(error);
   }
-  if (options_.connectTo.isEmpty()) {
-    if (QString error = startStandIn(worldFile_, path); !error.isEmpty()) {
-      if (!quiet) showLoadErrors(tr("Cannot start the stand-in with this robot"), error);
-      return error;
-    }
-    connectToRobot();
-  } else if (world_ && !world_->robots.empty()) {
-    WorldModel world = *world_;
-    world.robots[0].model = *robot;
-    showWorld(world);
-  }
+  if (remote) showWorld(*session_->world());
+  else sessionChanged();
   statusBar()->showMessage(tr("opened %1").arg(path), 5000);
   return {};
 }
@@ -404,8 +339,7 @@ void MainWindow::showLoadErrors(const QString& title, const QString& text) {
 }
 
 void MainWindow::addNote(const QString& text) {
-  if (standIn_) standIn_->addNote(text.toStdString());
-  if (recorder_) recorder_->event("note", text.toStdString());
+  session_->note(text.toStdString());
   link_->appendEvent(tr("note: %1").arg(text));
   statusBar()->showMessage(tr("note logged"), 3000);
 }
@@ -417,13 +351,12 @@ void MainWindow::emergencyStop() {
 }
 
 void MainWindow::sendCommand(const Command& command) {
-  const RobotModel* robot = world_ && !world_->robots.empty() ? &world_->robots[0].model : nullptr;
-  if (!link_->leaseHeld()) {
-    statusBar()->showMessage(tr("Not sent: take control first (Robot ▸ Take control)"), 4000);
+  if (const std::string why = session_->commandRefusal(link_->leaseHeld()); !why.empty()) {
+    statusBar()->showMessage(qs(why), 4000);
     return;
   }
-  connection_->send(command, robot);
-  if (recorder_) recorder_->command(command, robot);
+  connection_->send(command, session_->robot());
+  session_->commandSent(command);
 }
 
 bool MainWindow::eventFilter(QObject* watched, QEvent* event) {
@@ -445,89 +378,48 @@ void MainWindow::closeEvent(QCloseEvent* event) {
   event->accept();
 }
 
-void MainWindow::onTelemetry(const net::TelemetryMsg& t) {
-  ++telemetryCount_;
-  if (!world_ || world_->robots.empty()) return;
-  const RobotModel& robot = world_->robots[0].model;
-  if (t.jointNames != jointNames_) {
-    // Names travel in every frame; they are mapped only when they change.
-    jointNames_ = t.jointNames;
-    jointIndex_.clear();
-    for (const std::string& name : jointNames_) jointIndex_.push_back(robot.findJoint(name));
-  }
-  modelPositions_.assign(robot.joints.size(), 0.0);
-  for (size_t i = 0; i < jointIndex_.size() && i < t.jointPositions.size(); ++i)
-    if (jointIndex_[i] >= 0) modelPositions_[static_cast<size_t>(jointIndex_[i])] = t.jointPositions[i];
-  scene_->setRobotState(t.pose, modelPositions_);
+void MainWindow::onFrame(const RobotFrame& f) {
+  if (!session_->robot()) return;
+  modelPositions_ = f.jointPositions;
+  scene_->setRobotState(f.base, modelPositions_);
   std::vector<NamedPose> objects;
-  for (const net::ObjectPose& o : t.objects) objects.push_back({o.name, o.pose});
+  for (const ObjectReadout& o : f.objects) objects.push_back({o.name, o.pose});
   scene_->setObjectPoses(objects);
   measuredDirty_ = true;  // shown by the panel timer
-  wheelPlot_->addSample(t.time, t.wheelNormal);
-  if (recorder_) recorder_->telemetry(t, robot);
-
-  const double now = wallSeconds();
-  if (!timing_.empty() && t.time < timing_.back().second) timing_.clear();  // a new session restarted time
-  timing_.emplace_back(now, t.time);
-  while (timing_.size() > 2 && now - timing_.front().first > 1.0) timing_.pop_front();
-  const double wall = timing_.back().first - timing_.front().first;
-  rtf_ = wall > 0.2 ? (timing_.back().second - timing_.front().second) / wall : rtf_;
-
-  if (t.failsafe != failsafe_ || t.estop != estop_ || qs(t.health) != healthText_) {
-    failsafe_ = t.failsafe;
-    estop_ = t.estop;
-    healthText_ = qs(t.health);
+  wheelPlot_->addSample(f.time, f.wheelNormal);
+  if (f.failsafe != failsafe_ || f.estop != estop_ || qs(f.health) != healthText_) {
+    failsafe_ = f.failsafe;
+    estop_ = f.estop;
+    healthText_ = qs(f.health);
     link_->showLatches(failsafe_, estop_);
     updateBanner();
   }
-  lastTelemetry_ = t;
 }
 
-void MainWindow::onLaser(const net::LaserMsg& m) {
-  ++laserCount_;
-  scene_->setLaser(m.angleMin, m.angleStep, m.ranges);
-  laserPlot_->setScan(m.angleMin, m.angleStep, m.ranges);
-  if (recorder_) recorder_->laser(m);
-}
-
-void MainWindow::onReply(const net::ReplyMsg& m) {
-  if (m.status == net::ReplyStatus::Ok) return;
-  const QString text = tr("command %1 %2: %3").arg(m.seq).arg(QLatin1String(net::toString(m.status)), qs(m.reason));
-  linkEvent(QStringLiteral("link"), text);
-  statusBar()->showMessage(text, 5000);
-}
-
-void MainWindow::onEvent(const net::EventMsg& m) {
-  linkEvent(QLatin1String(net::toString(m.kind)), tr("robot %1: %2").arg(QLatin1String(net::toString(m.kind)), qs(m.text)));
-}
-
-void MainWindow::onConnection(int state, const QString& detail) {
-  const auto s = static_cast<net::ConnectionState>(state);
-  link_->showConnection(s, detail);
-  linkEvent(QStringLiteral("link"), tr("link %1%2").arg(QLatin1String(net::toString(s)), detail.isEmpty() ? QString() : QStringLiteral(": ") + detail));
-  updateBanner();
+void MainWindow::onLaser(const LaserFrame& scan) {
+  scene_->setLaser(scan.angleMin, scan.angleStep, scan.ranges);
+  laserPlot_->setScan(scan.angleMin, scan.angleStep, scan.ranges);
 }
 
 void MainWindow::refreshStatus() {
   const net::RobotClientStats stats = connection_->stats();
   link_->showStats(stats);
-  if (lastTelemetry_) {
-    simTime_->setText(tr("t = %1 s").arg(lastTelemetry_->time, 0, 'f', 2));
-    rtfLabel_->setText(tr("RTF %1").arg(rtf_, 0, 'f', 2));
+  const std::optional<net::TelemetryMsg>& last = feed_->lastTelemetry();
+  if (last) {
+    simTime_->setText(tr("t = %1 s").arg(last->time, 0, 'f', 2));
+    rtfLabel_->setText(tr("RTF %1").arg(session_->realTimeFactor(), 0, 'f', 2));
   } else {
     simTime_->setText(tr("t = –"));
     rtfLabel_->setText(tr("RTF –"));
   }
   if (!healthText_.isEmpty()) health_->setText(QStringLiteral("<b style='color:#c62828'>%1</b>").arg(tr("diverged")));
-  else if (lastTelemetry_) health_->setText(QStringLiteral("<span style='color:#2e7d32'>%1</span>").arg(tr("healthy")));
+  else if (last) health_->setText(QStringLiteral("<span style='color:#2e7d32'>%1</span>").arg(tr("healthy")));
   else health_->setText(tr("no telemetry"));
   health_->setToolTip(healthText_);
   const QString log = logPath();
   logLabel_->setText(log.isEmpty() ? tr("log: off") : tr("log: %1").arg(QFileInfo(log).fileName()));
   logLabel_->setToolTip(log);
-  QString logError;
-  if (standIn_ && standIn_->logFailed()) logError = qs(standIn_->logError());
-  if (recorder_ && recorder_->writer().failed()) logError = qs(recorder_->writer().errorMessage());
+  const QString logError = qs(session_->logError());
   if (!logError.isEmpty())
     logLabel_->setText(QStringLiteral("<b style='color:#c62828'>%1</b>").arg(tr("log failed: %1").arg(logError.toHtmlEscaped())));
 }
@@ -543,32 +435,16 @@ void MainWindow::updateBanner() {
 
 QString MainWindow::bannerText() const { return banner_->isVisible() ? banner_->text() : QString(); }
 
-QString MainWindow::logPath() const {
-  if (standIn_) return qs(standIn_->logPath());
-  return recorder_ ? qs(recorder_->path()) : QString();
-}
+QString MainWindow::logPath() const { return qs(session_->logPath()); }
 
-void MainWindow::openRemoteLog() {
-  recorder_.reset();
-  if (!options_.log || !world_) return;
-  const QString dir = options_.logDir.isEmpty() ? sessionsDir() : options_.logDir;
-  QDir().mkpath(dir);
-  const QString stamp = QDateTime::currentDateTime().toString(QStringLiteral("yyyyMMdd-HHmmss"));
-  QString path;
-  for (int n = 1; n < 1000 && (path.isEmpty() || QFileInfo::exists(path)); ++n)
-    path = QDir(dir).filePath(QStringLiteral("session-%1%2.splog").arg(stamp, n > 1 ? QStringLiteral("-%1").arg(n) : QString()));
-  std::string error;
-  recorder_ = TelemetryRecorder::open(path.toStdString(), *world_, QStringLiteral("%1:%2").arg(host_).arg(port_).toStdString(), error);
-  if (!recorder_) statusBar()->showMessage(tr("session log: %1").arg(qs(error)));
-}
+const std::optional<net::TelemetryMsg>& MainWindow::lastTelemetry() const { return feed_->lastTelemetry(); }
+int64_t MainWindow::telemetryReceived() const { return feed_->telemetryCount(); }
+int64_t MainWindow::laserReceived() const { return feed_->laserCount(); }
+double MainWindow::realTimeFactor() const { return session_->realTimeFactor(); }
 
 void MainWindow::linkEvent(const QString& kind, const QString& text) {
   link_->appendEvent(text);
-  if (recorder_) recorder_->event(kind.toStdString(), text.toStdString());
-}
-
-QString MainWindow::sessionsDir() const {
-  return QStandardPaths::writableLocation(QStandardPaths::GenericDataLocation) + QStringLiteral("/SimPartner/sessions");
+  session_->event(kind.toStdString(), text.toStdString());
 }
 
 }  // namespace sp

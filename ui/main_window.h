@@ -4,9 +4,10 @@
 // bar with the twin's time, real-time factor and health, and the menus to
 // open robot and world files and the session log folder.
 //
-// By default the window starts the stand-in robot (the twin behind the link
-// protocol) on loopback and connects to it; with a `connectTo` endpoint it
-// connects to any robot that speaks the protocol instead.
+// The session itself (the stand-in robot it runs on loopback or the robot
+// elsewhere it connects to, the world, the log) is a Qt-free ConsoleSession
+// (app/console_session.h); the views draw what a RobotFeed gives them (today
+// the live link, ui/robot_feed.h).
 //
 // Thread: GUI thread only. The stand-in's physics and network threads and
 // the link client's worker thread reach the window only through queued
@@ -16,12 +17,12 @@
 #include <QString>
 #include <QStringList>
 
-#include <deque>
 #include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
 
+#include "app/robot_frame.h"
 #include "net/message.h"
 #include "sim/robot_model.h"
 
@@ -30,13 +31,13 @@ class QDockWidget;
 
 namespace sp {
 
+class ConsoleSession;
 class ControlPanel;
+class LiveLinkFeed;
 class LaserPlot;
 class LinkPanel;
 class RobotConnection;
 class SceneView;
-class StandInRobot;
-class TelemetryRecorder;
 class WheelForcePlot;
 
 /// What the console starts with (the `simpartner` command line).
@@ -70,14 +71,16 @@ class MainWindow : public QMainWindow {
   WheelForcePlot* wheelForcePlot() const { return wheelPlot_; }
   LaserPlot* laserPlot() const { return laserPlot_; }
   RobotConnection* connection() const { return connection_; }
+  /// The console's session (robot, world, log).
+  ConsoleSession* session() const { return session_.get(); }
   /// The latest telemetry received, if any.
-  const std::optional<net::TelemetryMsg>& lastTelemetry() const { return lastTelemetry_; }
-  int64_t telemetryReceived() const { return telemetryCount_; }
-  int64_t laserReceived() const { return laserCount_; }
+  const std::optional<net::TelemetryMsg>& lastTelemetry() const;
+  int64_t telemetryReceived() const;
+  int64_t laserReceived() const;
   /// The session log being written, "" if none.
   QString logPath() const;
   /// The achieved real-time factor over the last second of telemetry.
-  double realTimeFactor() const { return rtf_; }
+  double realTimeFactor() const;
   /// The text of the banner over the 3D view ("" when nothing is latched).
   QString bannerText() const;
 
@@ -101,35 +104,24 @@ class MainWindow : public QMainWindow {
   void buildDocks();
   /// Replaces what is drawn and controlled by `world` (its first robot).
   void showWorld(const WorldModel& world);
-  /// Starts the stand-in on `world` (a file, and optionally another robot
-  /// file) and connects to it. "" or the error.
-  QString startStandIn(const QString& worldFile, const QString& robotFile);
-  void stopStandIn();
+  /// After the session started or switched robots: redraw, reconnect.
+  void sessionChanged();
   void connectToRobot();
-  void onTelemetry(const net::TelemetryMsg& message);
-  void onLaser(const net::LaserMsg& message);
-  void onReply(const net::ReplyMsg& message);
-  void onEvent(const net::EventMsg& message);
-  void onConnection(int state, const QString& detail);
+  void onFrame(const RobotFrame& frame);
+  void onLaser(const LaserFrame& scan);
   void sendCommand(const Command& command);
   void refreshStatus();
   void updateBanner();
-  QString sessionsDir() const;
   void showLoadErrors(const QString& title, const QString& text);
-  /// Starts the console's own log of a remote robot's session.
-  void openRemoteLog();
-  /// A link event, shown in the link dock and logged.
+  /// An event of the console's own (e-stop sent, re-arm sent), shown in the
+  /// link dock and logged.
   void linkEvent(const QString& kind, const QString& text);
 
   ConsoleOptions options_;
-  std::optional<WorldModel> world_;  // what is drawn; its robots[0] is the one controlled
-  QString worldFile_, robotFile_;    // the stand-in's files ("" robot = the world's own)
-  std::unique_ptr<StandInRobot> standIn_;
-  std::unique_ptr<TelemetryRecorder> recorder_;  // the log when connected to a remote robot
+  std::unique_ptr<ConsoleSession> session_;
+  int shownWorld_ = -1;  // the session's worldVersion() the views show
   RobotConnection* connection_ = nullptr;
-  QString host_;
-  uint16_t port_ = 0;
-  QString token_;
+  LiveLinkFeed* feed_ = nullptr;
 
   SceneView* scene_ = nullptr;
   ControlPanel* controls_ = nullptr;
@@ -145,13 +137,7 @@ class MainWindow : public QMainWindow {
   QLabel* health_ = nullptr;
   QLabel* logLabel_ = nullptr;
 
-  std::optional<net::TelemetryMsg> lastTelemetry_;
-  std::vector<std::string> jointNames_;  // of the last telemetry, to map names once
-  std::vector<int> jointIndex_;          // telemetry joint i -> model joint
   std::vector<double> modelPositions_;   // joint positions in model order
-  int64_t telemetryCount_ = 0, laserCount_ = 0;
-  std::deque<std::pair<double, double>> timing_;  // (wall [s], robot time [s]) over the last second
-  double rtf_ = 0;
   bool measuredDirty_ = false;  // modelPositions_ changed since the controls showed them
   int64_t panelTicks_ = 0;
   bool failsafe_ = false, estop_ = false;

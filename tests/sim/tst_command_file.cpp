@@ -176,6 +176,16 @@ void TestCommandFile::parseCommandErrors_data() {
   QTest::newRow("drive first bad number") << "drive y x" << "drive: bad number 'y'";
   QTest::newRow("drive leading plus") << "drive +1 0" << "drive: bad number '+1'";
   QTest::newRow("drive unit suffix") << "drive 1m/s 0" << "drive: bad number '1m/s'";
+  QTest::newRow("terrain too short") << "terrain 0 0 1"
+      << "terrain: expected column, row, columns, rows and columns x rows heights in m, got 3 arguments";
+  QTest::newRow("terrain count") << "terrain 0 0 2 2 0.1 0.2 0.3"
+      << "terrain: 2 x 2 patch needs 4 heights, got 3";
+  QTest::newRow("terrain negative column") << "terrain -1 0 1 1 0.1"
+      << "terrain: bad column '-1' (expected a whole number >= 0)";
+  QTest::newRow("terrain zero rows") << "terrain 0 0 1 0 0.1"
+      << "terrain: bad rows '0' (expected a whole number > 0)";
+  QTest::newRow("terrain bad height") << "terrain 0 0 1 2 0.1 up" << "terrain: bad height 'up'";
+  QTest::newRow("terrain inf height") << "terrain 0 0 1 1 inf" << "terrain: bad height 'inf'";
   QTest::newRow("wheels 3 args") << "wheels 1 2 3"
                                  << "wheels: expected 4 arguments (front-left, front-right, rear-left, "
                                     "rear-right rad/s), got 3";
@@ -213,6 +223,9 @@ void TestCommandFile::toTextWritesFileSyntax_data() {
   QTest::newRow("torque") << Command(JointTorqueCmd{"hip_fl", -300}) << "torque hip_fl -300";
   QTest::newRow("mode") << Command(JointModeCmd{"hip_fl", JointMode::Torque}) << "mode hip_fl torque";
   QTest::newRow("stop") << Command(StopCmd{}) << "stop";
+  // Heights in their shortest exact form: 0.1 + 0.2 reads back bit for bit.
+  QTest::newRow("terrain") << Command(TerrainPatchCmd{3, 4, 2, 1, {0.1 + 0.2, -1.5}})
+                           << "terrain 3 4 2 1 0.30000000000000004 -1.5";
 }
 
 // toText() writes sequence-file syntax in degrees with the fewest digits

@@ -132,9 +132,15 @@ class TestWorld : public QObject {
     QVERIFY(world);
     stepFor(*world, 1.0);
     QVERIFY(std::abs(world->objectPose(0).p.z - 0.2) < 0.002);
-    QVERIFY(!world->setTerrainHeights(std::vector<double>(4, 0.0)));  // wrong size
-    QVERIFY(world->setTerrainHeights(std::vector<double>(9, 0.08)));
+    // A patch that does not fit is refused whole, with the reason.
+    QCOMPARE(QString::fromStdString(world->submit(TerrainPatchCmd{2, 0, 2, 1, {0.08, 0.08}})),
+             QString("terrain: the patch (columns 2..3, rows 0..0) lies outside the 3 x 3 heightfield"));
+    const uint64_t before = world->stateHash();
+    QVERIFY(world->submit(TerrainPatchCmd{0, 0, 3, 3, std::vector<double>(9, 0.08)}).empty());
+    QCOMPARE(world->terrainHeight(0.3, -0.2), 0.0);  // applied at the next step boundary
+    world->step();
     QCOMPARE(world->terrainHeight(0.3, -0.2), 0.08);
+    QVERIFY(world->stateHash() != before);
     stepFor(*world, 1.0);
     QVERIFY2(std::abs(world->objectPose(0).p.z - 0.28) < 0.002,
              qPrintable(QString::number(world->objectPose(0).p.z, 'f', 5)));

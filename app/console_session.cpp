@@ -1,0 +1,176 @@
+#include "app/console_session.h"
+
+#include <filesystem>
+
+#include "app/session_recorder.h"
+#include "app/stand_in.h"
+#include "app/telemetry_recorder.h"
+#include "sim/model_loader.h"
+
+namespace sp {
+namespace {
+
+/// The diagnostics as one text without the final newline (for a dialog).
+std::string text(const Diagnostics& diag) {
+  const std::string all = diag.format();
+  return all.substr(0, all.find_last_not_of('\n') + 1);
+}
+
+}  // namespace
+
+ConsoleSession::ConsoleSession(ConsoleSessionOptions options) : options_(std::move(options)) {}
+
+ConsoleSession::~ConsoleSession() {
+  recorder_.reset();
+  if (standIn_) standIn_->stop();
+}
+
+const RobotModel* ConsoleSession::robot() const {
+  return world_ && !world_->robots.empty() ? &world_->robots[0].model : nullptr;
+}
+
+void ConsoleSession::setWorld(WorldModel world) {
+  world_ = std::move(world);
+  ++worldVersion_;
+  positions_.reset();
+  rates_.reset();
+  rate_.reset();
+}
+
+std::string ConsoleSession::start() {
+  if (!remote()) return startStandIn(options_.world, {});
+  // A remote robot: the world file only tells what to draw.
+  Diagnostics diag;
+  std::optional<WorldModel> world = loadWorld(options_.world, diag);
+  if (!world) return text(diag);
+  if (world->robots.empty()) return options_.world + ": error: the world has no <robot>";
+  const size_t colon = options_.connectTo.rfind(':');
+  uint32_t port = 0;
+  bool ok = colon != std::string::npos && colon > 0 && colon + 1 < options_.connectTo.size();
+  for (size_t i = colon + 1; ok && i < options_.connectTo.size(); ++i) {
+    const char c = options_.connectTo[i];
+    ok = c >= '0' && c <= '9' && port <= 65535;
+    port = port * 10 + static_cast<uint32_t>(c - '0');
+  }
+  if (!ok || port == 0 || port > 65535) return "--connect: expected HOST:PORT, got '" + options_.connectTo + "'";
+  endpoint_ = {options_.connectTo.substr(0, colon), static_cast<uint16_t>(port), options_.token, options_.connectTo};
+  worldFile_ = options_.world;
+  setWorld(std::move(*world));
+  openRemoteLog();
+  return {};
+}
+
+std::string ConsoleSession::startStandIn(const std::string& worldFile, const std::string& robotFile) {
+  StandInOptions o;
+  o.worldFile = worldFile;
+  o.robotFile = robotFile;
+  o.paramsFile = options_.params;
+  o.overrides = options_.overrides;
+  o.port = uint16_t{0};  // any free port: several consoles may run on one machine
+  o.token = options_.token;
+  if (options_.rtf >= 0) o.realTimeFactor = options_.rtf;
+  o.log = options_.log;
+  o.logDir = options_.logDir;
+  Diagnostics diag;
+  std::unique_ptr<StandInRobot> standIn = StandInRobot::create(o, diag);
+  if (!standIn) return text(diag);
+  if (std::string error = standIn->start(); !error.empty()) return error;
+  // Only now that the new robot runs is the old one replaced.
+  if (standIn_) standIn_->stop();
+  standIn_ = std::move(standIn);
+  worldFile_ = worldFile;
+  endpoint_ = {"127.0.0.1", standIn_->port(), standIn_->token(),
+               "127.0.0.1:" + std::to_string(standIn_->port()) + " (stand-in, " +
+                   std::filesystem::path(worldFile).filename().string() + ")"};
+  setWorld(standIn_->world());
+  return {};
+}
+
+std::string ConsoleSession::openWorld(const std::string& path) {
+  Diagnostics diag;
+  std::optional<WorldModel> world = loadWorld(path, diag);
+  if (!world) return text(diag);
+  if (world->robots.empty()) return path + ": error: the world has no <robot> to control";
+  if (!remote()) return startStandIn(path, {});
+  worldFile_ = path;
+  setWorld(std::move(*world));  // the remote robot runs in its own world: only the drawing changes
+  return {};
+}
+
+std::string ConsoleSession::openRobot(const std::string& path) {
+  Diagnostics diag;
+  std::optional<RobotModel> robot = loadRobot(path, diag);
+  if (!robot) return text(diag);
+  if (!remote()) return startStandIn(worldFile_, path);
+  if (world_ && !world_->robots.empty()) {
+    WorldModel world = *world_;
+    world.robots[0].model = std::move(*robot);
+    setWorld(std::move(world));
+  }
+  return {};
+}
+
+void ConsoleSession::openRemoteLog() {
+  recorder_.reset();
+  recorderError_.clear();
+  if (!options_.log || !world_) return;
+  const std::string path = newSessionLogPath(options_.logDir, recorderError_);
+  if (path.empty()) return;
+  recorder_ = TelemetryRecorder::open(path, *world_, endpoint_.label, recorderError_);
+}
+
+std::string ConsoleSession::logPath() const {
+  if (standIn_) return standIn_->logPath();
+  return recorder_ ? recorder_->path() : std::string();
+}
+
+std::string ConsoleSession::logError() const {
+  if (standIn_) return standIn_->logError();
+  if (recorder_ && recorder_->writer().failed()) return recorder_->writer().errorMessage();
+  return recorderError_;
+}
+
+RobotFrame ConsoleSession::telemetry(const net::TelemetryMsg& t, double wall) {
+  RobotFrame f;
+  f.time = t.time;
+  f.base = t.pose;
+  f.wheelNormal = t.wheelNormal;
+  f.roll = t.roll;
+  f.pitch = t.pitch;
+  f.health = t.health;
+  f.failsafe = t.failsafe;
+  f.estop = t.estop;
+  for (const net::ObjectPose& o : t.objects) f.objects.push_back({o.name, o.pose});
+  if (const RobotModel* model = robot()) {
+    f.jointPositions = positions_.toModelOrder(t.jointNames, t.jointPositions, *model);
+    f.jointRates = rates_.toModelOrder(t.jointNames, t.jointVelocities, *model);
+    if (recorder_) recorder_->telemetry(t, *model);
+  }
+  rate_.add(wall, t.time);
+  return f;
+}
+
+LaserFrame ConsoleSession::laser(const net::LaserMsg& m) {
+  if (recorder_) recorder_->laser(m);
+  return {m.time, m.angleMin, m.angleStep, m.ranges};
+}
+
+std::string ConsoleSession::commandRefusal(bool leaseHeld) const {
+  if (!leaseHeld) return "Not sent: take control first (Robot ▸ Take control)";
+  return {};
+}
+
+void ConsoleSession::commandSent(const Command& command) {
+  if (recorder_) recorder_->command(command, robot());
+}
+
+void ConsoleSession::note(const std::string& text) {
+  if (standIn_) standIn_->addNote(text);
+  if (recorder_) recorder_->event("note", text);
+}
+
+void ConsoleSession::event(const std::string& kind, const std::string& text) {
+  if (recorder_) recorder_->event(kind, text);
+}
+
+}  // namespace sp

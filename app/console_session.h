@@ -1,0 +1,126 @@
+#pragma once
+// The operator console's session, without any GUI: which robot it talks to
+// (the stand-in it runs on loopback, or a robot elsewhere), the world it
+// draws, the session log, and what arrives over the link turned into the
+// frames the views draw. ui/MainWindow is its face; tests drive it directly.
+//
+//   sp::ConsoleSession session(options);
+//   if (std::string error = session.start(); !error.empty()) show(error);
+//   connect a RobotClient to session.endpoint() ...
+//   on telemetry:  sp::RobotFrame f = session.telemetry(message, wallSeconds);
+//   before a command: if (auto why = session.commandRefusal(leaseHeld); !why.empty()) tell(why);
+//
+// Thread: the owner's (the console's GUI thread) only. The stand-in it runs
+// has threads of its own (app/stand_in.h); nothing here blocks on them or
+// on the disk.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/robot_frame.h"
+#include "net/message.h"
+#include "sim/robot_model.h"
+
+namespace sp {
+
+class StandInRobot;
+class TelemetryRecorder;
+
+/// What the console starts with (the `simpartner` command line).
+struct ConsoleSessionOptions {
+  std::string world = "terrains/flat.world.xml";  ///< drawn; run by the stand-in
+  std::string params;                  ///< parameters file; "" = built-in defaults
+  std::vector<std::string> overrides;  ///< KEY=VALUE
+  std::string connectTo;               ///< HOST:PORT of a robot; "" = run the stand-in on loopback
+  std::string token;                   ///< the robot's shared secret (generated for the stand-in if "")
+  bool log = true;                     ///< log the session
+  std::string logDir = "sessions";     ///< where new logs go
+  double rtf = -1;                     ///< stand-in real-time factor; < 0 = the parameters'
+};
+
+/// Where the console's link goes.
+struct RobotEndpoint {
+  std::string host;
+  uint16_t port = 0;  ///< 0 = nowhere yet
+  std::string token;
+  std::string label;  ///< for the operator, e.g. "127.0.0.1:41234 (stand-in, flat.world.xml)"
+};
+
+class ConsoleSession {
+ public:
+  explicit ConsoleSession(ConsoleSessionOptions options);
+  /// Stops the stand-in (its log is complete when this returns).
+  ~ConsoleSession();
+  ConsoleSession(const ConsoleSession&) = delete;
+  ConsoleSession& operator=(const ConsoleSession&) = delete;
+
+  /// Loads the world and starts the stand-in on it, or, with connectTo,
+  /// checks the endpoint and opens the console's own log of the remote
+  /// robot. "" on success, else what went wrong (`file:line: error: ...`
+  /// where there is a line).
+  std::string start();
+
+  /// Loads `path` as the world. With the stand-in: starts a new one on it
+  /// and replaces the running one only once it runs. With a remote robot:
+  /// only what is drawn changes. On error returns it and nothing changes.
+  std::string openWorld(const std::string& path);
+  /// Loads `path` as the robot, in place of the world's own (same place).
+  std::string openRobot(const std::string& path);
+
+  bool remote() const { return !options_.connectTo.empty(); }
+  /// The world drawn (its robots[0] is the one controlled); null before start().
+  const WorldModel* world() const { return world_ ? &*world_ : nullptr; }
+  /// robots[0]'s model, or null.
+  const RobotModel* robot() const;
+  /// Counts world changes: views rebuild when it moves on.
+  int worldVersion() const { return worldVersion_; }
+  const RobotEndpoint& endpoint() const { return endpoint_; }
+  /// The stand-in running, or null (remote, or before start()).
+  const StandInRobot* standIn() const { return standIn_.get(); }
+
+  /// The session log's path, "" without one.
+  std::string logPath() const;
+  /// Why the log failed, "" while it works.
+  std::string logError() const;
+
+  /// A telemetry frame arrived at wall time `wall` [s]: the frame to draw
+  /// (joints in the model's order), logged when the robot is remote.
+  RobotFrame telemetry(const net::TelemetryMsg& message, double wall);
+  /// A laser scan arrived: the frame to draw, logged when remote.
+  LaserFrame laser(const net::LaserMsg& message);
+  /// The achieved real-time factor over the last second of telemetry.
+  double realTimeFactor() const { return rate_.factor(); }
+
+  /// "" when a command may go to the robot now, else why not (for the
+  /// operator): only the lease holder commands.
+  std::string commandRefusal(bool leaseHeld) const;
+  /// A command went out: logged when the robot is remote (the stand-in logs
+  /// what it applies itself).
+  void commandSent(const Command& command);
+  /// An operator note into the session log.
+  void note(const std::string& text);
+  /// A link event the console saw ("link", "estop", ...): logged when remote
+  /// (the stand-in logs its own link events).
+  void event(const std::string& kind, const std::string& text);
+
+ private:
+  std::string startStandIn(const std::string& worldFile, const std::string& robotFile);
+  void setWorld(WorldModel world);
+  void openRemoteLog();
+
+  ConsoleSessionOptions options_;
+  std::optional<WorldModel> world_;
+  int worldVersion_ = 0;
+  std::string worldFile_;  // the stand-in's world file
+  std::unique_ptr<StandInRobot> standIn_;
+  std::unique_ptr<TelemetryRecorder> recorder_;  // the log of a remote robot
+  std::string recorderError_;
+  RobotEndpoint endpoint_;
+  JointNameMap positions_, rates_;
+  RateMeter rate_;
+};
+
+}  // namespace sp

@@ -1,0 +1,209 @@
+// Tests of sp::ConsoleSession (app/console_session.h): the console's session
+// without its window. A real stand-in robot on loopback, real session logs.
+
+#include <QtTest>
+
+#include <QTemporaryDir>
+
+#include <memory>
+
+#include "app/console_session.h"
+#include "app/session_log.h"
+#include "app/stand_in.h"
+#include "sim/command_file.h"
+
+using namespace sp;
+
+namespace {
+
+// A bad world file: the loader's error must come back with its line.
+const char* kBrokenWorld = R"(<?xml version="1.0"?>
+<world name="broken">
+  <terrain type="plane" height="oops"/>
+</world>
+)";
+
+net::TelemetryMsg telemetryAt(double time, std::vector<std::string> names, std::vector<double> positions) {
+  net::TelemetryMsg t;
+  t.time = time;
+  t.pose = Pose{{1, 2, 0.8}, {}};
+  t.jointNames = std::move(names);
+  t.jointPositions = positions;
+  t.jointVelocities.assign(t.jointPositions.size(), 0.5);
+  t.wheelNormal = {500, 510, 450, 460};
+  return t;
+}
+
+}  // namespace
+
+class TestConsoleSession : public QObject {
+  Q_OBJECT
+
+ private:
+  QTemporaryDir dir_;
+
+  ConsoleSessionOptions options(const std::string& sub) const {
+    ConsoleSessionOptions o;
+    o.logDir = dir_.filePath(QString::fromStdString(sub)).toStdString();
+    o.rtf = 1;
+    return o;
+  }
+  std::string write(const std::string& name, const char* text) const {
+    const std::string path = dir_.filePath(QString::fromStdString(name)).toStdString();
+    QFile f(QString::fromStdString(path));
+    if (f.open(QIODevice::WriteOnly)) f.write(text);
+    return path;
+  }
+
+ private slots:
+  // Started without --connect, the session runs the stand-in on loopback
+  // (a free port, a generated 128-bit token) and logs into the log folder.
+  void standInStarts() {
+    ConsoleSession session(options("standin"));
+    QCOMPARE(QString::fromStdString(session.start()), QString());
+    QVERIFY(!session.remote());
+    QVERIFY(session.standIn());
+    QCOMPARE(QString::fromStdString(session.endpoint().host), QString("127.0.0.1"));
+    QVERIFY(session.endpoint().port > 0);
+    QCOMPARE(session.endpoint().port, session.standIn()->port());
+    QCOMPARE(session.endpoint().token.size(), size_t{32});
+    QVERIFY(QString::fromStdString(session.endpoint().label).contains("stand-in, flat.world.xml"));
+    QVERIFY(session.robot());
+    QCOMPARE(QString::fromStdString(session.robot()->name), QString("workpartner"));
+    QVERIFY(QString::fromStdString(session.logPath()).startsWith(dir_.filePath("standin")));
+    QVERIFY(QFile::exists(QString::fromStdString(session.logPath())));
+    QCOMPARE(QString::fromStdString(session.logError()), QString());
+  }
+
+  // A broken world or robot file is refused with file:line and leaves the
+  // running session as it was; a good one replaces the stand-in.
+  void openWorldKeepsSessionOnError() {
+    ConsoleSession session(options("open"));
+    QCOMPARE(QString::fromStdString(session.start()), QString());
+    const RobotEndpoint before = session.endpoint();
+    const std::string log = session.logPath();
+    const int version = session.worldVersion();
+    const std::string bad = write("broken.world.xml", kBrokenWorld);
+    const QString error = QString::fromStdString(session.openWorld(bad));
+    QVERIFY2(error.startsWith(QString::fromStdString(bad) + ":3: error:"), qPrintable(error));
+    QCOMPARE(session.endpoint().port, before.port);
+    QCOMPARE(session.logPath(), log);
+    QCOMPARE(session.worldVersion(), version);
+    const QString robotError = QString::fromStdString(session.openRobot(bad));
+    QVERIFY2(robotError.contains(QString::fromStdString(bad)) && robotError.contains("error:"), qPrintable(robotError));
+    QCOMPARE(session.endpoint().port, before.port);
+
+    QCOMPARE(QString::fromStdString(session.openWorld("terrains/bumpy.world.xml")), QString());
+    QCOMPARE(session.worldVersion(), version + 1);
+    QVERIFY(session.endpoint().port != before.port || session.endpoint().token != before.token);
+    QVERIFY(session.logPath() != log);
+    QCOMPARE(QString::fromStdString(session.world()->file), QString("terrains/bumpy.world.xml"));
+  }
+
+  // --connect checks its endpoint before anything is opened.
+  void badEndpointsRefused_data() {
+    QTest::addColumn<QString>("endpoint");
+    QTest::newRow("no port") << "robot.local";
+    QTest::newRow("empty port") << "robot.local:";
+    QTest::newRow("port 0") << "robot.local:0";
+    QTest::newRow("port too big") << "robot.local:70000";
+    QTest::newRow("not a number") << "robot.local:47x0";
+    QTest::newRow("no host") << ":47800";
+  }
+  void badEndpointsRefused() {
+    QFETCH(QString, endpoint);
+    ConsoleSessionOptions o = options("bad");
+    o.connectTo = endpoint.toStdString();
+    ConsoleSession session(o);
+    QCOMPARE(QString::fromStdString(session.start()), "--connect: expected HOST:PORT, got '" + endpoint + "'");
+    QCOMPARE(session.endpoint().port, uint16_t{0});
+  }
+
+  // Telemetry becomes a frame in the model's joint order, whatever order
+  // the robot names its joints in; unknown names are ignored, joints not
+  // reported read 0; latches and wheel forces pass through.
+  void telemetryToModelOrder() {
+    ConsoleSessionOptions o = options("remote");
+    o.connectTo = "127.0.0.1:9";
+    o.log = false;
+    ConsoleSession session(o);
+    QCOMPARE(QString::fromStdString(session.start()), QString());
+    const RobotModel& robot = *session.robot();
+    const int knee = robot.findJoint("knee_fl"), waist = robot.findJoint("waist_yaw");
+    QVERIFY(knee >= 0 && waist >= 0);
+    net::TelemetryMsg t = telemetryAt(1.0, {"waist_yaw", "no_such_joint", "knee_fl"}, {0.3, 9.0, -0.2});
+    t.estop = true;
+    const RobotFrame f = session.telemetry(t, 100.0);
+    QCOMPARE(f.jointPositions.size(), robot.joints.size());
+    QCOMPARE(f.jointPositions[static_cast<size_t>(waist)], 0.3);
+    QCOMPARE(f.jointPositions[static_cast<size_t>(knee)], -0.2);
+    QCOMPARE(f.jointRates[static_cast<size_t>(knee)], 0.5);
+    double others = 0;
+    for (size_t j = 0; j < f.jointPositions.size(); ++j)
+      if (static_cast<int>(j) != knee && static_cast<int>(j) != waist) others += std::abs(f.jointPositions[j]);
+    QCOMPARE(others, 0.0);
+    QVERIFY(f.estop && !f.failsafe);
+    QCOMPARE(f.wheelNormal[2], 450.0);
+    QCOMPARE(f.base.p.y, 2.0);
+  }
+
+  // The real-time factor is robot time over wall time across the last
+  // second; a robot time that goes back (a new session) starts it over.
+  void realTimeFactor() {
+    ConsoleSessionOptions o = options("rtf");
+    o.connectTo = "127.0.0.1:9";
+    o.log = false;
+    ConsoleSession session(o);
+    QCOMPARE(QString::fromStdString(session.start()), QString());
+    QCOMPARE(session.realTimeFactor(), 0.0);
+    for (int i = 0; i <= 100; ++i) session.telemetry(telemetryAt(2.0 * 0.02 * i, {}, {}), 50.0 + 0.02 * i);
+    QVERIFY2(std::abs(session.realTimeFactor() - 2.0) < 1e-9, qPrintable(QString::number(session.realTimeFactor())));
+    for (int i = 0; i <= 100; ++i) session.telemetry(telemetryAt(0.5 * 0.02 * i, {}, {}), 60.0 + 0.02 * i);
+    QVERIFY2(std::abs(session.realTimeFactor() - 0.5) < 1e-9, qPrintable(QString::number(session.realTimeFactor())));
+  }
+
+  // Only the lease holder commands.
+  void commandsNeedTheLease() {
+    ConsoleSession session(options("lease"));
+    QCOMPARE(QString::fromStdString(session.commandRefusal(false)),
+             QString("Not sent: take control first (Robot ▸ Take control)"));
+    QCOMPARE(QString::fromStdString(session.commandRefusal(true)), QString());
+  }
+
+  // With a remote robot the console logs what it saw and did: telemetry
+  // samples, laser, the operator's commands, notes and link events.
+  void remoteSessionLogged() {
+    ConsoleSessionOptions o = options("remote-log");
+    o.connectTo = "127.0.0.1:9";
+    std::string path;
+    {
+      ConsoleSession session(o);
+      QCOMPARE(QString::fromStdString(session.start()), QString());
+      path = session.logPath();
+      QVERIFY(!path.empty());
+      for (int i = 0; i < 5; ++i) session.telemetry(telemetryAt(0.1 * i, {"knee_fl"}, {0.1 * i}), 10.0 + 0.1 * i);
+      session.laser(net::LaserMsg{1, 0.4, -1.0, 0.5, {1.0, 2.0, 3.0, 4.0, 5.0}});
+      session.commandSent(DriveCmd{0.5, degToRad(10)});
+      session.note("checked the left arm");
+      session.event("link", "link connected");
+    }
+    std::string error;
+    auto reader = SessionLogReader::open(path, error);
+    QVERIFY2(reader, error.c_str());
+    QCOMPARE(QString::fromStdString(reader->meta().at("log_source")), QString("telemetry"));
+    QCOMPARE(QString::fromStdString(reader->meta().at("robot_endpoint")), QString("127.0.0.1:9"));
+    QCOMPARE(reader->samplesBetween(0, 1).size(), size_t{5});
+    QCOMPARE(reader->laserBetween(0, 1).size(), size_t{1});
+    const std::vector<LogCommand> commands = reader->commands();
+    QCOMPARE(commands.size(), size_t{1});
+    QCOMPARE(QString::fromStdString(commands[0].text), QString("drive 0.5 10"));
+    QCOMPARE(QString::fromStdString(commands[0].source), QString("operator"));
+    QStringList events;
+    for (const LogEvent& e : reader->events()) events << QString::fromStdString(e.kind + ": " + e.text);
+    QVERIFY2(events.contains("note: checked the left arm"), qPrintable(events.join('\n')));
+    QVERIFY2(events.contains("link: link connected"), qPrintable(events.join('\n')));
+  }
+};
+
+QTEST_GUILESS_MAIN(TestConsoleSession)
+#include "tst_console_session.moc"

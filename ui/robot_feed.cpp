@@ -1,0 +1,62 @@
+#include "ui/robot_feed.h"
+
+#include <chrono>
+
+#include "app/console_session.h"
+#include "ui/robot_connection.h"
+
+namespace sp {
+
+namespace {
+
+double wallSeconds() {
+  using namespace std::chrono;
+  return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+QString qs(const std::string& s) { return QString::fromStdString(s); }
+
+}  // namespace
+
+LiveLinkFeed::LiveLinkFeed(RobotConnection* connection, ConsoleSession* session, QObject* parent)
+    : RobotFeed(parent), session_(session) {
+  connect(connection, &RobotConnection::telemetry, this, [this](const net::TelemetryMsg& t) {
+    ++telemetryCount_;
+    lastTelemetry_ = t;
+    emit frame(session_->telemetry(t, wallSeconds()));
+  });
+  connect(connection, &RobotConnection::laser, this, [this](const net::LaserMsg& m) {
+    ++laserCount_;
+    emit laser(session_->laser(m));
+  });
+  connect(connection, &RobotConnection::reply, this, [this](const net::ReplyMsg& m) {
+    if (m.status == net::ReplyStatus::Ok) return;
+    linkEvent(QStringLiteral("refused"),
+              tr("command %1 %2: %3").arg(m.seq).arg(QLatin1String(net::toString(m.status)), qs(m.reason)), "link");
+  });
+  connect(connection, &RobotConnection::event, this, [this](const net::EventMsg& m) {
+    const QLatin1String kind(net::toString(m.kind));
+    linkEvent(QStringLiteral("robot"), tr("robot %1: %2").arg(kind, qs(m.text)), net::toString(m.kind));
+  });
+  connect(connection, &RobotConnection::lease, this, [this](const net::LeaseStateMsg& lease) {
+    linkEvent(QStringLiteral("link"), lease.yours            ? tr("control: yours")
+                                      : lease.holder.empty() ? tr("control: free")
+                                                             : tr("control: held by %1").arg(qs(lease.holder)),
+              "link");
+  });
+  connect(connection, &RobotConnection::connectionChanged, this, [this](net::ConnectionState s, const QString& d) {
+    const QLatin1String state(net::toString(s));
+    linkEvent(QStringLiteral("link"), tr("link %1%2").arg(state, d.isEmpty() ? QString() : QStringLiteral(": ") + d),
+              "link");
+    emit stateChanged(state, d);
+  });
+  connect(connection, &RobotConnection::linkError, this,
+          [this](const QString& reason) { linkEvent(QStringLiteral("error"), tr("error: %1").arg(reason)); });
+}
+
+void LiveLinkFeed::linkEvent(const QString& kind, const QString& text, const char* logKind) {
+  if (logKind) session_->event(logKind, text.toStdString());
+  emit event(kind, text);
+}
+
+}  // namespace sp
