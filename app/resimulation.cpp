@@ -2,55 +2,20 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <map>
 #include <memory>
-#include <random>
 #include <vector>
 
 #include "app/session_log.h"
 #include "sim/command_file.h"
+#include "sim/file_set.h"
 #include "sim/model_loader.h"
 #include "sim/params.h"
 #include "sim/runner.h"
 #include "sim/world.h"
 
 namespace sp {
-namespace fs = std::filesystem;
 namespace {
-
-// A temporary folder removed when it goes out of scope.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    const fs::path base = fs::temp_directory_path();
-    for (int i = 0; i < 100 && path_.empty(); ++i) {
-      fs::path p = base / ("simpartner-resim-" + std::to_string(rd()));
-      std::error_code ec;
-      if (fs::create_directory(p, ec)) path_ = p;
-    }
-  }
-  ~TempDir() {
-    std::error_code ec;
-    if (!path_.empty()) fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-bool writeFile(const fs::path& path, const std::string& contents) {
-  std::error_code ec;
-  fs::create_directories(path.parent_path(), ec);
-  std::ofstream out(path, std::ios::binary);
-  out << contents;
-  return static_cast<bool>(out);
-}
 
 std::string get(const std::map<std::string, std::string>& meta, const std::string& key) {
   auto it = meta.find(key);
@@ -76,65 +41,28 @@ std::optional<ResimReport> resimulate(const std::string& path, const ResimOption
     return std::nullopt;
   }
 
-  // Lay the logged files out as recorded: the robot at its path relative to
-  // the world file's folder, the world file deep enough that every "..."
-  // of that relative path stays inside the temporary folder.
-  TempDir temp;
-  if (temp.path().empty()) {
-    error = path + ": cannot create a temporary folder to rebuild the world in";
-    return std::nullopt;
-  }
-  const fs::path worldAbs = fs::absolute(worldName).lexically_normal();
-  // A robot opened in place of the world's own goes where the world looks.
+  // The logged files, held in memory where they were recorded: the robot
+  // where the world file's reference to it leads (a robot opened in place
+  // of the world's own goes where the world looks). Nothing is written.
   const std::string replaced = get(meta, "replaced_robot_file");
-  const fs::path robotAbs = fs::absolute(replaced.empty() ? robotName : replaced).lexically_normal();
-  fs::path robotRel = robotAbs.lexically_relative(worldAbs.parent_path());
-  if (robotRel.empty()) robotRel = robotAbs.filename();
-  int depth = 0;
-  for (const fs::path& part : robotRel)
-    if (part == "..") ++depth;
-  fs::path worldDir = temp.path();
-  for (int i = 0; i < depth; ++i) worldDir /= "d" + std::to_string(i);
-  const fs::path worldFile = worldDir / worldAbs.filename();
-  const fs::path robotFile = (worldDir / robotRel).lexically_normal();
-  if (!writeFile(worldFile, get(meta, "world_contents")) || !writeFile(robotFile, get(meta, "robot_contents"))) {
-    error = path + ": cannot write the logged files to " + temp.path().string();
-    return std::nullopt;
-  }
+  FileSet files;
+  files.add(worldName, get(meta, "world_contents"));
+  files.add(replaced.empty() ? robotName : replaced, get(meta, "robot_contents"));
 
+  // A heightfield's data file is not stored in the log: it is read from the
+  // disk, beside the recorded world file.
   Diagnostics diag;
-  // The terrain data file is not logged: parse the logged world XML with
-  // relative paths resolved beside the recorded world file, except the
-  // robot, which the temporary layout provides.
-  std::optional<WorldModel> model = loadWorld(worldFile.string(), diag);
-  if (!model || model->robots.empty()) {
-    // A heightfield's file is missing from the temporary layout: copy it from
-    // beside the recorded world file and try again.
-    diag = Diagnostics{};
-    std::optional<WorldModel> probe =
-        parseWorld(get(meta, "world_contents"), worldName, worldAbs.parent_path().string(), diag);
-    if (probe && probe->terrain.kind != TerrainSpec::Kind::Plane) {
-      const fs::path terrainAbs = fs::absolute(probe->terrain.file).lexically_normal();
-      const fs::path terrainRel = terrainAbs.lexically_relative(worldAbs.parent_path());
-      std::error_code ec;
-      fs::create_directories((worldDir / terrainRel).parent_path(), ec);
-      fs::copy_file(terrainAbs, worldDir / terrainRel, fs::copy_options::overwrite_existing, ec);
-    }
-    diag = Diagnostics{};
-    model = loadWorld(worldFile.string(), diag);
-  }
+  std::optional<WorldModel> model = loadWorld(worldName, diag, &files);
   if (!model || model->robots.empty()) {
     error = path + ": cannot rebuild the logged world:\n" + diag.format();
     return std::nullopt;
   }
 
   SimParams params;
-  if (meta.count("params_contents")) {
-    const fs::path paramsFile = temp.path() / "session.params";
-    if (!writeFile(paramsFile, get(meta, "params_contents")) || !loadParams(paramsFile.string(), params, diag)) {
-      error = path + ": cannot load the logged parameters:\n" + diag.format();
-      return std::nullopt;
-    }
+  if (meta.count("params_contents") &&
+      !parseParams(get(meta, "params_contents"), get(meta, "params_file"), params, diag)) {
+    error = path + ": cannot load the logged parameters:\n" + diag.format();
+    return std::nullopt;
   }
   for (const LogEvent& e : reader->events())
     if (e.kind == "param_override" && !applyOverride(params, e.text, diag)) {

@@ -5,14 +5,13 @@
 // step, reporting the first divergence (box2d's recording replay).
 //
 // The world is rebuilt from the logged file *contents*, never from the paths
-// on disk: the contents are written to a fresh temporary folder that keeps
-// the recorded relative layout (the robot file where the world file's
-// relative reference expects it), so a log still re-simulates after the
-// files on disk were edited or moved. Limitations: a heightfield terrain's
-// data file is not stored in the log, so it is read from beside the recorded
-// world file (its heights are restored from the snapshot when the snapshot
-// carries them); parameter overrides come from the log's "param_override"
-// events.
+// on disk: the contents are held in memory (sim/file_set.h) under their
+// recorded paths, so a log still re-simulates after the files on disk were
+// edited or moved, and nothing is written. Limitations: a heightfield
+// terrain's data file is not stored in the log, so it is read from beside
+// the recorded world file (its heights are restored from the snapshot when
+// the snapshot carries them); parameter overrides come from the log's
+// "param_override" events.
 
 #include <cstdint>
 #include <optional>

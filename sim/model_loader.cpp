@@ -267,14 +267,6 @@ bool parseXml(XMLDocument& doc, std::string_view xml, std::string_view file, Dia
   return false;
 }
 
-std::optional<std::string> readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
-}
-
 const XMLElement* rootElement(const XMLDocument& doc, const char* expected, std::string_view file,
                               Diagnostics& diag) {
   const XMLElement* root = doc.RootElement();
@@ -679,8 +671,8 @@ std::optional<RobotModel> parseRobot(std::string_view xml, std::string_view file
   return robot;
 }
 
-std::optional<RobotModel> loadRobot(const std::string& path, Diagnostics& diag) {
-  std::optional<std::string> text = readFile(path);
+std::optional<RobotModel> loadRobot(const std::string& path, Diagnostics& diag, const FileSet* files) {
+  std::optional<std::string> text = readSourceFile(path, files);
   if (!text) {
     diag.error(path, 0, "cannot open robot file");
     return std::nullopt;
@@ -738,7 +730,7 @@ void readContact(const XMLElement* e, WorldModel& world, std::string_view file, 
 }
 
 void readTerrain(const XMLElement* e, WorldModel& world, std::string_view file, std::string_view baseDir,
-                 Diagnostics& diag, std::vector<std::pair<std::string, int>>& materialRefs) {
+                 Diagnostics& diag, std::vector<std::pair<std::string, int>>& materialRefs, const FileSet* files) {
   ElementReader r(e, file, diag);
   const int errorsBefore = diag.errorCount();
   TerrainSpec& t = world.terrain;
@@ -789,12 +781,12 @@ void readTerrain(const XMLElement* e, WorldModel& world, std::string_view file, 
   if (!f) return;
   t.file = resolvePath(baseDir, *f);
   src.path = t.file;
-  if (!fs::exists(t.file)) {
+  if (!sourceFileExists(t.file, files)) {
     r.error("terrain file '" + *f + "' not found (looked at " + t.file + ")");
     return;
   }
   if (diag.errorCount() != errorsBefore) return;  // do not load with bad scaling attributes
-  if (std::optional<HeightGrid> grid = loadHeightGrid(src, diag)) t.grid = std::move(*grid);
+  if (std::optional<HeightGrid> grid = loadHeightGrid(src, diag, files)) t.grid = std::move(*grid);
 }
 
 void readObject(const XMLElement* e, WorldModel& world, NameSet& names, std::string_view file,
@@ -821,7 +813,7 @@ void readObject(const XMLElement* e, WorldModel& world, NameSet& names, std::str
 }  // namespace
 
 std::optional<WorldModel> parseWorld(std::string_view xml, std::string_view file, std::string_view baseDir,
-                                     Diagnostics& diag) {
+                                     Diagnostics& diag, const FileSet* files) {
   const int errorsBefore = diag.errorCount();
   XMLDocument doc;
   WorldModel world;
@@ -857,7 +849,7 @@ std::optional<WorldModel> parseWorld(std::string_view xml, std::string_view file
         continue;
       }
       terrainLine = e->GetLineNum();
-      readTerrain(e, world, file, baseDir, diag, materialRefs);
+      readTerrain(e, world, file, baseDir, diag, materialRefs, files);
     } else if (tag == "object") {
       readObject(e, world, objects, file, diag);
     } else if (tag == "robot") {
@@ -872,9 +864,9 @@ std::optional<WorldModel> parseWorld(std::string_view xml, std::string_view file
       noChildren(e, file, diag);
       if (f) {
         const std::string path = resolvePath(baseDir, *f);
-        if (!fs::exists(path)) {
+        if (!sourceFileExists(path, files)) {
           r.error("robot file '" + *f + "' not found (looked at " + path + ")");
-        } else if (std::optional<RobotModel> model = loadRobot(path, diag)) {
+        } else if (std::optional<RobotModel> model = loadRobot(path, diag, files)) {
           inst.model = std::move(*model);
           for (const LinkSpec& link : inst.model.links)
             for (const GeomSpec& g : link.geoms)
@@ -910,18 +902,18 @@ std::optional<WorldModel> parseWorld(std::string_view xml, std::string_view file
   return world;
 }
 
-std::optional<WorldModel> loadWorld(const std::string& path, Diagnostics& diag) {
-  std::optional<std::string> text = readFile(path);
+std::optional<WorldModel> loadWorld(const std::string& path, Diagnostics& diag, const FileSet* files) {
+  std::optional<std::string> text = readSourceFile(path, files);
   if (!text) {
     diag.error(path, 0, "cannot open world file");
     return std::nullopt;
   }
-  return parseWorld(*text, path, fs::path(path).parent_path().string(), diag);
+  return parseWorld(*text, path, fs::path(path).parent_path().string(), diag, files);
 }
 
 std::string xmlRootName(const std::string& path) {
   XMLDocument doc;
-  std::optional<std::string> text = readFile(path);
+  std::optional<std::string> text = readSourceFile(path, nullptr);
   if (!text || doc.Parse(text->data(), text->size()) != tinyxml2::XML_SUCCESS || !doc.RootElement())
     return {};
   return doc.RootElement()->Name();

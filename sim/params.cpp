@@ -1,8 +1,9 @@
 #include "sim/params.h"
 
+#include "sim/file_set.h"
+
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
@@ -221,18 +222,27 @@ bool setParam(SimParams& params, std::string_view key, std::string_view value, s
 }
 
 bool loadParams(const std::string& path, SimParams& params, Diagnostics& diag) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    diag.error(path, 0, "cannot open parameters file");
+  const std::optional<std::string> contents = readSourceFile(path, nullptr);
+  if (!contents) {
+    // There but not readable as a file: a directory, say.
+    diag.error(path, 0, sourceFileExists(path, nullptr) ? "cannot read parameters file" : "cannot open parameters file");
     return false;
   }
+  return parseParams(*contents, path, params, diag);
+}
+
+bool parseParams(std::string_view contents, std::string_view path, SimParams& params, Diagnostics& diag) {
   // Applied to a copy, committed only if the whole file is valid.
   SimParams staged = params;
   std::map<std::string, int, std::less<>> firstLine;
   bool ok = true;
-  std::string raw;
-  for (int line = 1; std::getline(in, raw); ++line) {
-    std::string_view text = raw;
+  int line = 0;
+  for (size_t pos = 0; pos < contents.size();) {
+    size_t end = contents.find('\n', pos);
+    if (end == std::string_view::npos) end = contents.size();
+    std::string_view text = contents.substr(pos, end - pos);
+    pos = end + 1;
+    ++line;
     text = trim(text.substr(0, text.find('#')));
     if (text.empty()) continue;
     const size_t eq = text.find('=');
@@ -251,10 +261,6 @@ bool loadParams(const std::string& path, SimParams& params, Diagnostics& diag) {
     }
     if (findEntry(key)) firstLine.emplace(std::string(key), line);
     if (!setParam(staged, key, value, path, line, diag)) ok = false;
-  }
-  if (in.bad()) {  // a directory, say
-    diag.error(path, 0, "cannot read parameters file");
-    return false;
   }
   if (ok) params = staged;
   return ok;

@@ -59,6 +59,10 @@ bool setParam(SimParams& params, std::string_view key, std::string_view value,
 /// error `params` is left exactly as it was (no half-applied file).
 bool loadParams(const std::string& path, SimParams& params, Diagnostics& diag);
 
+/// The same for a properties file held in memory; `path` names it in
+/// diagnostics (a session log's stored parameters, say).
+bool parseParams(std::string_view contents, std::string_view path, SimParams& params, Diagnostics& diag);
+
 /// Applies a `key=value` override from the command line.
 bool applyOverride(SimParams& params, std::string_view assignment, Diagnostics& diag);
 

@@ -593,22 +593,15 @@ std::optional<TerrainFormat> formatFromExtension(const std::string& path) {
 
 }  // namespace
 
-std::optional<HeightGrid> loadHeightGrid(const TerrainSource& source, Diagnostics& diag) {
+std::optional<HeightGrid> loadHeightGrid(const TerrainSource& source, Diagnostics& diag, const FileSet* files) {
   Reporter r(source.path, diag);
 
-  std::string content;
-  {
-    std::error_code ec;
-    std::ifstream in;
-    if (std::filesystem::is_regular_file(source.path, ec)) in.open(source.path, std::ios::binary);
-    std::array<char, 65536> chunk{};
-    while (in && in.read(chunk.data(), chunk.size()).gcount() > 0)
-      content.append(chunk.data(), static_cast<size_t>(in.gcount()));
-    if (!in.is_open() || in.bad()) {
-      r.error(0, "cannot open terrain file");
-      return std::nullopt;
-    }
+  std::optional<std::string> read = readSourceFile(source.path, files);
+  if (!read) {
+    r.error(0, "cannot open terrain file");
+    return std::nullopt;
   }
+  const std::string content = std::move(*read);
 
   // Extents from the world file: 0 means "from the terrain file".
   if (!std::isfinite(source.width) || source.width < 0)

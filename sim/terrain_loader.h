@@ -6,6 +6,7 @@
 #include <string>
 
 #include "sim/diagnostics.h"
+#include "sim/file_set.h"
 #include "sim/height_grid.h"
 
 namespace sp {
@@ -28,6 +29,7 @@ struct TerrainSource {
 /// (or row) errors, all of them, and nullopt is returned when there is any.
 /// File rows are stored north first (image order): the first row of the file
 /// is the largest y, so the loader flips it into HeightGrid's +y order.
-std::optional<HeightGrid> loadHeightGrid(const TerrainSource& source, Diagnostics& diag);
+std::optional<HeightGrid> loadHeightGrid(const TerrainSource& source, Diagnostics& diag,
+                                         const FileSet* files = nullptr);
 
 }  // namespace sp
