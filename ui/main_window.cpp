@@ -195,7 +195,8 @@ void MainWindow::buildDocks() {
 void MainWindow::buildMenus() {
   QMenu* file = menuBar()->addMenu(tr("&File"));
   file->addAction(tr("Open &world…"), QKeySequence::Open, this, [this] {
-    const QString path = QFileDialog::getOpenFileName(this, tr("Open world"), QFileInfo(options_.world).path(),
+    const QString current = session_->world() ? qs(session_->world()->file) : options_.world;
+    const QString path = QFileDialog::getOpenFileName(this, tr("Open world"), QFileInfo(current).path(),
                                                       tr("World files (*.world.xml);;XML files (*.xml)"));
     if (!path.isEmpty()) openWorld(path);
   });
