@@ -1,7 +1,9 @@
 #include "sim/command_check.h"
 
 #include <charconv>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <system_error>
 
 #include "sim/gait.h"
@@ -120,6 +122,7 @@ struct Checker {
 
   CommandCheck operator()(const DriveCmd& c) const {
     if (CommandCheck e = needDrive(); !e.ok()) return e;
+    if (CommandCheck e = speedWithinLimit(c.speed); !e.ok()) return e;
     const JointSpec& j = robot.joints[robot.drive->articulation];
     if (j.limited && (c.articulation < j.lower || c.articulation > j.upper))
       return outOfLimits("articulation " + show(radToDeg(c.articulation)) + " deg is outside joint '" + j.name +
@@ -140,7 +143,26 @@ struct Checker {
     return {};
   }
 
-  CommandCheck operator()(const TurnCmd&) const { return needDrive(); }
+  CommandCheck operator()(const TurnCmd& c) const {
+    if (CommandCheck e = needDrive(); !e.ok()) return e;
+    if (CommandCheck e = speedWithinLimit(c.speed); !e.ok()) return e;
+    if (!std::isfinite(c.yawRate)) return outOfLimits("yaw rate " + show(radToDeg(c.yawRate)) + " deg/s is not finite");
+    return {};
+  }
+
+  // The hinge speed a drive may ask for: the slowest wheel motor's top speed
+  // on a straight line (in a turn the outer wheels run faster still, and the
+  // actuators' own limits hold them).
+  CommandCheck speedWithinLimit(double speed) const {
+    double top = std::numeric_limits<double>::infinity();
+    for (int w : robot.drive->wheels)
+      if (const int a = robot.findActuator(robot.joints[w].name); a >= 0)
+        top = std::min(top, robot.actuators[a].maxVelocity * robot.drive->wheelRadius);
+    if (!(std::abs(speed) <= top))
+      return outOfLimits("speed " + show(speed) + " m/s exceeds the drive's " + show(top) +
+                         " m/s (wheel max_velocity x wheel radius)");
+    return {};
+  }
 
   CommandCheck operator()(const GaitCmd&) const {
     if (CommandCheck e = needDrive(); !e.ok()) return e;

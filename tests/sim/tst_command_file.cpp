@@ -451,6 +451,16 @@ void TestCommandFile::checkCommandTakesSliderValuesInMetres() {
   QCOMPARE(q(checkCommand(JointVelocityCmd{"lift", -0.2}, robot)), QString());
   QCOMPARE(q(checkCommand(JointVelocityCmd{"lift", 0.3}, robot)),
            QString("velocity 0.3 m/s exceeds joint 'lift' max_velocity 0.2 m/s"));
+  // Drive and turn speeds are checked too, never clipped (the slowest wheel
+  // motor's top speed times the wheel radius).
+  QVERIFY(checkCommand(DriveCmd{1e300, 0}, robot).kind == CommandCheck::Kind::OutOfLimits);
+  QVERIFY(checkCommand(TurnCmd{-1e300, 0}, robot).kind == CommandCheck::Kind::OutOfLimits);
+  QVERIFY(checkCommand(DriveCmd{std::nan(""), 0}, robot).kind == CommandCheck::Kind::OutOfLimits);
+  QVERIFY(checkCommand(TurnCmd{0.5, std::numeric_limits<double>::infinity()}, robot).kind ==
+          CommandCheck::Kind::OutOfLimits);
+  QVERIFY(checkCommand(DriveCmd{0.5, 0}, robot).ok());
+  QCOMPARE(q(checkCommand(DriveCmd{-3.5, 0}, robot)),
+           QString("speed -3.5 m/s exceeds the drive's 3 m/s (wheel max_velocity x wheel radius)"));
   // Limits are a kind of their own (the link refuses them as out_of_limits).
   QVERIFY(checkCommand(JointTargetCmd{"lift", 0.5}, robot).kind == CommandCheck::Kind::OutOfLimits);
   QVERIFY(checkCommand(JointVelocityCmd{"lift", 0.3}, robot).kind == CommandCheck::Kind::OutOfLimits);
