@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "app/headless_runner.h"  // loadRunParams
 #include "app/session_recorder.h"
 #include "app/stand_in.h"
 #include "app/telemetry_recorder.h"
@@ -38,6 +39,10 @@ void ConsoleSession::setWorld(WorldModel world) {
 }
 
 std::string ConsoleSession::start() {
+  Diagnostics paramDiag;
+  std::optional<SimParams> params = loadRunParams(options_.params, options_.overrides, paramDiag);
+  if (!params) return text(paramDiag);
+  params_ = *params;
   if (!remote()) return startStandIn(options_.world, {});
   // A remote robot: the world file only tells what to draw.
   Diagnostics diag;

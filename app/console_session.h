@@ -22,6 +22,7 @@
 
 #include "app/robot_frame.h"
 #include "net/message.h"
+#include "sim/params.h"
 #include "sim/robot_model.h"
 
 namespace sp {
@@ -78,6 +79,9 @@ class ConsoleSession {
   /// Counts world changes: views rebuild when it moves on.
   int worldVersion() const { return worldVersion_; }
   const RobotEndpoint& endpoint() const { return endpoint_; }
+  /// The parameters (file, then overrides) as loaded by start(): the
+  /// client's keep-alive period and command expiry come from them.
+  const SimParams& params() const { return params_; }
   /// The stand-in running, or null (remote, or before start()).
   const StandInRobot* standIn() const { return standIn_.get(); }
 
@@ -112,6 +116,7 @@ class ConsoleSession {
   void openRemoteLog();
 
   ConsoleSessionOptions options_;
+  SimParams params_;
   std::optional<WorldModel> world_;
   int worldVersion_ = 0;
   std::string worldFile_;  // the stand-in's world file

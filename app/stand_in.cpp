@@ -78,6 +78,8 @@ std::string StandInRobot::start() {
   config.link.robotName = world_.robots[0].name;
   config.link.token = token_;
   config.link.telemetryRate = params_.telemetryRate;
+  config.link.deadman = params_.linkDeadman;
+  config.link.leaseConfirm = params_.linkLeaseConfirm;
   config.emulation = options_.emulation;
   // Both run on the server's thread; the host queues log events for the
   // physics thread, which stamps them with the twin's step and time.

@@ -162,6 +162,7 @@ void forEachField(M& m, F& f) {
     f("robot", m.robot, R);
     f("session", m.session, R);
     f("telemetry_rate", m.telemetryRate, R);
+    f("deadman", m.deadman, Need::Optional);
   } else if constexpr (std::is_same_v<T, LeaseStateMsg>) {
     f("holder", m.holder, R);
     f("yours", m.yours, R);
@@ -169,6 +170,7 @@ void forEachField(M& m, F& f) {
     f("seq", m.seq, R);
     f("expires_ms", m.expiresMs, R);
     f("command", m.command, R);
+    f("sent_ms", m.sentMs, Need::Optional);
   } else if constexpr (std::is_same_v<T, ReplyMsg>) {
     f("seq", m.seq, R);
     f("status", m.status, R);
@@ -288,8 +290,16 @@ struct Encoder {
   }
 
   void operator()(const char* key, const std::string& v, Need) { line(key, [&] { text(key, v); }); }
-  void operator()(const char* key, uint64_t v, Need) { line(key, [&] { appendNumber(out, v); }); }
-  void operator()(const char* key, double v, Need) { line(key, [&] { appendNumber(out, v); }); }
+  // An optional number at its default (0) is left out: older peers never
+  // see keys they do not know unless the value means something.
+  void operator()(const char* key, uint64_t v, Need need) {
+    if (need == Need::Optional && v == 0) return;
+    line(key, [&] { appendNumber(out, v); });
+  }
+  void operator()(const char* key, double v, Need need) {
+    if (need == Need::Optional && v == 0) return;
+    line(key, [&] { appendNumber(out, v); });
+  }
   void operator()(const char* key, bool v, Need) { line(key, [&] { out += v ? '1' : '0'; }); }
   void operator()(const char* key, Role v, Need) {
     line(key, [&] { name(key, static_cast<size_t>(v), kRoleNames); });

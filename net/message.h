@@ -83,6 +83,7 @@ struct WelcomeMsg {
   std::string robot;           ///< the robot's name
   uint64_t session = 0;        ///< this connection's session id
   double telemetryRate = 50;   ///< [Hz], finite and > 0
+  double deadman = 0;          ///< [s] the robot's deadman (optional key `deadman`; 0 = not announced)
   friend bool operator==(const WelcomeMsg&, const WelcomeMsg&) = default;
 };
 /// LEASE_ACQUIRE: no keys.
@@ -108,6 +109,9 @@ struct CommandMsg {
   uint64_t seq = 0;        ///< increasing per connection
   uint64_t expiresMs = 0;  ///< [ms] > 0: not to be executed later than this after sending
   std::string command;     ///< sequence-file syntax without time, e.g. `drive 0.5 10`
+  /// [ms] the sender's monotonic clock when sent (optional key `sent_ms`;
+  /// 0 = not given: then the robot cannot judge expiry and does not).
+  uint64_t sentMs = 0;
   friend bool operator==(const CommandMsg&, const CommandMsg&) = default;
 };
 /// REPLY: keys `seq`, `status`, `reason` (optional, default empty).

@@ -202,7 +202,7 @@ class RobotClient::Impl {
       if (ec || !running_) return;
       if (ready_ && leaseHeld_) send(LeaseKeepaliveMsg{});
       // Fixed deadlines, no drift; after a stall, resync instead of a burst.
-      nextKeepalive_ = std::max(nextKeepalive_ + config_.keepaliveInterval, now());
+      nextKeepalive_ = std::max(nextKeepalive_ + keepaliveInterval_, now());
       keepaliveLoop();
     });
   }
@@ -438,7 +438,11 @@ class RobotClient::Impl {
     updateStats([&](RobotClientStats& s) {
       s.robot = m.robot;
       s.telemetryRateAnnounced = m.telemetryRate;
+      s.robotDeadman = m.deadman;
     });
+    // Keep-alives at least four per deadman period, so one late or lost
+    // keep-alive never trips it.
+    keepaliveInterval_ = m.deadman > 0 ? std::min(config_.keepaliveInterval, m.deadman / 4) : config_.keepaliveInterval;
     setState(ConnectionState::Ready, m.robot);
     sendHeartbeat();  // a first round trip at once
     if (estopOnWelcome_) {
@@ -507,8 +511,12 @@ class RobotClient::Impl {
     if (cb_.error) cb_.error(m);
   }
 
-  void doCommand(const CommandMsg& m) {
+  void doCommand(CommandMsg m) {
     if (!ready_) return localReply(m.seq, ReplyStatus::Failed, "client: not connected, not sent");
+    // Stamped as it leaves, for the robot's expiry judgement (any monotonic
+    // clock will do: the robot only compares our stamps with each other).
+    m.sentMs = static_cast<uint64_t>(
+        std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now().time_since_epoch()).count());
     std::string error;
     if (!send(m, &error)) return localReply(m.seq, ReplyStatus::Invalid, "client: " + error);
     const double t = now();
@@ -587,6 +595,7 @@ class RobotClient::Impl {
   LinkEmulator emulator_;
   std::multimap<double, std::string> delayed_;  ///< due time [s] -> frame, on the emulated link
   bool ready_ = false, leaseHeld_ = false, acquireOnWelcome_ = false;
+  double keepaliveInterval_ = 0.05;  // [s] config's, or a quarter of the robot's deadman if shorter
   std::optional<std::string> estopOnWelcome_;
   std::string errorBeforeWelcome_;
   std::map<uint64_t, Pending> pending_;  ///< commands sent, waiting for their REPLY

@@ -43,7 +43,9 @@ struct RobotClientConfig {
 
   double reconnectMin = 0.2;  ///< [s] wait before the first reconnect after a drop or failed connect
   double reconnectMax = 2.0;  ///< [s] the wait doubles up to this after each failure
-  double keepaliveInterval = 0.05;  ///< [s] LEASE_KEEPALIVE period while holding the lease (robot deadman: 0.2 s)
+  /// [s] LEASE_KEEPALIVE period while holding the lease; shortened to a
+  /// quarter of the deadman the robot announces in WELCOME when that is less.
+  double keepaliveInterval = 0.05;
   double heartbeatInterval = 0.2;   ///< [s] period of the client's own HEARTBEATs (round-trip time)
   uint64_t commandExpiryMs = 500;   ///< [ms] COMMAND `expires_ms` when a send call passes 0
   /// [s] a command without REPLY after its expiry plus max(this, 3 x RTT) is
@@ -91,6 +93,7 @@ struct RobotClientStats {
   uint64_t rttSamples = 0;            ///< heartbeat echoes received
   double robotRttMs = 0;              ///< [ms] round trip as the robot measures it (TELEMETRY `rtt_ms`)
   double telemetryRateAnnounced = 0;  ///< [Hz] WELCOME `telemetry_rate`
+  double robotDeadman = 0;            ///< [s] WELCOME `deadman`: the robot's deadman (0 = not announced)
   double telemetryRateHz = 0;         ///< [Hz] TELEMETRY frames received per second, over the last ~1 s
   uint64_t telemetryFrames = 0;       ///< TELEMETRY frames received
   uint64_t telemetryLost = 0;         ///< frames missing from gaps in TELEMETRY `seq` (within each connection)

@@ -23,7 +23,7 @@ RobotLink::RobotLink(RobotLinkConfig config, const RobotModel* robot,
 
 void RobotLink::connected(ClientId client, double) { clients_[client] = Client{}; }
 
-void RobotLink::disconnected(ClientId client, double) {
+void RobotLink::disconnected(ClientId client, double now) {
   const std::string name = who(client);
   clients_.erase(client);
   if (holder_ == client) {
@@ -31,6 +31,12 @@ void RobotLink::disconnected(ClientId client, double) {
     // the holder's last packet and stops the robot (tick()).
     holder_ = 0;
     holderLost_ = true;
+    if (awaitingHolder_) {
+      // Lost before its first keep-alive: the deadman counts from now.
+      awaitingHolder_ = false;
+      deadmanArmed_ = true;
+      lastFromHolder_ = now;
+    }
     notice("link", "lease lost with the connection of " + name);
     broadcastLease();
   }
@@ -99,7 +105,7 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
     c.name = hello->name;
     c.role = hello->role;
     notice("link", who(client) + " authenticated as " + toString(c.role));
-    send(client, WelcomeMsg{config_.robotName, ++session_, config_.telemetryRate});
+    send(client, WelcomeMsg{config_.robotName, ++session_, config_.telemetryRate, config_.deadman});
     const std::string holderName = holder_ ? clients_[holder_].name : std::string();
     send(client, LeaseStateMsg{holderName, false});
     if (failsafe_) send(client, EventMsg{EventKind::Failsafe, "failsafe latched: re-arm to move"});
@@ -129,15 +135,21 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
           if (holderLost_ && deadmanArmed_ && !failsafe_)
             stopEverything(EventKind::Failsafe, "the previous controlling client's connection was lost", now);
           holderLost_ = false;
-          if (holder_ != client) notice("link", "lease taken by " + who(client));
-          holder_ = client;
-          lastFromHolder_ = now;
-          deadmanArmed_ = true;
+          if (holder_ != client) {
+            notice("link", "lease taken by " + who(client));
+            // The holder hears of the grant a one-way trip from now and its
+            // keep-alives take another: the deadman waits for the first.
+            holder_ = client;
+            deadmanArmed_ = false;
+            awaitingHolder_ = true;
+            grantedAt_ = now;
+          } else {
+            heardFromHolder(now);
+          }
           broadcastLease();
         } else if constexpr (std::is_same_v<T, LeaseKeepaliveMsg>) {
           if (client == holder_) {
-            lastFromHolder_ = now;
-            deadmanArmed_ = true;
+            heardFromHolder(now);
           } else {
             send(client, ErrorMsg{"LEASE_KEEPALIVE without the lease"});
           }
@@ -147,6 +159,7 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
             // nobody is in control any more.
             holder_ = 0;
             deadmanArmed_ = false;
+            awaitingHolder_ = false;
             commands_.emplace_back(std::in_place_type<StopCmd>);
             notice("link", "lease released by " + who(client) + " (the robot stops)");
             broadcastLease();
@@ -162,11 +175,21 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
                                              : "out of order: last sequence number was " + std::to_string(c.lastSeq));
           c.anySeq = true;
           c.lastSeq = m.seq;
-          // One-way delay estimated as half the measured round trip.
-          if (c.rttMs / 2 > static_cast<double>(m.expiresMs))
-            return refuse(client, m.seq, ReplyStatus::Expired,
-                          "arrived about " + std::to_string(static_cast<int>(c.rttMs / 2)) + " ms after sending, " +
-                              "expiry " + std::to_string(m.expiresMs) + " ms");
+          heardFromHolder(now);
+          // Expiry against the link's own delay: the clocks are not shared,
+          // so (arrival - sent) is the one-way delay plus an unknown offset;
+          // its smallest value so far stands for the link's usual delay, and
+          // a command later than that by more than its expiry is stale.
+          if (m.sentMs > 0) {
+            const double offset = now * 1000 - static_cast<double>(m.sentMs);
+            if (!c.anyOffset || offset < c.minOffsetMs) c.minOffsetMs = offset;
+            c.anyOffset = true;
+            const double late = offset - c.minOffsetMs;
+            if (late > static_cast<double>(m.expiresMs))
+              return refuse(client, m.seq, ReplyStatus::Expired,
+                            "arrived " + std::to_string(static_cast<int64_t>(late)) +
+                                " ms later than the link's usual delay, expiry " + std::to_string(m.expiresMs) + " ms");
+          }
           if (failsafe_ || estop_)
             return refuse(client, m.seq, ReplyStatus::Failed,
                           std::string(estop_ ? "e-stop" : "failsafe") + " latched: re-arm first");
@@ -178,8 +201,6 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
             const bool limit = verdict.kind == CommandCheck::Kind::OutOfLimits;
             return refuse(client, m.seq, limit ? ReplyStatus::OutOfLimits : ReplyStatus::Invalid, verdict.message);
           }
-          lastFromHolder_ = now;
-          deadmanArmed_ = true;
           commands_.push_back(*command);
           ++accepted_;
           send(client, ReplyMsg{m.seq, ReplyStatus::Ok, ""});
@@ -209,7 +230,23 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
       message);
 }
 
+void RobotLink::heardFromHolder(double now) {
+  awaitingHolder_ = false;
+  lastFromHolder_ = now;
+  deadmanArmed_ = true;
+}
+
 void RobotLink::tick(double now) {
+  // A new holder that never confirms loses the lease again (the robot
+  // stood still meanwhile: nothing latches).
+  if (awaitingHolder_ && now - grantedAt_ > config_.leaseConfirm) {
+    awaitingHolder_ = false;
+    notice("link", "lease taken back from " + who(holder_) + ": no keep-alive within " +
+                       std::to_string(static_cast<int>(config_.leaseConfirm * 1000)) + " ms of the grant");
+    holder_ = 0;
+    commands_.emplace_back(std::in_place_type<StopCmd>);
+    broadcastLease();
+  }
   // The deadman watches the holder, and keeps watching after a holder is
   // lost until it fires: losing the operator stops the robot.
   if (deadmanArmed_ && !failsafe_ && now - lastFromHolder_ > config_.deadman) {

@@ -30,7 +30,16 @@ using ClientId = uint64_t;
 struct RobotLinkConfig {
   std::string robotName = "workpartner";
   std::string token;            ///< shared secret, >= 32 hex digits; checked in constant time
-  double deadman = 0.2;         ///< [s] without a command or keep-alive from the holder => failsafe
+  /// [s] longest gap between arrivals of the holder's commands or
+  /// keep-alives => failsafe. Judged on arrival, so a constant delay never
+  /// trips it; it must exceed the keep-alive period plus twice the link's
+  /// jitter (docs/protocol.md has settings per link). Announced in WELCOME.
+  double deadman = 0.2;
+  /// [s] after granting the lease, how long the robot waits for the new
+  /// holder's first keep-alive or command (it learns of the grant a round
+  /// trip later) before it takes the lease back. The deadman counts from
+  /// that first arrival; the robot stands still meanwhile.
+  double leaseConfirm = 10;
   double telemetryRate = 50;    ///< [Hz], announced in WELCOME
 };
 
@@ -109,12 +118,18 @@ class RobotLink {
     uint64_t lastSeq = 0;
     bool anySeq = false;
     double rttMs = 0;
+    // Command expiry: the smallest (arrival - sent) seen [ms]; commands
+    // that arrive later than that by more than their expiry are refused.
+    bool anyOffset = false;
+    double minOffsetMs = 0;
   };
   void send(ClientId client, Message message);
   void broadcast(const Message& message);
   void broadcastLease();
   void refuse(ClientId client, uint64_t seq, ReplyStatus status, std::string reason);
   void stopEverything(EventKind why, const std::string& text, double now);
+  /// A keep-alive or command from the holder arrived: the deadman counts from now.
+  void heardFromHolder(double now);
   void close(ClientId client, const std::string& reason);
   void notice(std::string kind, std::string text);
   /// "'NAME' (client N)" for notices.
@@ -127,6 +142,8 @@ class RobotLink {
   ClientId holder_ = 0;
   double lastFromHolder_ = 0;
   bool deadmanArmed_ = false;
+  bool awaitingHolder_ = false;  // lease granted, nothing from the new holder yet
+  double grantedAt_ = 0;
   bool holderLost_ = false;  // the holder's connection dropped; deadman not fired yet
   bool failsafe_ = false, estop_ = false;
   double lastFailsafe_ = -1;

@@ -34,7 +34,21 @@ class RobotServer::Session {
     double due;      // when the emulated link lets it go
   };
   std::deque<Queued> queue;  // frames to write, front first
-  size_t queuedTelemetry = 0;
+
+  /// Telemetry frames the client could have read by `now`: due ones still
+  /// queued. Frames the emulated link still holds are in flight, not
+  /// waiting for a slow reader, so a long delay drops nothing.
+  size_t telemetryWaiting(double now, bool inOrder) const {
+    size_t n = 0;
+    for (const Queued& q : queue) {
+      if (q.due > now) {
+        if (inOrder) break;  // due times never decrease
+        continue;
+      }
+      n += q.telemetry;
+    }
+    return n;
+  }
   bool writing = false, reading = false;
   bool closing = false;  // write what is queued, then close
   bool closed = false;
@@ -134,7 +148,8 @@ void RobotServer::enqueue(Session& s, const Message& message, bool telemetry) {
   std::string error;
   std::optional<std::string> frame = encodeMessage(message, error);
   if (!frame) return;
-  if (telemetry && s.queuedTelemetry >= config_.maxQueuedFrames) {
+  if (telemetry && s.telemetryWaiting(now(), !config_.emulation.active() || config_.emulation.keepOrder) >=
+                       config_.maxQueuedFrames) {
     // A slow reader loses telemetry; the control loop never waits for it.
     ++s.lost;
     ++stats_.telemetryDropped;
@@ -153,7 +168,6 @@ void RobotServer::enqueue(Session& s, const Message& message, bool telemetry) {
     }
     due = *at;
   }
-  s.queuedTelemetry += telemetry;
   s.queue.push_back({std::move(*frame), telemetry, due});
 }
 
@@ -229,7 +243,6 @@ void RobotServer::flush() {
       Session& ses = *it->second;
       ses.writing = false;
       if (ec) return closeSession(sid);
-      ses.queuedTelemetry -= ses.queue.front().telemetry;
       ses.queue.pop_front();
       flush();
     });

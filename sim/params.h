@@ -34,6 +34,11 @@ struct SimParams {
   double csvRate = 100;           ///< rows per sim second in `run --csv`
   // Ports
   int robotPort = 47800;          ///< TCP port of the robot link
+  // Robot link timing (docs/protocol.md has settings per link); LAN defaults
+  double linkDeadman = 0.2;       ///< [s] robot: longest gap between the holder's keep-alives
+  double linkKeepalive = 0.05;    ///< [s] console: keep-alive period (at most a quarter of the deadman)
+  double linkCommandExpiry = 0.5; ///< [s] console: how much later than the link's usual delay a command may arrive
+  double linkLeaseConfirm = 10;   ///< [s] robot: wait for a new holder's first keep-alive
   // Gaits (sim/gait.h); swings in degrees about the stance pose
   double caterpillarHipSwing = 12;   ///< [deg]
   double caterpillarPhaseTime = 1.0; ///< [s] per half cycle

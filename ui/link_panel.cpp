@@ -28,7 +28,10 @@ LinkPanel::LinkPanel(QWidget* parent) : QWidget(parent) {
   loss_ = new QLabel;
   lease_ = new QLabel;
   latches_ = new QLabel;
-  for (QLabel* l : {endpoint_, state_, rtt_, rate_, loss_, lease_, latches_}) l->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  deadman_ = new QLabel;
+  deadman_->setToolTip(tr("The robot's deadman: it stops (failsafe) when the controller's keep-alives stop arriving for this long"));
+  for (QLabel* l : {endpoint_, state_, rtt_, rate_, loss_, lease_, latches_, deadman_})
+    l->setTextInteractionFlags(Qt::TextSelectableByMouse);
   form->addRow(tr("robot"), endpoint_);
   form->addRow(tr("link"), state_);
   form->addRow(tr("round trip"), rtt_);
@@ -36,6 +39,7 @@ LinkPanel::LinkPanel(QWidget* parent) : QWidget(parent) {
   form->addRow(tr("lost"), loss_);
   form->addRow(tr("control"), lease_);
   form->addRow(tr("latches"), latches_);
+  form->addRow(tr("deadman"), deadman_);
   layout->addLayout(form);
 
   auto* row = new QHBoxLayout;
@@ -91,6 +95,8 @@ void LinkPanel::showStats(const net::RobotClientStats& s) {
                       .arg(s.rttMaxMs, 0, 'f', 1));
     rate_->setText(tr("%1 Hz of %2").arg(s.telemetryRateHz, 0, 'f', 1).arg(s.telemetryRateAnnounced, 0, 'f', 0));
   }
+  deadman_->setText(s.robotDeadman > 0 ? tr("%1 ms (the robot's)").arg(s.robotDeadman * 1000, 0, 'f', 0)
+                                       : tr("not announced"));
   const uint64_t total = s.telemetryFrames + s.telemetryLost;
   const double percent = total ? 100.0 * static_cast<double>(s.telemetryLost) / static_cast<double>(total) : 0.0;
   loss_->setText(tr("%1 frames (%2 %), robot dropped %3, %4 reconnects")

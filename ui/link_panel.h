@@ -53,6 +53,7 @@ class LinkPanel : public QWidget {
   QLabel* loss_ = nullptr;
   QLabel* lease_ = nullptr;
   QLabel* latches_ = nullptr;
+  QLabel* deadman_ = nullptr;  // the robot's, from WELCOME
   QPushButton* connect_ = nullptr;
   QPushButton* control_ = nullptr;
   QPushButton* estop_ = nullptr;

@@ -284,6 +284,8 @@ void MainWindow::connectToRobot() {
   config.port = e.port;
   config.token = e.token;
   config.name = QStringLiteral("console@%1").arg(QCoreApplication::applicationPid()).toStdString();
+  config.keepaliveInterval = session_->params().linkKeepalive;
+  config.commandExpiryMs = static_cast<uint64_t>(std::llround(session_->params().linkCommandExpiry * 1000));
   connection_->open(config);
   if (options_.takeControl) connection_->acquireLease();
 }

@@ -3,8 +3,11 @@
 
 #include <QtTest>
 
+#include <deque>
+
 #include <random>
 
+#include "net/link_emulator.h"
 #include "net/robot_link.h"
 #include "sim/command_file.h"
 
@@ -26,7 +29,7 @@ CommandCheck check(const Command& c) {
 }
 
 struct Fixture {
-  RobotLink link{RobotLinkConfig{"workpartner", kToken, 0.2, 50}, nullptr, check};
+  RobotLink link{RobotLinkConfig{"workpartner", kToken, 0.2, 10, 50}, nullptr, check};
   double now = 1.0;
 
   void hello(ClientId id, Role role, const std::string& token = kToken) {
@@ -139,19 +142,29 @@ class TestRobotLink : public QObject {
     QCOMPARE(f.link.takeCommands().size(), size_t{2});
   }
 
-  // A command whose expiry is shorter than the link's one-way delay (half
-  // the measured round trip) is refused as expired.
+  // Expiry is judged against the link's usual delay: with the client's
+  // clock 5000 s off and a constant 1 s one-way delay nothing expires; a
+  // command 300 ms later than the fastest so far expires with a 200 ms
+  // expiry and not with a 500 ms one. Without `sent_ms` nothing is judged.
   void expiredCommands() {
     Fixture f;
     f.hello(1, Role::Control);
     f.link.received(1, LeaseAcquireMsg{}, f.now);
-    f.link.sendHeartbeats(f.now);
-    const HeartbeatMsg ping = f.sentTo<HeartbeatMsg>(1).at(0);
-    f.now += 0.8;  // 800 ms round trip
-    f.link.received(1, ping, f.now);
-    QVERIFY(std::abs(f.link.rttMs(1) - 800) < 1e-6);
-    QCOMPARE(f.command(1, 1, "stop", 300).status, ReplyStatus::Expired);
-    QCOMPARE(f.command(1, 2, "stop", 500).status, ReplyStatus::Ok);
+    auto sent = [&](double delay, uint64_t seq, uint64_t expires) {
+      const auto ms = static_cast<uint64_t>((f.now - delay + 5000) * 1000);
+      f.link.received(1, CommandMsg{seq, expires, "stop", ms}, f.now);
+      auto replies = f.sentTo<ReplyMsg>(1);
+      return replies.empty() ? ReplyMsg{} : replies.back();
+    };
+    for (uint64_t seq = 1; seq <= 20; ++seq) {
+      QCOMPARE(sent(1.0, seq, 100).status, ReplyStatus::Ok);
+      f.now += 0.05;
+    }
+    QCOMPARE(sent(1.3, 21, 500).status, ReplyStatus::Ok);
+    const ReplyMsg late = sent(1.3, 22, 200);
+    QCOMPARE(late.status, ReplyStatus::Expired);
+    QCOMPARE(QString::fromStdString(late.reason), QString("arrived 300 ms later than the link's usual delay, expiry 200 ms"));
+    QCOMPARE(f.command(1, 23, "stop", 1).status, ReplyStatus::Ok);  // no sent_ms: not judged
   }
 
   // Deadman: after random cut times in the holder's keep-alives, the stop
@@ -184,6 +197,59 @@ class TestRobotLink : public QObject {
       worst = std::max(worst, delay);
     }
     qInfo("deadman: worst stop %.1f ms after the last packet over 500 random cuts", worst * 1000);
+  }
+
+  // The deadman judges gaps between arrivals, from the holder's first
+  // keep-alive on: over an emulated link (keep-alives every 50 ms through a
+  // LinkEmulator, in order as TCP delivers) a constant 1 s delay never trips
+  // the LAN deadman of 200 ms, and 2 s +- 0.1 s round trips (1 s +- 0.1 s
+  // each way) stay within a 0.5 s deadman for 60 s. Control: the same jitter
+  // trips the 200 ms deadman.
+  void deadmanUnderDelay_data() {
+    QTest::addColumn<double>("jitter");
+    QTest::addColumn<double>("deadman");
+    QTest::addColumn<bool>("trips");
+    QTest::newRow("constant 1 s, deadman 0.2") << 0.0 << 0.2 << false;
+    QTest::newRow("1 s +- 0.1, deadman 0.5") << 0.1 << 0.5 << false;
+    QTest::newRow("1 s +- 0.1, deadman 0.2 (control)") << 0.1 << 0.2 << true;
+  }
+  void deadmanUnderDelay() {
+    QFETCH(double, jitter);
+    QFETCH(double, deadman);
+    QFETCH(bool, trips);
+    RobotLink link{RobotLinkConfig{"workpartner", kToken, deadman, 10, 50}, nullptr, check};
+    LinkEmulator toRobot({1.0, jitter, 0, 0, true, 7}), toClient({1.0, jitter, 0, 0, true, 8});
+    double now = 1.0;
+    link.connected(1, now);
+    link.received(1, HelloMsg{"far", kToken, Role::Control}, now);
+    link.received(1, LeaseAcquireMsg{}, now);  // arrives now; the grant reaches the client later
+    const double grantSeen = *toClient.schedule(64, now);
+    std::deque<double> arrivals;
+    for (double sent = grantSeen; sent < now + 60; sent += 0.05) arrivals.push_back(*toRobot.schedule(32, sent));
+    for (; now < 61 && !link.failsafeLatched(); now += 0.001) {
+      while (!arrivals.empty() && arrivals.front() <= now) {
+        link.received(1, LeaseKeepaliveMsg{}, arrivals.front());
+        arrivals.pop_front();
+      }
+      link.tick(now);
+    }
+    QCOMPARE(link.failsafeLatched(), trips);
+    QCOMPARE(link.holder(), ClientId{1});
+  }
+
+  // A holder that never confirms its lease loses it after leaseConfirm; the
+  // robot stood still, so nothing latches.
+  void unconfirmedLeaseTakenBack() {
+    RobotLink link{RobotLinkConfig{"workpartner", kToken, 0.2, 3, 50}, nullptr, check};
+    link.connected(1, 1.0);
+    link.received(1, HelloMsg{"silent", kToken, Role::Control}, 1.0);
+    link.received(1, LeaseAcquireMsg{}, 1.0);
+    link.tick(3.9);
+    QCOMPARE(link.holder(), ClientId{1});
+    link.tick(4.1);
+    QCOMPARE(link.holder(), ClientId{0});
+    QVERIFY(!link.failsafeLatched());
+    QVERIFY(std::holds_alternative<StopCmd>(link.takeCommands().at(0)));
   }
 
   // The failsafe latches: a reconnected operator's commands are refused

@@ -50,6 +50,10 @@ SimParams allChanged() {
   p.logRate = 3;
   p.csvRate = 4;
   p.robotPort = 1234;
+  p.linkDeadman = 0.5;
+  p.linkKeepalive = 0.1;
+  p.linkCommandExpiry = 2;
+  p.linkLeaseConfirm = 20;
   p.maxLinearSpeed = 5;
   p.maxAngularSpeed = 6;
   p.maxJointError = 7;
@@ -129,7 +133,7 @@ void TestParams::tableDefaultsAreSimParamsDefaults() {
   std::set<std::string> seen;
   const QRegularExpression keyPattern("^[a-z]+(\\.[a-z_]+)+$");
   const std::vector<ParamInfo> table = paramTable();
-  QCOMPARE(table.size(), size_t(26));
+  QCOMPARE(table.size(), size_t(30));
   for (const ParamInfo& info : table) {
     QVERIFY2(seen.insert(info.key).second, info.key.c_str());
     QVERIFY2(keyPattern.match(q(info.key)).hasMatch(), info.key.c_str());
