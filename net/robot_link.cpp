@@ -90,6 +90,16 @@ void RobotLink::malformed(ClientId client, const std::string& error, double) {
   close(client, "malformed frame: " + error);
 }
 
+void RobotLink::refused(ClientId client, const std::string& error, double) {
+  auto it = clients_.find(client);
+  if (it == clients_.end()) return;
+  if (!it->second.authenticated) {
+    notice("link", who(client) + " closed before HELLO: refused: " + error);
+    return close(client, "refused: " + error);
+  }
+  send(client, ErrorMsg{"refused: " + error});
+}
+
 void RobotLink::received(ClientId client, const Message& message, double now) {
   auto it = clients_.find(client);
   if (it == clients_.end()) return;
@@ -223,6 +233,9 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
           deadmanArmed_ = holder_ != 0;
           notice(toString(EventKind::Rearmed), "re-armed by " + who(client));
           broadcast(EventMsg{EventKind::Rearmed, "re-armed by '" + c.name + "'"});
+        } else if constexpr (std::is_same_v<T, ErrorMsg>) {
+          // A client's own ERROR: noted, never answered (no ping-pong).
+          notice("link", who(client) + " reported an error: " + m.reason);
         } else {
           send(client, ErrorMsg{std::string(toString(typeOf(message))) + " is not sent to the robot"});
         }

@@ -62,6 +62,11 @@ class RobotLink {
   /// A frame from the client could not be decoded: answers ERROR and asks
   /// for the connection to close.
   void malformed(ClientId client, const std::string& error, double now);
+  /// A well-framed message whose content was refused (unknown type, a
+  /// missing or bad key): answers ERROR `refused: <why>`, naming the message
+  /// and the key. Before authentication it also closes the connection (only
+  /// a good HELLO opens one).
+  void refused(ClientId client, const std::string& error, double now);
   /// Checks the deadman; call often (every few ms).
   void tick(double now);
 

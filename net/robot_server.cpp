@@ -54,7 +54,14 @@ class RobotServer::Session {
   bool closed = false;
   uint64_t telemetrySeq = 0, laserSeq = 0, lost = 0;
   LinkEmulator toClient, fromClient;
-  std::deque<std::pair<double, Message>> inbox;  // received, held back by the emulated link
+  // Received, held back by the emulated link: a message, or why its
+  // content was refused.
+  struct Inbound {
+    double due;
+    std::optional<Message> message;
+    std::string refusal;
+  };
+  std::deque<Inbound> inbox;
 };
 
 RobotServer::RobotServer(asio::io_context& io, RobotServerConfig config, RobotPort& robot)
@@ -178,16 +185,16 @@ void RobotServer::received(ClientId id, const std::string& bytes) {
     ++stats_.framesIn;
     std::string error;
     std::optional<Message> message = decodeMessage(*frame, error);
-    // A well-framed message with bad content: refused, connection kept.
-    if (!message) message = ErrorMsg{"refused: " + error};
+    // A well-framed message with bad content: refused, with the reason.
     if (config_.emulation.active()) {
       const std::optional<double> at =
           s.fromClient.schedule(frame->payload.size() + kFrameHeaderSize + kFrameCrcSize, now());
       if (!at) ++stats_.emulatedLost;
-      else s.inbox.emplace_back(*at, std::move(*message));
+      else s.inbox.push_back({*at, std::move(message), error});
       continue;
     }
-    link_.received(id, *message, now());
+    if (message) link_.received(id, *message, now());
+    else link_.refused(id, error, now());
   }
   if (s.decoder.failed()) {
     // A broken frame: the stream cannot be resynchronised; close it.
@@ -202,10 +209,11 @@ void RobotServer::deliverDue() {
   const double t = now();
   for (auto& [id, ptr] : sessions_) {
     Session& s = *ptr;
-    while (!s.closed && !s.inbox.empty() && s.inbox.front().first <= t) {
-      const Message m = std::move(s.inbox.front().second);
+    while (!s.closed && !s.inbox.empty() && s.inbox.front().due <= t) {
+      Session::Inbound in = std::move(s.inbox.front());
       s.inbox.pop_front();
-      link_.received(id, m, t);
+      if (in.message) link_.received(id, *in.message, t);
+      else link_.refused(id, in.refusal, t);
     }
   }
 }

@@ -252,6 +252,29 @@ class TestRobotLink : public QObject {
     QVERIFY(std::holds_alternative<StopCmd>(link.takeCommands().at(0)));
   }
 
+  // A message whose content was refused gets ERROR with the reason (not
+  // "ERROR is not sent to the robot"); before HELLO it also closes, with the
+  // reason rather than "HELLO first". A client's own ERROR is not answered.
+  void refusedMessagesSayWhy() {
+    Fixture f;
+    f.link.connected(1, f.now);
+    f.link.refused(1, "HELLO: key 'token': expected at least 32 hex digits (128 bits), got 31", f.now);
+    auto out = f.link.takeOutgoing();
+    QCOMPARE(out.size(), size_t{1});
+    QCOMPARE(std::get<ErrorMsg>(out[0].message).reason,
+             std::string("refused: HELLO: key 'token': expected at least 32 hex digits (128 bits), got 31"));
+    QCOMPARE(f.link.takeClosing(), std::vector<ClientId>{1});
+    f.hello(2, Role::Control);
+    f.link.takeOutgoing();
+    f.link.refused(2, "COMMAND: missing key 'expires_ms'", f.now);
+    out = f.link.takeOutgoing();
+    QCOMPARE(out.size(), size_t{1});
+    QCOMPARE(std::get<ErrorMsg>(out[0].message).reason, std::string("refused: COMMAND: missing key 'expires_ms'"));
+    QVERIFY(f.link.takeClosing().empty());
+    f.link.received(2, ErrorMsg{"something odd"}, f.now);
+    QVERIFY(f.link.takeOutgoing().empty());
+  }
+
   // The failsafe latches: a reconnected operator's commands are refused
   // until it re-arms.
   void failsafeLatches() {
