@@ -4,12 +4,14 @@
 // hardware.
 
 #include <signal.h>
+#include <unistd.h>
 
 #include <iostream>
 #include <mutex>
 #include <string>
 #include <vector>
 
+#include "app/line_writer.h"
 #include "app/stand_in.h"
 
 namespace {
@@ -42,11 +44,10 @@ constexpr const char* kUsage = R"(usage:
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   sp::StandInOptions options;
-  std::mutex lineMutex;
-  options.lineLog = [&lineMutex](const std::string& line) {
-    std::lock_guard<std::mutex> lock(lineMutex);
-    std::cerr << "simpartner-robot: " << line << "\n";
-  };
+  // The link's lines go through their own thread: the link thread (which
+  // runs the deadman) never waits for a stderr nobody reads.
+  sp::LineWriter lines(STDERR_FILENO, "simpartner-robot: ");
+  options.lineLog = [&lines](const std::string& line) { lines.write(line); };
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--help" || a == "-h") {
@@ -134,8 +135,7 @@ int main(int argc, char** argv) {
   while (sigtimedwait(&stopSignals, nullptr, &poll) < 0) {
     if (!toldLogFailure && robot->logFailed()) {
       toldLogFailure = true;
-      std::lock_guard<std::mutex> lock(lineMutex);
-      std::cerr << "simpartner-robot: error: " << robot->logError() << "; the twin runs on without logging\n";
+      lines.write("error: " + robot->logError() + "; the twin runs on without logging");
     }
   }
   robot->stop();
