@@ -62,6 +62,7 @@ class RobotServer::Session {
     std::string refusal;
   };
   std::deque<Inbound> inbox;
+  double connectedAt = 0;  // [s] for the HELLO timeout
 };
 
 RobotServer::RobotServer(asio::io_context& io, RobotServerConfig config, RobotPort& robot)
@@ -70,7 +71,8 @@ RobotServer::RobotServer(asio::io_context& io, RobotServerConfig config, RobotPo
       robot_(robot),
       link_(config_.link, robot.model(), [&robot](const Command& c) { return robot.check(c); }),
       acceptor_(io),
-      timer_(io) {}
+      timer_(io),
+      acceptRetry_(io) {}
 
 RobotServer::~RobotServer() { stop(); }
 
@@ -104,12 +106,36 @@ void RobotServer::stop() {
   asio::error_code ec;
   acceptor_.close(ec);
   timer_.cancel();
+  acceptRetry_.cancel();
   for (auto& [id, s] : sessions_) s->socket.close(ec);
 }
 
 void RobotServer::accept() {
   acceptor_.async_accept([this](asio::error_code ec, asio::ip::tcp::socket socket) {
-    if (ec || stopped_) return;
+    if (stopped_ || ec == asio::error::operation_aborted) return;
+    if (ec) {
+      // Out of descriptors, say: keep accepting once some are free again
+      // (said at most once a second), never stop for good.
+      ++stats_.acceptErrors;
+      if (config_.log && now() - lastAcceptErrorLog_ >= 1.0) {
+        lastAcceptErrorLog_ = now();
+        config_.log("cannot accept a connection: " + ec.message() + "; trying again");
+      }
+      acceptRetry_.expires_after(std::chrono::milliseconds(100));
+      acceptRetry_.async_wait([this](asio::error_code e) {
+        if (!e && !stopped_) accept();
+      });
+      return;
+    }
+    if (sessions_.size() >= config_.maxConnections) {
+      ++stats_.refusedConnections;
+      if (config_.log)
+        config_.log("connection refused: " + std::to_string(sessions_.size()) + " connections open already (the limit)");
+      asio::error_code ignored;
+      socket.close(ignored);
+      accept();
+      return;
+    }
     asio::error_code ignored;
     socket.set_option(asio::ip::tcp::no_delay(true), ignored);
     // A small kernel send buffer keeps a slow client's backlog in our
@@ -127,6 +153,7 @@ void RobotServer::accept() {
       config_.log("client " + std::to_string(id) + " connected from " +
                   (peerError ? std::string("?") : peer.address().to_string() + ":" + std::to_string(peer.port())));
     }
+    s.connectedAt = now();
     link_.connected(id, now());
     startRead(id);
     accept();
@@ -290,6 +317,21 @@ void RobotServer::onTimer() {
   const double t = now();
   if (config_.emulation.active()) deliverDue();
   link_.tick(t);
+  // Connections that never said HELLO are closed: they would hold a slot
+  // (and a descriptor) for nothing.
+  std::vector<ClientId> silent;
+  // An emulated link holds the HELLO for its delay too.
+  const double helloLimit =
+      config_.helloTimeout + (config_.emulation.active() ? config_.emulation.delay + config_.emulation.jitter : 0);
+  for (const auto& [id, s] : sessions_)
+    if (!s->closed && !s->closing && t - s->connectedAt > helloLimit && !link_.authenticated(id))
+      silent.push_back(id);
+  for (ClientId id : silent) {
+    ++stats_.helloTimeouts;
+    if (config_.log) config_.log("client " + std::to_string(id) + " closed: no HELLO within " +
+                                 std::to_string(static_cast<int>(config_.helloTimeout * 1000)) + " ms");
+    closeSession(id);
+  }
   if (t >= nextHeartbeat_) {
     nextHeartbeat_ = t + 0.5;
     link_.sendHeartbeats(t);

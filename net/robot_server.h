@@ -69,6 +69,11 @@ struct RobotServerConfig {
   RobotLinkConfig link;
   size_t maxQueuedFrames = 64;       ///< per client; telemetry beyond it is dropped and counted
   size_t maxQueuedControl = 1024;    ///< replies and events beyond it close a client that does not read
+  /// Connections open at once; one more is accepted and closed at once
+  /// (logged), so the backlog never fills with clients nobody serves.
+  size_t maxConnections = 64;
+  /// [s] a connection without a good HELLO by then is closed.
+  double helloTimeout = 2.0;
   /// Where the server reports connections, refusals and bad frames (one
   /// line each, no newline); may be empty.
   std::function<void(const std::string&)> log;
@@ -87,6 +92,9 @@ struct RobotServerStats {
   uint64_t badFrames = 0;       ///< connections closed for a malformed frame
   uint64_t telemetryDropped = 0;
   uint64_t emulatedLost = 0;    ///< frames the emulated link dropped (both directions)
+  uint64_t refusedConnections = 0;  ///< closed at once: maxConnections were open
+  uint64_t helloTimeouts = 0;       ///< closed for no HELLO within helloTimeout
+  uint64_t acceptErrors = 0;        ///< accept() failures (out of descriptors, say); accepting goes on
 };
 
 class RobotServer {
@@ -120,6 +128,8 @@ class RobotServer {
   RobotLink link_;
   asio::ip::tcp::acceptor acceptor_;
   asio::steady_timer timer_;
+  asio::steady_timer acceptRetry_;  // after an accept error (out of descriptors): try again soon
+  double lastAcceptErrorLog_ = -1e9;
   // Sessions are owned here; asynchronous handlers hold only their id and
   // look the session up, so a closed session is never touched.
   std::map<ClientId, std::unique_ptr<Session>> sessions_;

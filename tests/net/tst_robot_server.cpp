@@ -5,6 +5,12 @@
 #include <QProcess>
 #include <QtTest>
 
+#include <sys/resource.h>
+
+#include <filesystem>
+#include <functional>
+#include <future>
+
 #include <asio.hpp>
 
 #include <algorithm>
@@ -34,7 +40,8 @@ struct Robot {
   std::unique_ptr<RobotServer> server;
   std::thread thread;
 
-  explicit Robot(LinkEmulatorConfig emulation = {}, SimParams params = {}) {
+  explicit Robot(LinkEmulatorConfig emulation = {}, SimParams params = {},
+                 const std::function<void(RobotServerConfig&)>& tweak = {}) {
     Diagnostics diag;
     auto model = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
     if (!model) qFatal("%s", diag.format().c_str());
@@ -43,6 +50,7 @@ struct Robot {
     config.port = 0;
     config.link.token = kToken;
     config.emulation = emulation;
+    if (tweak) tweak(config);
     server = std::make_unique<RobotServer>(io, config, *host);
     const std::string error = server->start();
     if (!error.empty()) qFatal("%s", error.c_str());
@@ -124,6 +132,69 @@ class TestRobotServer : public QObject {
   Q_OBJECT
 
  private slots:
+  // A connection that never says HELLO is closed after the HELLO timeout;
+  // an authenticated one on the same robot stays.
+  void silentConnectionsClosed() {
+    Robot robot({}, {}, [](RobotServerConfig& c) { c.helloTimeout = 0.3; });
+    Client silent(robot.server->port()), talker(robot.server->port());
+    talker.hello(Role::Monitor, "talker");
+    QVERIFY(!silent.next(1.5));
+    QVERIFY(silent.eof);
+    QVERIFY(talker.waitFor<TelemetryMsg>(1.0));
+    QVERIFY(!talker.eof);
+  }
+
+  // Beyond maxConnections a connection is accepted and closed at once; once
+  // one closes, the next is served.
+  void connectionCap() {
+    Robot robot({}, {}, [](RobotServerConfig& c) { c.maxConnections = 2; });
+    auto a = std::make_unique<Client>(robot.server->port());
+    Client b(robot.server->port());
+    a->hello(Role::Monitor, "a");
+    b.hello(Role::Monitor, "b");
+    Client c(robot.server->port());
+    QVERIFY(!c.next(1.0));
+    QVERIFY(c.eof);
+    a.reset();
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    Client d(robot.server->port());
+    d.hello(Role::Monitor, "d");
+  }
+
+  // Out of file descriptors, accepting fails for a while but never stops:
+  // with the limit back and descriptors free, the next client is served.
+  void acceptSurvivesDescriptorExhaustion() {
+    Robot robot;
+    rlimit old{};
+    QVERIFY(getrlimit(RLIMIT_NOFILE, &old) == 0);
+    int open = 0;
+    for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd")) (void)entry, ++open;
+    rlimit tight = old;
+    tight.rlim_cur = static_cast<rlim_t>(open + 12);
+    QVERIFY(setrlimit(RLIMIT_NOFILE, &tight) == 0);
+    std::vector<std::unique_ptr<asio::ip::tcp::socket>> hogs;
+    asio::io_context io;
+    for (int i = 0; i < 40; ++i) {
+      auto s = std::make_unique<asio::ip::tcp::socket>(io);
+      asio::error_code ec;
+      s->connect({asio::ip::make_address("127.0.0.1"), robot.server->port()}, ec);
+      if (ec) break;
+      hogs.push_back(std::move(s));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the server meets EMFILE meanwhile
+    hogs.clear();
+    QVERIFY(setrlimit(RLIMIT_NOFILE, &old) == 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    Client late(robot.server->port());
+    late.hello(Role::Monitor, "late");
+    QVERIFY(late.waitFor<TelemetryMsg>(1.0));
+    // It did run out (else this test proves nothing).
+    std::promise<uint64_t> errors;
+    asio::post(robot.io, [&] { errors.set_value(robot.server->stats().acceptErrors); });
+    const uint64_t acceptErrors = errors.get_future().get();
+    QVERIFY2(acceptErrors > 0, "the server never met the descriptor limit");
+  }
+
   // A wrong token gets ERROR and the connection is closed.
   void wrongToken() {
     Robot robot;
