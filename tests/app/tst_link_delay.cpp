@@ -16,6 +16,7 @@
 
 #include "app/stand_in.h"
 #include "net/robot_client.h"
+#include "tests/app/shared_state.h"
 
 using namespace sp;
 using namespace sp::net;
@@ -26,27 +27,12 @@ namespace {
 const std::string kToken = "00112233445566778899aabbccddeeff";
 
 // What the client's callbacks report (on its thread), for the test's thread.
-struct Seen {
-  std::mutex mutex;
-  std::condition_variable cv;
+struct Seen : sp::test::SharedState {
   bool ready = false, lease = false;
   std::optional<ReplyMsg> reply;
   int failsafes = 0;
   std::optional<TelemetryMsg> telemetry;
 
-  template <typename F>
-  void add(F f) {
-    {
-      std::lock_guard lock(mutex);
-      f();
-    }
-    cv.notify_all();
-  }
-  template <typename P>
-  bool waitFor(P pred, std::chrono::seconds limit) {
-    std::unique_lock lock(mutex);
-    return cv.wait_for(lock, limit, pred);
-  }
   RobotClientCallbacks callbacks() {
     RobotClientCallbacks cb;
     cb.connection = [this](ConnectionState s, const std::string&) { add([&] { ready = s == ConnectionState::Ready; }); };

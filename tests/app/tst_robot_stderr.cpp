@@ -25,6 +25,7 @@
 #include <thread>
 
 #include "net/robot_client.h"
+#include "tests/app/shared_state.h"
 
 extern char** environ;
 
@@ -36,24 +37,9 @@ namespace {
 
 const std::string kToken = "00112233445566778899aabbccddeeff";
 
-struct Seen {
-  std::mutex mutex;
-  std::condition_variable cv;
+struct Seen : sp::test::SharedState {
   bool ready = false, lease = false, ok = false;
   Clock::time_point failsafeAt{};
-  template <typename F>
-  void add(F f) {
-    {
-      std::lock_guard lock(mutex);
-      f();
-    }
-    cv.notify_all();
-  }
-  template <typename P>
-  bool waitFor(P pred, std::chrono::milliseconds limit) {
-    std::unique_lock lock(mutex);
-    return cv.wait_for(lock, limit, pred);
-  }
 };
 
 }  // namespace

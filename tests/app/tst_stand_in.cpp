@@ -24,6 +24,7 @@
 #include "app/session_log.h"
 #include "app/stand_in.h"
 #include "net/robot_client.h"
+#include "tests/app/shared_state.h"
 
 using namespace sp;
 using namespace sp::net;
@@ -46,26 +47,11 @@ StandInOptions options(const std::string& logPath) {
 }
 
 // What a client's callbacks report (on its thread), for the test's thread.
-struct Seen {
-  std::mutex mutex;
-  std::condition_variable cv;
+struct Seen : sp::test::SharedState {
   bool ready = false, lease = false;
   std::vector<ReplyMsg> replies;
   std::vector<EventKind> events;
 
-  template <typename F>
-  void add(F f) {
-    {
-      std::lock_guard lock(mutex);
-      f();
-    }
-    cv.notify_all();
-  }
-  template <typename P>
-  bool waitFor(P pred) {
-    std::unique_lock lock(mutex);
-    return cv.wait_for(lock, 5s, pred);
-  }
   RobotClientCallbacks callbacks() {
     RobotClientCallbacks cb;
     cb.connection = [this](ConnectionState s, const std::string&) { add([&] { ready = s == ConnectionState::Ready; }); };
