@@ -7,6 +7,7 @@
 #include "app/headless_runner.h"
 #include "app/session_recorder.h"
 #include "app/twin_host.h"
+#include "net/auth.h"
 #include "net/robot_server.h"
 #include "sim/model_loader.h"
 
@@ -80,6 +81,8 @@ std::string StandInRobot::start() {
   config.link.telemetryRate = params_.telemetryRate;
   config.link.deadman = params_.linkDeadman;
   config.link.leaseConfirm = params_.linkLeaseConfirm;
+  config.maxConnections = static_cast<size_t>(params_.linkMaxConnections);
+  config.helloTimeout = params_.linkHelloTimeout;
   config.emulation = options_.emulation;
   // Both run on the server's thread; the host queues log events for the
   // physics thread, which stamps them with the twin's step and time.

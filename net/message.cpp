@@ -5,11 +5,14 @@
 #include <cmath>
 #include <cstdio>
 #include <iterator>
+#include <limits>
 #include <string_view>
 #include <system_error>
 #include <type_traits>
 
+#include "sim/command_check.h"
 #include "sim/command_file.h"
+#include "sim/robot_model.h"
 
 namespace sp::net {
 namespace {
@@ -22,7 +25,8 @@ constexpr size_t kQuoteMax = 40;  // bytes of a value quoted in an error
 constexpr const char* kTypeNames[] = {
     "HELLO",     "WELCOME", "LEASE_ACQUIRE", "LEASE_KEEPALIVE", "LEASE_RELEASE",
     "LEASE_STATE", "COMMAND", "REPLY",       "TELEMETRY",       "LASER",
-    "HEARTBEAT", "ESTOP",   "REARM",         "EVENT",           "ERROR"};
+    "HEARTBEAT", "ESTOP",   "REARM",         "EVENT",           "ERROR",
+    "CHALLENGE", "LIMITS"};
 constexpr const char* kRoleNames[] = {"control", "monitor"};
 constexpr const char* kStatusNames[] = {"ok",   "invalid", "out_of_limits", "not_owner",
                                         "busy", "failed",  "expired",       "duplicate"};
@@ -156,8 +160,9 @@ void forEachField(M& m, F& f) {
   constexpr Need R = Need::Required;
   if constexpr (std::is_same_v<T, HelloMsg>) {
     f("name", m.name, R);
-    f("token", m.token, R);
     f("role", m.role, R);
+    f("proof", m.proof, Need::Optional);
+    f("token", m.token, Need::Optional);
   } else if constexpr (std::is_same_v<T, WelcomeMsg>) {
     f("robot", m.robot, R);
     f("session", m.session, R);
@@ -208,6 +213,17 @@ void forEachField(M& m, F& f) {
     f("text", m.text, Need::Optional);
   } else if constexpr (std::is_same_v<T, ErrorMsg>) {
     f("reason", m.reason, R);
+  } else if constexpr (std::is_same_v<T, ChallengeMsg>) {
+    f("nonce", m.nonce, R);
+  } else if constexpr (std::is_same_v<T, LimitsMsg>) {
+    f("joints", m.joints, R);
+    f("lower", m.lower, R);
+    f("upper", m.upper, R);
+    f("max_velocity", m.maxVelocity, R);
+    f("max_torque", m.maxTorque, R);
+    f("drive_speed", m.driveSpeed, Need::Optional);
+    f("wheel_speed", m.wheelSpeed, Need::Optional);
+    f("articulation", m.articulation, Need::Optional);
   } else {
     // LEASE_ACQUIRE, LEASE_KEEPALIVE, LEASE_RELEASE, REARM: no keys.
     static_assert(std::is_empty_v<T>);
@@ -219,10 +235,36 @@ void forEachField(M& m, F& f) {
 struct Validator {
   std::string operator()(const HelloMsg& m) const {
     if (m.name.empty()) return "key 'name': must not be empty";
+    if (m.proof.empty() == m.token.empty())
+      return m.proof.empty() ? "missing key 'proof' (or, on loopback, 'token')" : "keys 'proof' and 'token': send one, not both";
+    if (!m.token.empty()) return hexDigits("token", m.token, 32, "at least 32 hex digits (128 bits)");
+    if (m.proof.size() != 64) return "key 'proof': expected 64 hex digits (HMAC-SHA256), got " + std::to_string(m.proof.size());
+    return hexDigits("proof", m.proof, 64, "64 hex digits (HMAC-SHA256)");
+  }
+  std::string operator()(const ChallengeMsg& m) const {
+    return hexDigits("nonce", m.nonce, 32, "at least 32 hex digits (128 bits)");
+  }
+  std::string operator()(const LimitsMsg& m) const {
+    for (size_t i = 0; i < m.joints.size(); ++i)
+      if (m.joints[i].empty() || m.joints[i].find(' ') != std::string::npos)
+        return "key 'joints': name " + std::to_string(i + 1) + " is empty or contains a space";
+    const std::pair<const char*, size_t> lists[] = {{"lower", m.lower.size()},
+                                                    {"upper", m.upper.size()},
+                                                    {"max_velocity", m.maxVelocity.size()},
+                                                    {"max_torque", m.maxTorque.size()}};
+    for (const auto& [key, n] : lists)
+      if (n != m.joints.size())
+        return std::string("key '") + key + "': expected " + std::to_string(m.joints.size()) +
+               " numbers (one per joint), got " + std::to_string(n);
+    if (m.articulation.find(' ') != std::string::npos) return "key 'articulation': contains a space";
+    return {};
+  }
+  // A run of at least `min` hex digits; never quotes the value (a token).
+  static std::string hexDigits(const char* key, const std::string& value, size_t min, const char* expected) {
     const auto hex = [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F'); };
-    if (!std::all_of(m.token.begin(), m.token.end(), hex)) return "key 'token': expected hex digits only";
-    if (m.token.size() < 32)
-      return "key 'token': expected at least 32 hex digits (128 bits), got " + std::to_string(m.token.size());
+    if (!std::all_of(value.begin(), value.end(), hex)) return std::string("key '") + key + "': expected hex digits only";
+    if (value.size() < min)
+      return std::string("key '") + key + "': expected " + expected + ", got " + std::to_string(value.size());
     return {};
   }
   std::string operator()(const WelcomeMsg& m) const {
@@ -289,7 +331,10 @@ struct Encoder {
     else out += names[value];
   }
 
-  void operator()(const char* key, const std::string& v, Need) { line(key, [&] { text(key, v); }); }
+  void operator()(const char* key, const std::string& v, Need need) {
+    if (need == Need::Optional && v.empty()) return;
+    line(key, [&] { text(key, v); });
+  }
   // An optional number at its default (0) is left out: older peers never
   // see keys they do not know unless the value means something.
   void operator()(const char* key, uint64_t v, Need need) {
@@ -478,6 +523,26 @@ Message messageOfIndex(size_t i) {
   return Message(std::in_place_index<I>);
 }
 
+// The frame of `type` with `payload`, or nullopt and the error encodeMessage() gives.
+std::optional<std::string> frameOf(MessageType type, const std::string& payload, std::string& error) {
+  std::optional<std::string> frame = encodeFrame(static_cast<uint8_t>(type), payload);
+  if (!frame)
+    error = std::string(toString(type)) + ": payload of " + std::to_string(payload.size()) +
+            " bytes exceeds the maximum " + std::to_string(kMaxPayloadSize);
+  return frame;
+}
+
+// Where the line of `key` starts in a payload (keys start lines; values
+// hold no line feed, so "\nkey=" cannot occur inside a value).
+size_t lineOf(const std::string& payload, const char* key) {
+  const std::string prefix = key + std::string("=");
+  if (payload.compare(0, prefix.size(), prefix) == 0) return 0;
+  const size_t at = payload.find("\n" + prefix);
+  return at == std::string::npos ? at : at + 1;
+}
+size_t endOfLine(const std::string& payload, size_t start) { return payload.find('\n', start) + 1; }
+
+
 }  // namespace
 
 static_assert(std::variant_size_v<Message> == kLastMessageType);
@@ -514,11 +579,7 @@ std::optional<std::string> encodePayload(const Message& message, std::string& er
 std::optional<std::string> encodeMessage(const Message& message, std::string& error) {
   std::optional<std::string> payload = encodePayload(message, error);
   if (!payload) return std::nullopt;
-  std::optional<std::string> frame = encodeFrame(static_cast<uint8_t>(typeOf(message)), *payload);
-  if (!frame)
-    error = std::string(toString(typeOf(message))) + ": payload of " + std::to_string(payload->size()) +
-            " bytes exceeds the maximum " + std::to_string(kMaxPayloadSize);
-  return frame;
+  return frameOf(typeOf(message), *payload, error);
 }
 
 std::optional<Message> decodeMessage(const Frame& frame, std::string& error) {
@@ -571,6 +632,77 @@ std::optional<Message> decodeMessage(const Frame& frame, std::string& error) {
   if (!decoder.error.empty()) return fail(decoder.error);
   if (std::string problem = validate(message); !problem.empty()) return fail(problem);
   return message;
+}
+
+TelemetryFanOut::TelemetryFanOut(const TelemetryMsg& common) {
+  std::optional<std::string> payload = encodePayload(common, error_);
+  if (!payload) return;
+  // Laid out as seq, ..., rtt_ms, lost, ... (forEachField's order).
+  const size_t afterSeq = endOfLine(*payload, lineOf(*payload, "seq"));
+  const size_t rtt = lineOf(*payload, "rtt_ms");
+  const size_t afterLost = endOfLine(*payload, lineOf(*payload, "lost"));
+  middle_ = payload->substr(afterSeq, rtt - afterSeq);
+  tail_ = payload->substr(afterLost);
+}
+
+std::optional<std::string> TelemetryFanOut::frame(uint64_t seq, double rttMs, uint64_t lost, std::string& error) const {
+  if (!error_.empty()) {
+    error = error_;
+    return std::nullopt;
+  }
+  std::string payload = "seq=";
+  payload.reserve(middle_.size() + tail_.size() + 64);
+  appendNumber(payload, seq);
+  payload += '\n';
+  payload += middle_;
+  payload += "rtt_ms=";
+  appendNumber(payload, rttMs);
+  payload += "\nlost=";
+  appendNumber(payload, lost);
+  payload += '\n';
+  payload += tail_;
+  return frameOf(MessageType::Telemetry, payload, error);
+}
+
+LaserFanOut::LaserFanOut(const LaserMsg& common) {
+  std::optional<std::string> payload = encodePayload(common, error_);
+  if (payload) tail_ = payload->substr(endOfLine(*payload, lineOf(*payload, "seq")));
+}
+
+std::optional<std::string> LaserFanOut::frame(uint64_t seq, std::string& error) const {
+  if (!error_.empty()) {
+    error = error_;
+    return std::nullopt;
+  }
+  std::string payload = "seq=";
+  payload.reserve(tail_.size() + 32);
+  appendNumber(payload, seq);
+  payload += '\n';
+  payload += tail_;
+  return frameOf(MessageType::Laser, payload, error);
+}
+
+LimitsMsg limitsOf(const RobotModel& robot) {
+  LimitsMsg out;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  for (const ActuatorSpec& a : robot.actuators) {
+    if (a.joint < 0 || static_cast<size_t>(a.joint) >= robot.joints.size()) continue;
+    const JointSpec& joint = robot.joints[a.joint];
+    out.joints.push_back(joint.name);
+    out.lower.push_back(joint.limited ? joint.lower : -inf);
+    out.upper.push_back(joint.limited ? joint.upper : inf);
+    out.maxVelocity.push_back(a.maxVelocity);
+    out.maxTorque.push_back(a.maxTorque);
+  }
+  if (robot.drive) {
+    out.driveSpeed = driveSpeedLimit(robot);
+    out.wheelSpeed = inf;
+    for (int w : robot.drive->wheels)
+      if (const int a = robot.findActuator(robot.joints[w].name); a >= 0)
+        out.wheelSpeed = std::min(out.wheelSpeed, robot.actuators[a].maxVelocity);
+    out.articulation = robot.joints[robot.drive->articulation].name;
+  }
+  return out;
 }
 
 CommandMsg makeCommandMsg(uint64_t seq, uint64_t expiresMs, const Command& command, const RobotModel* robot) {

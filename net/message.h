@@ -52,9 +52,11 @@ enum class MessageType : uint8_t {
   Rearm = 13,          ///< C: clears a latched failsafe or e-stop
   Event = 14,          ///< R: failsafe, divergence, e-stop, re-armed, link
   Error = 15,          ///< C and R: a message was refused
+  Challenge = 16,      ///< R: first message on a connection: the nonce HELLO's proof covers
+  Limits = 17,         ///< R: after WELCOME: the robot's joint and drive limits
 };
 inline constexpr uint8_t kFirstMessageType = 1;
-inline constexpr uint8_t kLastMessageType = 15;
+inline constexpr uint8_t kLastMessageType = 17;
 
 /// "HELLO", "LEASE_ACQUIRE", ... as in docs/protocol.md.
 const char* toString(MessageType type);
@@ -71,11 +73,16 @@ const char* toString(Role role);                  ///< "control", "monitor"
 const char* toString(ReplyStatus status);         ///< "ok", "out_of_limits", ...
 const char* toString(EventKind kind);             ///< "failsafe", ...
 
-/// HELLO: keys `name`, `token`, `role`.
+/// HELLO: keys `name`, `role`, and `proof` or (loopback only) `token`.
 struct HelloMsg {
   std::string name;   ///< the client's name, not empty; shown to other clients
-  std::string token;  ///< shared secret, at least 32 hex digits (128 bits)
+  /// The shared secret in clear (optional key `token`, >= 32 hex digits):
+  /// accepted only by a robot listening on loopback.
+  std::string token;
   Role role = Role::Monitor;
+  /// HMAC-SHA256 over the robot's CHALLENGE nonce, the name and the role,
+  /// keyed by the token (optional key `proof`, 64 hex digits; net/auth.h).
+  std::string proof;
   friend bool operator==(const HelloMsg&, const HelloMsg&) = default;
 };
 /// WELCOME: keys `robot`, `session`, `telemetry_rate`.
@@ -188,11 +195,32 @@ struct ErrorMsg {
   friend bool operator==(const ErrorMsg&, const ErrorMsg&) = default;
 };
 
+/// CHALLENGE: key `nonce`.
+struct ChallengeMsg {
+  std::string nonce;  ///< fresh random hex digits (at least 32) for this connection's HELLO proof
+  friend bool operator==(const ChallengeMsg&, const ChallengeMsg&) = default;
+};
+/// LIMITS: keys `joints`, `lower`, `upper`, `max_velocity`, `max_torque`
+/// (one number per joint), and for a robot with a drive `drive_speed`,
+/// `wheel_speed`, `articulation` (optional). What the robot refuses as
+/// `out_of_limits`, so that a client can refuse it before sending.
+struct LimitsMsg {
+  std::vector<std::string> joints;  ///< the actuated joints (names without spaces)
+  /// [rad or m] per joint; -inf and inf for a joint without limits.
+  std::vector<double> lower, upper;
+  std::vector<double> maxVelocity;  ///< [rad/s or m/s] per joint
+  std::vector<double> maxTorque;    ///< [N m or N] per joint
+  double driveSpeed = 0;            ///< [m/s] top speed of drive/turn (0: no drive)
+  double wheelSpeed = 0;            ///< [rad/s] the slowest wheel motor's top speed (0: no drive)
+  std::string articulation;         ///< the steering hinge's joint name ("" = no drive)
+  friend bool operator==(const LimitsMsg&, const LimitsMsg&) = default;
+};
+
 /// Any message. The alternatives are in type-code order: index() + 1 is the
 /// MessageType.
 using Message = std::variant<HelloMsg, WelcomeMsg, LeaseAcquireMsg, LeaseKeepaliveMsg, LeaseReleaseMsg,
                              LeaseStateMsg, CommandMsg, ReplyMsg, TelemetryMsg, LaserMsg, HeartbeatMsg,
-                             EstopMsg, RearmMsg, EventMsg, ErrorMsg>;
+                             EstopMsg, RearmMsg, EventMsg, ErrorMsg, ChallengeMsg, LimitsMsg>;
 
 MessageType typeOf(const Message& message);
 
@@ -207,12 +235,44 @@ std::optional<std::string> encodePayload(const Message& message, std::string& er
 /// of more than some 3400 full-precision ranges); never cut.
 std::optional<std::string> encodeMessage(const Message& message, std::string& error);
 
+/// One TELEMETRY state for many clients: the payload is encoded once and
+/// only the per-connection keys (`seq`, `rtt_ms`, `lost`) are written per
+/// client; frame() is byte for byte what encodeMessage() makes of the same
+/// message. The robot's fan-out, where encoding per client cost 500 idle
+/// monitors the controller's round trip (bench/bench_link).
+class TelemetryFanOut {
+ public:
+  /// `common`'s seq, rttMs and lost are ignored.
+  explicit TelemetryFanOut(const TelemetryMsg& common);
+  /// The frame for one client; nullopt and `error` as encodeMessage().
+  std::optional<std::string> frame(uint64_t seq, double rttMs, uint64_t lost, std::string& error) const;
+
+ private:
+  std::string error_;
+  std::string middle_;  // the lines between `seq` and `rtt_ms`
+  std::string tail_;    // the lines after `lost`
+};
+
+/// LASER for many clients, as TelemetryFanOut: only `seq` differs.
+class LaserFanOut {
+ public:
+  explicit LaserFanOut(const LaserMsg& common);
+  std::optional<std::string> frame(uint64_t seq, std::string& error) const;
+
+ private:
+  std::string error_;
+  std::string tail_;  // the lines after `seq`
+};
+
 /// The message in `frame`; on error nullopt and `error` names the type and,
 /// where there is one, the key or line, e.g. `COMMAND: missing key 'seq'`,
 /// `COMMAND: key 'seq': expected an unsigned integer, got '-1'`,
 /// `unknown message type 200`. Values are quoted at most 40 bytes long with
 /// control characters escaped; a bad token is never echoed.
 std::optional<Message> decodeMessage(const Frame& frame, std::string& error);
+
+/// The limits `robot` enforces on commands (sp::checkCommand), for LIMITS.
+LimitsMsg limitsOf(const RobotModel& robot);
 
 /// A COMMAND carrying `command` as text (sp::toText: degrees for hinges,
 /// metres for the slider joints of `robot`; without a robot every joint is

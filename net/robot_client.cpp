@@ -13,6 +13,7 @@
 #include <thread>
 #include <utility>
 
+#include "net/auth.h"
 #include "net/frame.h"
 
 namespace sp::net {
@@ -99,6 +100,11 @@ class RobotClient::Impl {
   RobotClientStats stats() const {
     std::lock_guard lock(statsMutex_);
     return stats_;
+  }
+
+  std::optional<LimitsMsg> limits() const {
+    std::lock_guard lock(statsMutex_);
+    return limits_;
   }
 
   const RobotClientConfig config_;
@@ -275,7 +281,7 @@ class RobotClient::Impl {
     if (everConnected_) updateStats([](RobotClientStats& s) { ++s.reconnects; });
     everConnected_ = true;
     setState(ConnectionState::Authenticating, config_.host + ":" + std::to_string(config_.port));
-    send(HelloMsg{config_.name, config_.token, config_.role});
+    // HELLO answers the robot's CHALLENGE (handle(ChallengeMsg)).
     read();
   }
 
@@ -429,6 +435,20 @@ class RobotClient::Impl {
         *message);
   }
 
+  void handle(const ChallengeMsg& m) {
+    if (ready_) return;
+    // The token never leaves: the proof covers this connection's nonce only.
+    send(HelloMsg{config_.name, {}, config_.role, helloProof(config_.token, m.nonce, config_.name, config_.role)});
+  }
+
+  void handle(const LimitsMsg& m) {
+    {
+      std::lock_guard lock(statsMutex_);
+      limits_ = m;
+    }
+    if (cb_.limits) cb_.limits(m);
+  }
+
   void handle(const WelcomeMsg& m) {
     if (ready_) return;
     ready_ = true;
@@ -571,6 +591,7 @@ class RobotClient::Impl {
 
   mutable std::mutex statsMutex_;
   RobotClientStats stats_;  ///< under statsMutex_
+  std::optional<LimitsMsg> limits_;  ///< under statsMutex_
 
  public:
   // Declared before everything that uses it, so destroyed after.
@@ -643,6 +664,7 @@ void RobotClient::setEmulation(const LinkEmulatorConfig& emulation) {
 }
 
 RobotClientStats RobotClient::stats() const { return impl_->stats(); }
+std::optional<LimitsMsg> RobotClient::limits() const { return impl_->limits(); }
 const RobotClientConfig& RobotClient::config() const { return impl_->config_; }
 
 }  // namespace sp::net

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "net/link_emulator.h"
@@ -38,7 +39,9 @@ struct RobotClientConfig {
   std::string host = "127.0.0.1";  ///< name or address of the robot
   uint16_t port = 47800;           ///< the robot's `port.robot`
   std::string name = "console";    ///< HELLO `name`: shown to other clients as the lease holder
-  std::string token;               ///< HELLO `token`: the robot's shared secret, >= 32 hex digits
+  /// The robot's shared secret, >= 32 hex digits: keys HELLO's `proof` over
+  /// the robot's CHALLENGE; never sent.
+  std::string token;
   Role role = Role::Control;       ///< HELLO `role`: Monitor never asks for the lease
 
   double reconnectMin = 0.2;  ///< [s] wait before the first reconnect after a drop or failed connect
@@ -128,6 +131,8 @@ struct RobotClientCallbacks {
   /// ERRORs from the robot (a message of ours it refused), and local notices
   /// prefixed `client: ` (an ESTOP or REARM that could not be sent).
   std::function<void(const ErrorMsg&)> error;
+  /// The robot's LIMITS (after WELCOME on each connection).
+  std::function<void(const LimitsMsg&)> limits;
   /// Each heartbeat round trip [ms], as measured (for plots and benchmarks).
   std::function<void(double rttMs)> rtt;
 };
@@ -201,6 +206,8 @@ class RobotClient {
 
   /// A copy of the statistics. Thread-safe (a short lock).
   RobotClientStats stats() const;
+  /// The robot's last LIMITS; nullopt before the first. Thread-safe.
+  std::optional<LimitsMsg> limits() const;
   /// The configuration given to the constructor.
   const RobotClientConfig& config() const;
 

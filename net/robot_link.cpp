@@ -2,26 +2,29 @@
 
 #include <algorithm>
 
-namespace sp::net {
+#include "net/auth.h"
 
-bool equalConstantTime(const std::string& a, const std::string& b) {
-  // Runs over the longer string whatever the contents, so the time taken
-  // tells nothing about where the first difference is.
-  const size_t n = std::max(a.size(), b.size());
-  unsigned char diff = a.size() == b.size() ? 0 : 1;
-  for (size_t i = 0; i < n; ++i) {
-    const unsigned char x = i < a.size() ? static_cast<unsigned char>(a[i]) : 0;
-    const unsigned char y = i < b.size() ? static_cast<unsigned char>(b[i]) : 0;
-    diff = static_cast<unsigned char>(diff | (x ^ y));
-  }
-  return diff == 0;
-}
+namespace sp::net {
 
 RobotLink::RobotLink(RobotLinkConfig config, const RobotModel* robot,
                      std::function<CommandCheck(const Command&)> check)
     : config_(std::move(config)), robot_(robot), check_(std::move(check)) {}
 
-void RobotLink::connected(ClientId client, double) { clients_[client] = Client{}; }
+void RobotLink::connected(ClientId client, double) {
+  Client c;
+  c.nonce = randomHex(16);
+  send(client, ChallengeMsg{c.nonce});
+  clients_[client] = std::move(c);
+}
+
+std::string RobotLink::authenticationProblem(const Client& c, const HelloMsg& hello) const {
+  if (config_.token.empty()) return "the robot has no token";
+  if (!hello.token.empty()) {
+    if (!config_.clearTokenAllowed) return "a token in clear is accepted on loopback only: send 'proof'";
+    return equalConstantTime(hello.token, config_.token) ? "" : "wrong token";
+  }
+  return equalConstantTime(hello.proof, helloProof(config_.token, c.nonce, hello.name, hello.role)) ? "" : "wrong proof";
+}
 
 void RobotLink::disconnected(ClientId client, double now) {
   const std::string name = who(client);
@@ -107,15 +110,18 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
 
   if (const auto* hello = std::get_if<HelloMsg>(&message)) {
     if (c.authenticated) return send(client, ErrorMsg{"already authenticated"});
-    if (config_.token.empty() || !equalConstantTime(hello->token, config_.token)) {
-      notice("link", who(client) + " refused: authentication failed");
-      return close(client, "authentication failed");
+    // The client learns only that it failed; the log says why.
+    if (const std::string problem = authenticationProblem(c, *hello); !problem.empty()) {
+      notice("link", who(client) + " refused: authentication failed: " + problem);
+      return close(client, problem.starts_with("a token in clear") ? "authentication failed: " + problem
+                                                                    : "authentication failed");
     }
     c.authenticated = true;
     c.name = hello->name;
     c.role = hello->role;
     notice("link", who(client) + " authenticated as " + toString(c.role));
     send(client, WelcomeMsg{config_.robotName, ++session_, config_.telemetryRate, config_.deadman});
+    if (robot_) send(client, limitsOf(*robot_));
     const std::string holderName = holder_ ? clients_[holder_].name : std::string();
     send(client, LeaseStateMsg{holderName, false});
     if (failsafe_) send(client, EventMsg{EventKind::Failsafe, "failsafe latched: re-arm to move"});

@@ -41,10 +41,12 @@ struct RobotLinkConfig {
   /// that first arrival; the robot stands still meanwhile.
   double leaseConfirm = 10;
   double telemetryRate = 50;    ///< [Hz], announced in WELCOME
+  /// Whether a HELLO may carry the token in clear (`token`) instead of a
+  /// proof over this connection's CHALLENGE: only for a robot listening on
+  /// loopback, where nobody without the machine can read the link
+  /// (RobotServer sets it from the address it binds).
+  bool clearTokenAllowed = false;
 };
-
-/// Constant-time comparison (no early exit), for tokens.
-bool equalConstantTime(const std::string& a, const std::string& b);
 
 class RobotLink {
  public:
@@ -53,7 +55,10 @@ class RobotLink {
   /// picks the reply (out_of_limits or invalid).
   RobotLink(RobotLinkConfig config, const RobotModel* robot, std::function<CommandCheck(const Command&)> check);
 
+  /// A new connection: sends it a CHALLENGE with a fresh nonce.
   void connected(ClientId client, double now);
+  /// See RobotLinkConfig::clearTokenAllowed.
+  void setClearTokenAllowed(bool allowed) { config_.clearTokenAllowed = allowed; }
   /// Drops the client; a lease holder's lease is released (the deadman
   /// then fires, and the failsafe latches, as for any lost holder).
   void disconnected(ClientId client, double now);
@@ -120,6 +125,7 @@ class RobotLink {
     bool authenticated = false;
     std::string name;
     Role role = Role::Monitor;
+    std::string nonce;  // this connection's CHALLENGE
     uint64_t lastSeq = 0;
     bool anySeq = false;
     double rttMs = 0;
@@ -137,6 +143,8 @@ class RobotLink {
   void heardFromHolder(double now);
   void close(ClientId client, const std::string& reason);
   void notice(std::string kind, std::string text);
+  /// Why `hello` does not authenticate on connection `c`; "" if it does.
+  std::string authenticationProblem(const Client& c, const HelloMsg& hello) const;
   /// "'NAME' (client N)" for notices.
   std::string who(ClientId client) const;
 

@@ -1,17 +1,8 @@
 #include "net/robot_server.h"
 
 #include <chrono>
-#include <random>
 
 namespace sp::net {
-
-std::string randomToken() {
-  std::random_device device;
-  std::string token;
-  static const char* hex = "0123456789abcdef";
-  for (int i = 0; i < 32; ++i) token += hex[device() & 15u];
-  return token;
-}
 
 /// One client connection: its socket, decoder and bounded write queue.
 class RobotServer::Session {
@@ -85,6 +76,7 @@ std::string RobotServer::start() {
   asio::error_code ec;
   const asio::ip::address address = asio::ip::make_address(config_.address, ec);
   if (ec) return "bad address '" + config_.address + "': " + ec.message();
+  link_.setClearTokenAllowed(address.is_loopback());
   const asio::ip::tcp::endpoint endpoint(address, config_.port);
   acceptor_.open(endpoint.protocol(), ec);
   if (!ec) acceptor_.set_option(asio::ip::tcp::acceptor::reuse_address(true), ec);
@@ -178,31 +170,35 @@ void RobotServer::startRead(ClientId id) {
   });
 }
 
-void RobotServer::enqueue(Session& s, const Message& message, bool telemetry) {
+bool RobotServer::telemetryRoom(Session& s) {
+  if (s.telemetryWaiting(now(), !config_.emulation.active() || config_.emulation.keepOrder) < config_.maxQueuedFrames)
+    return true;
+  // A slow reader loses telemetry; the control loop never waits for it.
+  ++s.lost;
+  ++stats_.telemetryDropped;
+  return false;
+}
+
+void RobotServer::enqueue(Session& s, const Message& message) {
   std::string error;
-  std::optional<std::string> frame = encodeMessage(message, error);
-  if (!frame) return;
-  if (telemetry && s.telemetryWaiting(now(), !config_.emulation.active() || config_.emulation.keepOrder) >=
-                       config_.maxQueuedFrames) {
-    // A slow reader loses telemetry; the control loop never waits for it.
-    ++s.lost;
-    ++stats_.telemetryDropped;
-    return;
-  }
+  if (std::optional<std::string> frame = encodeMessage(message, error)) enqueueFrame(s, std::move(*frame), false);
+}
+
+void RobotServer::enqueueFrame(Session& s, std::string frame, bool telemetry) {
   if (!telemetry && s.queue.size() >= config_.maxQueuedControl) {
     s.closing = true;  // a client that does not read its replies is dropped
     return;
   }
   double due = 0;
   if (config_.emulation.active()) {
-    const std::optional<double> at = s.toClient.schedule(frame->size(), now());
+    const std::optional<double> at = s.toClient.schedule(frame.size(), now());
     if (!at) {
       ++stats_.emulatedLost;
       return;
     }
     due = *at;
   }
-  s.queue.push_back({std::move(*frame), telemetry, due});
+  s.queue.push_back({std::move(frame), telemetry, due});
 }
 
 void RobotServer::received(ClientId id, const std::string& bytes) {
@@ -254,35 +250,36 @@ void RobotServer::flush() {
   if (!commands.empty()) robot_.apply(commands);
   for (const RobotLink::Outgoing& o : link_.takeOutgoing()) {
     auto it = sessions_.find(o.client);
-    if (it != sessions_.end() && !it->second->closed) enqueue(*it->second, o.message, false);
+    if (it != sessions_.end() && !it->second->closed) enqueue(*it->second, o.message);
   }
   for (ClientId id : link_.takeClosing()) {
     auto it = sessions_.find(id);
     if (it != sessions_.end()) it->second->closing = true;
   }
   std::vector<ClientId> finished;  // closed after the loop: closing erases sessions
-  for (auto& [id, ptr] : sessions_) {
-    Session& s = *ptr;
-    if (s.writing || s.closed) continue;
-    if (s.queue.empty()) {
-      if (s.closing) finished.push_back(id);
-      continue;
-    }
-    if (s.queue.front().due > now()) continue;  // the emulated link holds it; the timer comes back
-    s.writing = true;
-    const ClientId sid = id;
-    // One frame per write; the completion continues with the next.
-    asio::async_write(s.socket, asio::buffer(s.queue.front().bytes), [this, sid](asio::error_code ec, size_t) {
-      auto it = sessions_.find(sid);
-      if (it == sessions_.end()) return;
-      Session& ses = *it->second;
-      ses.writing = false;
-      if (ec) return closeSession(sid);
-      ses.queue.pop_front();
-      flush();
-    });
-  }
+  for (auto& [id, ptr] : sessions_)
+    if (!writeNext(id, *ptr)) finished.push_back(id);
   for (ClientId id : finished) closeSession(id);
+}
+
+bool RobotServer::writeNext(ClientId id, Session& s) {
+  if (s.writing || s.closed) return true;
+  if (s.queue.empty()) return !s.closing;
+  if (s.queue.front().due > now()) return true;  // the emulated link holds it; the timer comes back
+  s.writing = true;
+  // One frame per write; the completion continues with this session's next
+  // (only: a scan of every session per completion made 500 clients cost
+  // the controller its round trip).
+  asio::async_write(s.socket, asio::buffer(s.queue.front().bytes), [this, id](asio::error_code ec, size_t) {
+    auto it = sessions_.find(id);
+    if (it == sessions_.end()) return;
+    Session& ses = *it->second;
+    ses.writing = false;
+    if (ec) return closeSession(id);
+    ses.queue.pop_front();
+    if (!writeNext(id, ses)) closeSession(id);
+  });
+  return true;
 }
 
 void RobotServer::closeSession(ClientId id) {
@@ -336,51 +333,53 @@ void RobotServer::onTimer() {
     nextHeartbeat_ = t + 0.5;
     link_.sendHeartbeats(t);
   }
-  std::vector<std::pair<ClientId, Message>> frames;
+  // Telemetry and laser are encoded once per state and only the
+  // per-client keys per client; a client whose queue is full is skipped
+  // before any encoding (500 idle monitors must not slow the controller).
+  // A skipped frame still takes its sequence number: the gap tells the
+  // client it lost one.
+  const auto fanOut = [&](uint64_t Session::*seq, const auto& makeFrame) {
+    for (ClientId id : link_.subscribers()) {
+      auto it = sessions_.find(id);
+      if (it == sessions_.end() || it->second->closed) continue;
+      Session& s = *it->second;
+      ++(s.*seq);
+      if (!telemetryRoom(s)) continue;
+      std::string error;
+      if (std::optional<std::string> frame = makeFrame(s, id, error)) enqueueFrame(s, std::move(*frame), true);
+    }
+  };
   if (t >= nextTelemetry_) {
     nextTelemetry_ += 1.0 / config_.link.telemetryRate;
     if (nextTelemetry_ < t) nextTelemetry_ = t;  // no burst after a stall
-    const RobotState st = robot_.state();
+    RobotState st = robot_.state();
     if (st.health != lastHealth_) {
       lastHealth_ = st.health;
       if (!st.health.empty()) link_.announce(EventKind::Divergence, st.health);
     }
-    for (ClientId id : link_.subscribers()) {
-      auto it = sessions_.find(id);
-      if (it == sessions_.end()) continue;
-      Session& s = *it->second;
-      TelemetryMsg m;
-      m.seq = ++s.telemetrySeq;
-      m.time = st.time;
-      m.pose = st.pose;
-      m.jointNames = st.jointNames;
-      m.jointPositions = st.jointPositions;
-      m.jointVelocities = st.jointVelocities;
-      m.wheelNormal = st.wheelNormal;
-      m.wheelTangential = st.wheelTangential;
-      m.roll = st.roll;
-      m.pitch = st.pitch;
-      m.rttMs = link_.rttMs(id);
-      m.lost = s.lost;
-      m.failsafe = link_.failsafeLatched();
-      m.estop = link_.estopLatched();
-      m.health = st.health;
-      m.objects = st.objects;
-      frames.emplace_back(id, std::move(m));
-    }
+    TelemetryMsg m;
+    m.time = st.time;
+    m.pose = st.pose;
+    m.jointNames = std::move(st.jointNames);
+    m.jointPositions = std::move(st.jointPositions);
+    m.jointVelocities = std::move(st.jointVelocities);
+    m.wheelNormal = st.wheelNormal;
+    m.wheelTangential = st.wheelTangential;
+    m.roll = st.roll;
+    m.pitch = st.pitch;
+    m.failsafe = link_.failsafeLatched();
+    m.estop = link_.estopLatched();
+    m.health = std::move(st.health);
+    m.objects = std::move(st.objects);
+    const TelemetryFanOut telemetry(m);
+    fanOut(&Session::telemetrySeq, [&](Session& s, ClientId id, std::string& error) {
+      return telemetry.frame(s.telemetrySeq, link_.rttMs(id), s.lost, error);
+    });
   }
   if (std::optional<LaserScanState> scan = robot_.laserAfter(lastLaser_)) {
     lastLaser_ = scan->count;
-    for (ClientId id : link_.subscribers()) {
-      auto it = sessions_.find(id);
-      if (it == sessions_.end()) continue;
-      frames.emplace_back(id, LaserMsg{++it->second->laserSeq, scan->time, scan->angleMin, scan->angleStep,
-                                       scan->ranges});
-    }
-  }
-  for (auto& [id, m] : frames) {
-    auto it = sessions_.find(id);
-    if (it != sessions_.end() && !it->second->closed) enqueue(*it->second, m, true);
+    const LaserFanOut laser(LaserMsg{0, scan->time, scan->angleMin, scan->angleStep, std::move(scan->ranges)});
+    fanOut(&Session::laserSeq, [&](Session& s, ClientId, std::string& error) { return laser.frame(s.laserSeq, error); });
   }
   flush();
 }

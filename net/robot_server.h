@@ -113,7 +113,13 @@ class RobotServer {
   class Session;
   void accept();
   void startRead(ClientId id);
-  void enqueue(Session& session, const Message& message, bool telemetry);
+  void enqueue(Session& session, const Message& message);
+  void enqueueFrame(Session& session, std::string frame, bool telemetry);
+  /// Starts writing the session's next due frame unless a write is under
+  /// way; false when the session is done (closing with nothing queued).
+  bool writeNext(ClientId id, Session& session);
+  /// Whether telemetry may be queued for `session`; if not, counts it lost.
+  bool telemetryRoom(Session& session);
   void schedule();
   void onTimer();
   void flush();
@@ -141,8 +147,5 @@ class RobotServer {
   RobotServerStats stats_;
   bool stopped_ = false;
 };
-
-/// A random token of 128 bits, as 32 hex digits.
-std::string randomToken();
 
 }  // namespace sp::net

@@ -154,10 +154,7 @@ struct Checker {
   // on a straight line (in a turn the outer wheels run faster still, and the
   // actuators' own limits hold them).
   CommandCheck speedWithinLimit(double speed) const {
-    double top = std::numeric_limits<double>::infinity();
-    for (int w : robot.drive->wheels)
-      if (const int a = robot.findActuator(robot.joints[w].name); a >= 0)
-        top = std::min(top, robot.actuators[a].maxVelocity * robot.drive->wheelRadius);
+    const double top = driveSpeedLimit(robot);
     if (!(std::abs(speed) <= top))
       return outOfLimits("speed " + show(speed) + " m/s exceeds the drive's " + show(top) +
                          " m/s (wheel max_velocity x wheel radius)");
@@ -188,6 +185,14 @@ struct Checker {
 };
 
 }  // namespace
+
+double driveSpeedLimit(const RobotModel& robot) {
+  double top = std::numeric_limits<double>::infinity();
+  for (int w : robot.drive->wheels)
+    if (const int a = robot.findActuator(robot.joints[w].name); a >= 0)
+      top = std::min(top, robot.actuators[a].maxVelocity * robot.drive->wheelRadius);
+  return top;
+}
 
 CommandCheck checkCommand(const Command& command, const RobotModel& robot) {
   return std::visit(Checker{robot}, command);

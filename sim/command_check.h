@@ -24,6 +24,11 @@ struct CommandCheck {
   bool ok() const { return kind == Kind::Ok; }
 };
 
+/// [m/s] the fastest `drive` or `turn` the robot takes: the slowest wheel
+/// motor's max_velocity times the wheel radius (infinity without wheel
+/// actuators). Needs robot.drive with valid joint indices.
+double driveSpeedLimit(const RobotModel& robot);
+
 /// Checks one command (parsed with the same robot) against `robot`. Any thread.
 CommandCheck checkCommand(const Command& command, const RobotModel& robot);
 

@@ -39,6 +39,8 @@ struct SimParams {
   double linkKeepalive = 0.05;    ///< [s] console: keep-alive period (at most a quarter of the deadman)
   double linkCommandExpiry = 0.5; ///< [s] console: how much later than the link's usual delay a command may arrive
   double linkLeaseConfirm = 10;   ///< [s] robot: wait for a new holder's first keep-alive
+  int linkMaxConnections = 64;    ///< robot: connections open at once; one more is closed at once
+  double linkHelloTimeout = 2;    ///< [s] robot: a connection without a good HELLO by then is closed
   // Gaits (sim/gait.h); swings in degrees about the stance pose
   double caterpillarHipSwing = 12;   ///< [deg]
   double caterpillarPhaseTime = 1.0; ///< [s] per half cycle

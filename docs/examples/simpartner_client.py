@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """A minimal client of the SimPartner robot link, using only Python's standard library.
 
-It connects to the robot (or to the stand-in `simpartner-robot`), authenticates with the
-shared token, takes the control lease, drives forward (`drive 0.5 0`) for a few seconds
+It connects to the robot (or to the stand-in `simpartner-robot`), authenticates by
+answering the robot's CHALLENGE with an HMAC of the shared token (the token itself never
+crosses the link), takes the control lease, drives forward (`drive 0.5 0`) for a few seconds
 while sending keep-alives, prints telemetry and replies, then stops and gives the lease
 back. docs/protocol.md describes every message used here.
 
@@ -14,6 +15,8 @@ command `ok`, sent at least 10 TELEMETRY frames, and its x position increased.
 """
 
 import argparse
+import hashlib
+import hmac
 import select
 import socket
 import struct
@@ -24,6 +27,7 @@ import zlib
 # Message types (docs/protocol.md, "Messages").
 HELLO, WELCOME, LEASE_ACQUIRE, LEASE_KEEPALIVE, LEASE_RELEASE, LEASE_STATE = 1, 2, 3, 4, 5, 6
 COMMAND, REPLY, TELEMETRY, LASER, HEARTBEAT, ESTOP, REARM, EVENT, ERROR = 7, 8, 9, 10, 11, 12, 13, 14, 15
+CHALLENGE, LIMITS = 16, 17
 NAMES = {v: k for k, v in globals().items() if k.isupper() and isinstance(v, int)}
 
 ROBOT_HEARTBEAT_BASE = 1 << 62   # the robot's heartbeats count from here; echo them unchanged
@@ -118,13 +122,18 @@ def main():
     parser.add_argument("--print-every", type=int, default=5, help="print every N-th TELEMETRY frame")
     args = parser.parse_args()
 
-    got = {"welcome": False, "lease": False, "lease_granted": False, "drive_ok": False}
+    got = {"challenge": None, "welcome": False, "lease": False, "lease_granted": False, "drive_ok": False}
     telemetry = []   # (time, x, y) of every frame
     drive_seq = None
 
     def handle(msg_type, fields):
         nonlocal drive_seq
-        if msg_type == WELCOME:
+        if msg_type == CHALLENGE:
+            got["challenge"] = fields["nonce"]
+        elif msg_type == LIMITS:
+            print(f"LIMITS drive_speed={fields.get('drive_speed', '-')} m/s "
+                  f"articulation={fields.get('articulation', '-')} joints={len(fields['joints'].split())}")
+        elif msg_type == WELCOME:
             got["welcome"] = True
             print(f"WELCOME robot={fields['robot']} session={fields['session']} "
                   f"telemetry_rate={fields['telemetry_rate']} Hz")
@@ -171,8 +180,15 @@ def main():
 
     try:
         client = Client(args.host, args.port, timeout=5)
-        # HELLO first: nothing else is served before the token is accepted.
-        client.send(HELLO, {"name": args.name, "token": args.token, "role": "control"})
+        # The robot speaks first: a CHALLENGE with a fresh nonce. HELLO answers it with
+        # HMAC-SHA256(token, "simpartner-hello\n" nonce "\n" name "\n" role); nothing
+        # else is served before it is accepted.
+        if not wait_for(lambda: got["challenge"], 5):
+            print("error: no CHALLENGE from the robot", file=sys.stderr)
+            return 1
+        text = f"simpartner-hello\n{got['challenge']}\n{args.name}\ncontrol".encode()
+        proof = hmac.new(args.token.encode(), text, hashlib.sha256).hexdigest()
+        client.send(HELLO, {"name": args.name, "role": "control", "proof": proof})
         if not wait_for(lambda: got["welcome"], 5):
             print("error: no WELCOME (wrong token?)", file=sys.stderr)
             return 1

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
 
 #include "net/message.h"
 #include "sim/robot_model.h"
@@ -73,7 +74,6 @@ const char* kTelemetryText =
     "lost=3\n"
     "failsafe=0\n"
     "estop=1\n"
-    "health=\n"
     "objects=\n";
 
 // kTelemetryText with the line of `key` replaced by `line`.
@@ -104,11 +104,47 @@ class TestMessage : public QObject {
   void encodeErrors();
   void oversizeMessage();
   void commandHelpers();
+  void fanOutEqualsEncodeMessage();
 };
+
+// The robot's fan-out writes, per client, exactly the frame encodeMessage()
+// writes for the same message.
+void TestMessage::fanOutEqualsEncodeMessage() {
+  std::string error;
+  TelemetryMsg m = telemetry();
+  m.objects = {{"pole", Pose{{2.5, 0, 0.94}, {0.5, 0.5, -0.5, 0.5}}}};
+  m.health = "diverged";
+  const TelemetryFanOut telemetryOut(m);
+  for (const auto& [seq, rtt, lost] : {std::tuple<uint64_t, double, uint64_t>{1, 0, 0}, {42, 12.3, 3},
+                                       {18446744073709551615u, 1e-300, 7}, {5, std::nan(""), 0}}) {
+    m.seq = seq;
+    m.rttMs = rtt;
+    m.lost = lost;
+    QCOMPARE(telemetryOut.frame(seq, rtt, lost, error).value_or(error), encodeMessage(m, error).value_or("?"));
+  }
+  LaserMsg laser{0, 1.25, -2.356194490192345, 0.004363323129985824, {1.5, 0.25, 30}};
+  const LaserFanOut laserOut(laser);
+  for (uint64_t seq : {1u, 2u, 1000000u}) {
+    laser.seq = seq;
+    QCOMPARE(laserOut.frame(seq, error).value_or(error), encodeMessage(laser, error).value_or("?"));
+  }
+  // A message that does not encode gives the encoder's error for every client.
+  m.jointNames[0] = "bad name";
+  QVERIFY(!TelemetryFanOut(m).frame(1, 0, 0, error));
+  QCOMPARE(error, std::string("TELEMETRY: key 'joint_names': name 1 is empty or contains a space"));
+}
 
 void TestMessage::roundTrip_data() {
   QTest::addColumn<Message>("message");
-  QTest::newRow("HELLO") << Message(HelloMsg{"console é", kToken + "ABCDEF", Role::Control});
+  QTest::newRow("HELLO") << Message(HelloMsg{"console é", kToken + "ABCDEF", Role::Control, {}});
+  QTest::newRow("HELLO with proof") << Message(HelloMsg{"console", "", Role::Monitor, std::string(64, 'a')});
+  QTest::newRow("CHALLENGE") << Message(ChallengeMsg{kToken});
+  LimitsMsg limits{{"hip_fl", "lift"}, {-1.5, -0.1}, {1.5, 0.2}, {2, 0.05}, {120, 800}, 0.9, 3.6, "steer"};
+  QTest::newRow("LIMITS") << Message(limits);
+  limits.lower[0] = -std::numeric_limits<double>::infinity();
+  limits.upper[0] = std::numeric_limits<double>::infinity();
+  QTest::newRow("LIMITS unlimited joint") << Message(limits);
+  QTest::newRow("LIMITS without drive") << Message(LimitsMsg{{"arm"}, {0}, {1}, {2}, {3}, 0, 0, ""});
   QTest::newRow("WELCOME") << Message(WelcomeMsg{"workpartner", 18446744073709551615u, 50});
   QTest::newRow("LEASE_ACQUIRE") << Message(LeaseAcquireMsg{});
   QTest::newRow("LEASE_KEEPALIVE") << Message(LeaseKeepaliveMsg{});
@@ -153,13 +189,14 @@ void TestMessage::roundTrip() {
 void TestMessage::typeNames() {
   const char* names[] = {"HELLO",     "WELCOME", "LEASE_ACQUIRE", "LEASE_KEEPALIVE", "LEASE_RELEASE",
                          "LEASE_STATE", "COMMAND", "REPLY",        "TELEMETRY",       "LASER",
-                         "HEARTBEAT", "ESTOP",   "REARM",         "EVENT",           "ERROR"};
-  for (int code = 1; code <= 15; ++code) {
+                         "HEARTBEAT", "ESTOP",   "REARM",         "EVENT",           "ERROR",
+                         "CHALLENGE", "LIMITS"};
+  for (int code = 1; code <= 17; ++code) {
     QCOMPARE(messageTypeName(static_cast<uint8_t>(code)), names[code - 1]);
     QCOMPARE(toString(static_cast<MessageType>(code)), names[code - 1]);
   }
   QCOMPARE(messageTypeName(0), "unknown");
-  QCOMPARE(messageTypeName(16), "unknown");
+  QCOMPARE(messageTypeName(18), "unknown");
   QCOMPARE(toString(ReplyStatus::NotOwner), "not_owner");
   QCOMPARE(toString(EventKind::Rearmed), "rearmed");
   QCOMPARE(toString(Role::Monitor), "monitor");
@@ -222,7 +259,7 @@ void TestMessage::decodeAccepts_data() {
   QTest::newRow("leading zeros, exponent") << 11 << QByteArray("seq=007\ntime=1e3\n") << Message(HeartbeatMsg{7, 1000});
   QTest::newRow("upper-case token")
       << 1 << QByteArray("name=c\ntoken=00112233445566778899AABBCCDDEEFF\nrole=monitor\n")
-      << Message(HelloMsg{"c", "00112233445566778899AABBCCDDEEFF", Role::Monitor});
+      << Message(HelloMsg{"c", "00112233445566778899AABBCCDDEEFF", Role::Monitor, {}});
   QTest::newRow("keys on a message without keys") << 3 << QByteArray("later=1\n") << Message(LeaseAcquireMsg{});
   QTest::newRow("objects absent") << 9 << telemetryWith("objects", "") << Message(telemetry());
   TelemetryMsg withPole = telemetry();
@@ -344,7 +381,7 @@ void TestMessage::decodeErrors() {
 void TestMessage::encodeErrors_data() {
   QTest::addColumn<Message>("message");
   QTest::addColumn<QString>("error");
-  QTest::newRow("line feed") << Message(HelloMsg{"a\nb", kToken, Role::Control})
+  QTest::newRow("line feed") << Message(HelloMsg{"a\nb", kToken, Role::Control, {}})
                              << "HELLO: key 'name': contains a line feed";
   QTest::newRow("not UTF-8") << Message(ErrorMsg{"\xff"}) << "ERROR: key 'reason': is not valid UTF-8";
   TelemetryMsg t = telemetry();
@@ -360,8 +397,20 @@ void TestMessage::encodeErrors_data() {
                                      << "TELEMETRY: key 'objects': name 1 is empty or contains a space";
   t.objects = {{"pole\n", Pose{}}};
   QTest::newRow("object name with line feed") << Message(t) << "TELEMETRY: key 'objects': contains a line feed";
-  QTest::newRow("short token") << Message(HelloMsg{"c", "abc", Role::Monitor})
+  QTest::newRow("short token") << Message(HelloMsg{"c", "abc", Role::Monitor, {}})
                                << "HELLO: key 'token': expected at least 32 hex digits (128 bits), got 3";
+  QTest::newRow("token and proof") << Message(HelloMsg{"c", kToken, Role::Monitor, std::string(64, 'a')})
+                                   << "HELLO: keys 'proof' and 'token': send one, not both";
+  QTest::newRow("neither token nor proof") << Message(HelloMsg{"c", "", Role::Monitor, ""})
+                                           << "HELLO: missing key 'proof' (or, on loopback, 'token')";
+  QTest::newRow("short proof") << Message(HelloMsg{"c", "", Role::Monitor, std::string(63, 'a')})
+                               << "HELLO: key 'proof': expected 64 hex digits (HMAC-SHA256), got 63";
+  QTest::newRow("proof not hex") << Message(HelloMsg{"c", "", Role::Monitor, std::string(63, 'a') + "g"})
+                                 << "HELLO: key 'proof': expected hex digits only";
+  QTest::newRow("short nonce") << Message(ChallengeMsg{"abcd"})
+                               << "CHALLENGE: key 'nonce': expected at least 32 hex digits (128 bits), got 4";
+  QTest::newRow("limits list too short") << Message(LimitsMsg{{"a", "b"}, {0, 0}, {1, 1}, {1}, {1, 1}, 0, 0, ""})
+                                         << "LIMITS: key 'max_velocity': expected 2 numbers (one per joint), got 1";
   QTest::newRow("zero expiry") << Message(CommandMsg{1, 0, "stop"}) << "COMMAND: key 'expires_ms': must be > 0";
   QTest::newRow("bad enum") << Message(ReplyMsg{1, static_cast<ReplyStatus>(99), ""})
                             << "REPLY: key 'status': bad enum value 99";

@@ -19,6 +19,7 @@
 
 #include "net/frame.h"
 #include "net/message.h"
+#include "net/auth.h"
 #include "net/robot_client.h"
 
 using namespace sp;
@@ -567,10 +568,14 @@ class TestRobotClient : public QObject {
     FakeRobot fake;
     Client c(clientConfig(fake.port(), "operator"));
     fake.accept();
+    // The client answers the challenge with a proof, never the token.
+    const std::string nonce = "0123456789abcdef0123456789abcdef";
+    fake.send(ChallengeMsg{nonce});
     const auto hello = fake.nextOf<HelloMsg>();
     QVERIFY(hello);
     QCOMPARE(hello->name, std::string("operator"));
-    QCOMPARE(hello->token, kToken);
+    QVERIFY(hello->token.empty());
+    QCOMPARE(hello->proof, helloProof(kToken, nonce, "operator", Role::Control));
     QCOMPARE(hello->role, Role::Control);
     fake.send(WelcomeMsg{"fake", 1, 50});
     QVERIFY(c.waitReady());
@@ -600,6 +605,7 @@ class TestRobotClient : public QObject {
     config.replyGrace = 0.3;
     Client c(config);
     fake.accept();
+    fake.send(ChallengeMsg{"0123456789abcdef0123456789abcdef"});
     QVERIFY(fake.nextOf<HelloMsg>());
     fake.send(WelcomeMsg{"fake", 1, 50});
     QVERIFY(c.waitReady());

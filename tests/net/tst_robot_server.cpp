@@ -16,10 +16,12 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <random>
 #include <thread>
 
 #include "app/twin_host.h"
+#include "net/auth.h"
 #include "net/robot_server.h"
 #include "sim/model_loader.h"
 
@@ -120,8 +122,14 @@ struct Client {
     }
     return std::nullopt;
   }
+  /// The HELLO that answers this connection's CHALLENGE with a proof of `token`.
+  HelloMsg provingHello(Role role, const std::string& name, const std::string& token = kToken) {
+    const auto challenge = waitFor<ChallengeMsg>(3.0);
+    if (!challenge) return HelloMsg{name, {}, role, std::string(64, '0')};
+    return HelloMsg{name, {}, role, helloProof(token, challenge->nonce, name, role)};
+  }
   void hello(Role role, const std::string& name) {
-    send(HelloMsg{name, kToken, role});
+    send(provingHello(role, name));
     QVERIFY(waitFor<WelcomeMsg>(2.0));
   }
 };
@@ -138,6 +146,7 @@ class TestRobotServer : public QObject {
     Robot robot({}, {}, [](RobotServerConfig& c) { c.helloTimeout = 0.3; });
     Client silent(robot.server->port()), talker(robot.server->port());
     talker.hello(Role::Monitor, "talker");
+    QVERIFY(silent.waitFor<ChallengeMsg>(1.0));
     QVERIFY(!silent.next(1.5));
     QVERIFY(silent.eof);
     QVERIFY(talker.waitFor<TelemetryMsg>(1.0));
@@ -195,16 +204,69 @@ class TestRobotServer : public QObject {
     QVERIFY2(acceptErrors > 0, "the server never met the descriptor limit");
   }
 
-  // A wrong token gets ERROR and the connection is closed.
+  // A proof made with a wrong token, or a wrong token in clear, gets ERROR
+  // and the connection is closed.
   void wrongToken() {
     Robot robot;
     Client c(robot.server->port());
-    c.send(HelloMsg{"intruder", "ffffffffffffffffffffffffffffffff", Role::Control});
+    c.send(c.provingHello(Role::Control, "intruder", "ffffffffffffffffffffffffffffffff"));
     const auto error = c.waitFor<ErrorMsg>(2.0);
     QVERIFY(error);
     QCOMPARE(error->reason, std::string("authentication failed"));
     QVERIFY(!c.next(1.0));
     QVERIFY(c.eof);
+    Client clear(robot.server->port());
+    clear.send(HelloMsg{"intruder", "ffffffffffffffffffffffffffffffff", Role::Control, {}});
+    QCOMPARE(clear.waitFor<ErrorMsg>(2.0).value_or(ErrorMsg{}).reason, std::string("authentication failed"));
+  }
+
+  // A HELLO captured on one connection does not open another: the proof
+  // covers that connection's nonce only. (The control: the same HELLO did
+  // open its own connection.)
+  void capturedHelloDoesNotReplay() {
+    Robot robot;
+    Client first(robot.server->port());
+    const HelloMsg captured = first.provingHello(Role::Control, "operator");
+    first.send(captured);
+    QVERIFY(first.waitFor<WelcomeMsg>(2.0));
+    Client replay(robot.server->port());
+    QVERIFY(replay.waitFor<ChallengeMsg>(2.0));
+    replay.send(captured);
+    QCOMPARE(replay.waitFor<ErrorMsg>(2.0).value_or(ErrorMsg{}).reason, std::string("authentication failed"));
+    QVERIFY(!replay.next(1.0));
+    QVERIFY(replay.eof);
+  }
+
+  // The token in clear is accepted on loopback only; a robot listening on
+  // any other address wants the proof, and says so.
+  void clearTokenOnLoopbackOnly() {
+    Robot loopback;
+    Client c(loopback.server->port());
+    c.send(HelloMsg{"tool", kToken, Role::Monitor, {}});
+    QVERIFY(c.waitFor<WelcomeMsg>(2.0));
+
+    Robot open({}, {}, [](RobotServerConfig& config) { config.address = "0.0.0.0"; });
+    Client clear(open.server->port());
+    clear.send(HelloMsg{"tool", kToken, Role::Monitor, {}});
+    QCOMPARE(clear.waitFor<ErrorMsg>(2.0).value_or(ErrorMsg{}).reason,
+             std::string("authentication failed: a token in clear is accepted on loopback only: send 'proof'"));
+    Client proving(open.server->port());
+    proving.send(proving.provingHello(Role::Monitor, "console"));
+    QVERIFY(proving.waitFor<WelcomeMsg>(2.0));
+  }
+
+  // After WELCOME the robot tells its limits: the same ones it enforces.
+  void limitsAfterWelcome() {
+    Robot robot;
+    Client c(robot.server->port());
+    c.send(c.provingHello(Role::Monitor, "console"));
+    QVERIFY(c.waitFor<WelcomeMsg>(2.0));
+    const auto limits = c.waitFor<LimitsMsg>(2.0);
+    QVERIFY(limits);
+    QCOMPARE(*limits, limitsOf(*robot.host->model()));
+    QVERIFY(limits->driveSpeed > 0 && std::isfinite(limits->driveSpeed));
+    QVERIFY(!limits->articulation.empty());
+    QVERIFY(limits->joints.size() > 10);
   }
 
   // Garbage and an oversize frame close only their own connections; a
@@ -334,7 +396,7 @@ class TestRobotServer : public QObject {
     slow.delay = 0.25;
     Robot robot(slow);
     Client c(robot.server->port());
-    c.send(HelloMsg{"far away", kToken, Role::Control});
+    c.send(c.provingHello(Role::Control, "far away"));
     QVERIFY(c.waitFor<WelcomeMsg>(3.0));
     c.send(LeaseAcquireMsg{});
     const auto t0 = Clock::now();

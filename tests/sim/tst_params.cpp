@@ -54,6 +54,8 @@ SimParams allChanged() {
   p.linkKeepalive = 0.1;
   p.linkCommandExpiry = 2;
   p.linkLeaseConfirm = 20;
+  p.linkMaxConnections = 500;
+  p.linkHelloTimeout = 3;
   p.maxLinearSpeed = 5;
   p.maxAngularSpeed = 6;
   p.maxJointError = 7;
@@ -133,7 +135,7 @@ void TestParams::tableDefaultsAreSimParamsDefaults() {
   std::set<std::string> seen;
   const QRegularExpression keyPattern("^[a-z]+(\\.[a-z_]+)+$");
   const std::vector<ParamInfo> table = paramTable();
-  QCOMPARE(table.size(), size_t(30));
+  QCOMPARE(table.size(), size_t(32));
   for (const ParamInfo& info : table) {
     QVERIFY2(seen.insert(info.key).second, info.key.c_str());
     QVERIFY2(keyPattern.match(q(info.key)).hasMatch(), info.key.c_str());
