@@ -183,6 +183,8 @@ const std::vector<Entry>& table() {
             integer(&SimParams::linkMaxConnections, 1, 10000)),
       entry("link.hello_timeout", "robot: a connection without a good HELLO by then is closed [s], [0.1, 600]",
             real(&SimParams::linkHelloTimeout, closed(0.1, 600))),
+      entry("console.stale_after", "console: no telemetry this long greys the robot and says 'no data' [s], [0.05, 60]",
+            real(&SimParams::consoleStaleAfter, closed(0.05, 60))),
       entry("gait.caterpillar.hip_swing", "caterpillar: hip swing about the stance pose [deg], (0, 45]",
             real(&SimParams::caterpillarHipSwing, openClosed(0, 45))),
       entry("gait.caterpillar.phase_time", "caterpillar: duration of each half cycle [s], (0, 60]",

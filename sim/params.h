@@ -41,6 +41,7 @@ struct SimParams {
   double linkLeaseConfirm = 10;   ///< [s] robot: wait for a new holder's first keep-alive
   int linkMaxConnections = 64;    ///< robot: connections open at once; one more is closed at once
   double linkHelloTimeout = 2;    ///< [s] robot: a connection without a good HELLO by then is closed
+  double consoleStaleAfter = 0.5; ///< [s] console: no telemetry this long => the robot is drawn grey, "no data"
   // Gaits (sim/gait.h); swings in degrees about the stance pose
   double caterpillarHipSwing = 12;   ///< [deg]
   double caterpillarPhaseTime = 1.0; ///< [s] per half cycle

@@ -1,5 +1,7 @@
 #include "ui/control_panel.h"
 
+#include "ui/limit_spin_box.h"
+
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
@@ -38,13 +40,15 @@ ControlPanel::ControlPanel(QWidget* parent) : QWidget(parent) {
   auto* drive = new QGridLayout(driveBox_);
   speedSlider_ = new QSlider(Qt::Horizontal);
   speedSlider_->setMinimumWidth(90);
-  speedSpin_ = new QDoubleSpinBox;
+  speedSpin_ = new LimitSpinBox;
+  speedSpin_->setWhat(tr("speed"));
   speedSpin_->setSuffix(tr(" m/s"));
   speedSpin_->setDecimals(2);
   speedSpin_->setSingleStep(kSpeedKeyStep);
   speedSlider_->setToolTip(tr("Speed at the articulation hinge (keys Up/Down or W/S over the 3D view)"));
   articulationSlider_ = new QSlider(Qt::Horizontal);
-  articulationSpin_ = new QDoubleSpinBox;
+  articulationSpin_ = new LimitSpinBox;
+  articulationSpin_->setWhat(tr("articulation"));
   articulationSpin_->setSuffix(tr(" °"));
   articulationSpin_->setDecimals(1);
   articulationSpin_->setSingleStep(kArticulationKeyStep);
@@ -65,11 +69,14 @@ ControlPanel::ControlPanel(QWidget* parent) : QWidget(parent) {
   gait_->addItem(tr("rolking"), static_cast<int>(Gait::Rolking));
   gait_->setToolTip(tr("Locomotion mode: rolling on the wheels (driven by the sliders) or a gait"));
   auto* stopButton = new QPushButton(tr("Stop"));
+  // No button takes the keyboard: Space and the arrows are drive keys
+  // wherever the focus is, never a click on whatever button had it.
+  stopButton->setFocusPolicy(Qt::NoFocus);
   stopButton->setToolTip(tr("Stop driving and any gait (key Space over the 3D view). For an emergency use E-STOP (Esc)."));
   modeRow->addWidget(new QLabel(tr("gait")));
   modeRow->addWidget(gait_, 1);
   modeRow->addWidget(stopButton);
-  layout->addLayout(modeRow);
+  modeRow->setContentsMargins(0, 0, 0, 0);
 
   auto* jointsBox = new QGroupBox(tr("Joint targets"), this);
   auto* jointsOuter = new QVBoxLayout(jointsBox);
@@ -85,6 +92,12 @@ ControlPanel::ControlPanel(QWidget* parent) : QWidget(parent) {
   jointsOuter->addWidget(scroll);
   layout->addWidget(jointsBox, 1);
 
+  // Everything that sends a command; disabled without the lease.
+  auto* gaitRow = new QWidget;
+  gaitRow->setLayout(modeRow);
+  layout->insertWidget(1, gaitRow);
+  controlWidgets_ = {driveBox_, gaitRow, jointsBox};
+
   driveTimer_ = new QTimer(this);
   driveTimer_->setSingleShot(true);
   driveTimer_->setInterval(50);
@@ -99,7 +112,7 @@ ControlPanel::ControlPanel(QWidget* parent) : QWidget(parent) {
     updating_ = false;
     driveChanged();
   });
-  connect(speedSpin_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+  connect(speedSpin_, &LimitSpinBox::accepted, this, [this](double v) {
     if (updating_) return;
     updating_ = true;
     speedSlider_->setValue(static_cast<int>(std::lround(v * 100)));
@@ -113,7 +126,7 @@ ControlPanel::ControlPanel(QWidget* parent) : QWidget(parent) {
     updating_ = false;
     driveChanged();
   });
-  connect(articulationSpin_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+  connect(articulationSpin_, &LimitSpinBox::accepted, this, [this](double v) {
     if (updating_) return;
     updating_ = true;
     articulationSlider_->setValue(toTicks(v));
@@ -121,6 +134,7 @@ ControlPanel::ControlPanel(QWidget* parent) : QWidget(parent) {
     driveChanged();
   });
   connect(stopButton, &QPushButton::clicked, this, &ControlPanel::stop);
+  for (LimitSpinBox* box : {speedSpin_, articulationSpin_}) connect(box, &LimitSpinBox::refused, this, &ControlPanel::refused);
   connect(gait_, &QComboBox::activated, this, &ControlPanel::gaitChanged);
 }
 
@@ -152,9 +166,9 @@ void ControlPanel::setRobot(const RobotModel& robot) {
   const double articulationDeg = std::floor(maxArticulationDeg_ + 1e-6);
   updating_ = true;
   speedSlider_->setRange(-static_cast<int>(speedCm), static_cast<int>(speedCm));
-  speedSpin_->setRange(-speedCm / 100, speedCm / 100);
+  speedSpin_->setLimits(-speedCm / 100, speedCm / 100);
   articulationSlider_->setRange(-toTicks(articulationDeg), toTicks(articulationDeg));
-  articulationSpin_->setRange(-articulationDeg, articulationDeg);
+  articulationSpin_->setLimits(-articulationDeg, articulationDeg);
   speedSlider_->setValue(0);
   speedSpin_->setValue(0);
   articulationSlider_->setValue(0);
@@ -189,11 +203,11 @@ void ControlPanel::setRobot(const RobotModel& robot) {
     row.slider = new QSlider(Qt::Horizontal);
     row.slider->setRange(toTicks(lo), toTicks(hi));
     row.slider->setMinimumWidth(90);
-    row.spin = new QDoubleSpinBox;
-    row.spin->setRange(lo, hi);
+    row.spin = new LimitSpinBox;
+    row.spin->setLimits(lo, hi);
+    row.spin->setWhat(tr("%1 target").arg(QString::fromStdString(joint.name)));
     row.spin->setDecimals(1);
     row.spin->setSuffix(slider ? tr(" mm") : tr(" °"));
-    row.spin->setKeyboardTracking(false);  // one command per typed value, not per digit
     const double initial = std::clamp(act.initialTarget * row.scale, lo, hi);
     row.slider->setValue(toTicks(initial));
     row.spin->setValue(initial);
@@ -224,7 +238,8 @@ void ControlPanel::setRobot(const RobotModel& robot) {
       JointRow& rw = rows_[index];
       emit command(JointTargetCmd{model_.joints[static_cast<size_t>(rw.joint)].name, rw.spin->value() / rw.scale});
     });
-    connect(row.spin, &QDoubleSpinBox::valueChanged, this, [this, index](double v) {
+    connect(row.spin, &LimitSpinBox::refused, this, &ControlPanel::refused);
+    connect(row.spin, &LimitSpinBox::accepted, this, [this, index](double v) {
       JointRow& rw = rows_[index];
       const QSignalBlocker block(rw.slider);
       rw.slider->setValue(toTicks(v));
@@ -237,6 +252,15 @@ void ControlPanel::setRobot(const RobotModel& robot) {
   // Rows scroll vertically only: the area is as wide as a row.
   scroll_->setMinimumWidth(grid->sizeHint().width() + scroll_->verticalScrollBar()->sizeHint().width() + 4);
   jointsLayout_->addStretch(1);
+}
+
+bool isDriveKey(int key) {
+  switch (key) {
+    case Qt::Key_Up: case Qt::Key_W: case Qt::Key_Down: case Qt::Key_S:
+    case Qt::Key_Left: case Qt::Key_A: case Qt::Key_Right: case Qt::Key_D:
+    case Qt::Key_Space: return true;
+    default: return false;
+  }
 }
 
 bool ControlPanel::handleKey(int key) {
@@ -259,7 +283,7 @@ void ControlPanel::showMeasured(const std::vector<double>& jointPositions) {
   for (JointRow& row : rows_) {
     const auto j = static_cast<size_t>(row.joint);
     if (j >= jointPositions.size()) continue;
-    row.measured->setText(QString::number(jointPositions[j] * row.scale, 'f', 1) + row.spin->suffix());
+    row.measured->setText(formatFixed(jointPositions[j] * row.scale, 1) + row.spin->suffix());
   }
 }
 
@@ -267,10 +291,49 @@ double ControlPanel::speed() const { return speedSpin_->value(); }
 double ControlPanel::articulation() const { return degToRad(articulationSpin_->value()); }
 
 void ControlPanel::setDrive(double newSpeed, double articulationDeg) {
-  // The spin boxes clamp to the robot's limits: a key never asks for more.
-  speedSpin_->setValue(newSpeed);
-  articulationSpin_->setValue(articulationDeg);
+  // Clamped to the robot's limits: a key never asks for more.
+  speedSpin_->setValue(std::clamp(newSpeed, speedSpin_->lower(), speedSpin_->upper()));
+  articulationSpin_->setValue(std::clamp(articulationDeg, articulationSpin_->lower(), articulationSpin_->upper()));
 }
+
+void ControlPanel::syncToRobot(const std::vector<double>& jointPositions) {
+  driveTimer_->stop();
+  updating_ = true;
+  speedSpin_->setValue(0);
+  speedSlider_->setValue(0);
+  // The articulation and the joints hold where they are after a stop: the
+  // controls show that, so that the next key press starts from it.
+  double articulationDeg = 0;
+  if (model_.drive && static_cast<size_t>(model_.drive->articulation) < jointPositions.size())
+    articulationDeg = radToDeg(jointPositions[static_cast<size_t>(model_.drive->articulation)]);
+  articulationDeg = std::clamp(articulationDeg, articulationSpin_->lower(), articulationSpin_->upper());
+  articulationSpin_->setValue(articulationDeg);
+  articulationSlider_->setValue(toTicks(articulationDeg));
+  for (JointRow& row : rows_) {
+    const auto j = static_cast<size_t>(row.joint);
+    if (j >= jointPositions.size()) continue;
+    const double v = std::clamp(jointPositions[j] * row.scale, row.spin->lower(), row.spin->upper());
+    const QSignalBlocker blockSpin(row.spin), blockSlider(row.slider);
+    row.spin->setValue(v);
+    row.slider->setValue(toTicks(v));
+  }
+  {
+    const QSignalBlocker block(gait_);
+    gait_->setCurrentIndex(0);
+  }
+  updating_ = false;
+}
+
+void ControlPanel::setControlsEnabled(bool enabled, const QString& why) {
+  disabledWhy_ = enabled ? QString() : why;
+  for (QWidget* w : controlWidgets_) {
+    w->setEnabled(enabled);
+    w->setToolTip(enabled ? QString() : why);
+  }
+  if (!enabled) driveTimer_->stop();
+}
+
+bool ControlPanel::controlsEnabled() const { return controlWidgets_.empty() || controlWidgets_.front()->isEnabled(); }
 
 void ControlPanel::driveChanged() {
   if (gait_->currentIndex() != 0) {

@@ -14,7 +14,6 @@
 #include "sim/robot_model.h"
 
 class QComboBox;
-class QDoubleSpinBox;
 class QGroupBox;
 class QLabel;
 class QScrollArea;
@@ -23,6 +22,11 @@ class QTimer;
 class QVBoxLayout;
 
 namespace sp {
+
+class LimitSpinBox;
+
+/// Whether `key` is a drive key of ControlPanel::handleKey().
+bool isDriveKey(int key);
 
 class ControlPanel : public QWidget {
   Q_OBJECT
@@ -35,7 +39,8 @@ class ControlPanel : public QWidget {
   /// joint other than the drive's. Resets every control to zero.
   void setRobot(const RobotModel& robot);
 
-  /// Keyboard driving, for keys pressed over the 3D view: Up/Down (W/S) step
+  /// Keyboard driving (the console routes these keys here wherever the
+  /// focus is, except in text and number fields): Up/Down (W/S) step
   /// the speed by 0.05 m/s, Left/Right (A/D) the articulation by 2 degrees,
   /// Space stops. Returns whether the key was one of these.
   bool handleKey(int key);
@@ -47,6 +52,18 @@ class ControlPanel : public QWidget {
   /// [degree] (clamped to the robot's limits) and sends one drive command.
   void setDrive(double speed, double articulationDeg);
 
+  /// After a stop (e-stop, failsafe, re-arm, release, lost control, gait
+  /// end): the controls show what the robot does: speed 0, the articulation
+  /// and joint targets where `jointPositions` (robot.joints order, measured)
+  /// say they are, no gait. Sends nothing.
+  void syncToRobot(const std::vector<double>& jointPositions);
+  /// Enables or disables everything that sends commands; `why` becomes their
+  /// tooltip while disabled (e.g. "take control first").
+  void setControlsEnabled(bool enabled, const QString& why = {});
+  bool controlsEnabled() const;
+  /// Why the controls are disabled ("" when enabled).
+  QString toolTipWhenDisabled() const { return disabledWhy_; }
+
   double speed() const;         ///< [m/s] the drive's set speed
   double articulation() const;  ///< [rad] the drive's set articulation
   double maxSpeed() const { return maxSpeed_; }
@@ -54,13 +71,15 @@ class ControlPanel : public QWidget {
  signals:
   /// A command for the robot (drive, joint target, gait, stop).
   void command(const sp::Command& command);
+  /// A typed value was refused (beyond the robot's limits): why, for the operator.
+  void refused(const QString& why);
 
  private:
   struct JointRow {
     int joint = -1;
     double scale = 1;  // display unit per SI unit (degrees or millimetres)
     QSlider* slider = nullptr;
-    QDoubleSpinBox* spin = nullptr;
+    LimitSpinBox* spin = nullptr;
     QLabel* measured = nullptr;
   };
   void driveChanged();
@@ -71,15 +90,17 @@ class ControlPanel : public QWidget {
   RobotModel model_;
   double maxSpeed_ = 0, maxArticulationDeg_ = 0;
   QSlider* speedSlider_ = nullptr;      // [cm/s]
-  QDoubleSpinBox* speedSpin_ = nullptr;  // [m/s]
+  LimitSpinBox* speedSpin_ = nullptr;  // [m/s]
   QSlider* articulationSlider_ = nullptr;  // [0.1 degree]
-  QDoubleSpinBox* articulationSpin_ = nullptr;  // [degree]
+  LimitSpinBox* articulationSpin_ = nullptr;  // [degree]
   QComboBox* gait_ = nullptr;
   QGroupBox* driveBox_ = nullptr;
   QVBoxLayout* jointsLayout_ = nullptr;
   QWidget* jointsHost_ = nullptr;
   QScrollArea* scroll_ = nullptr;
   std::vector<JointRow> rows_;
+  std::vector<QWidget*> controlWidgets_;
+  QString disabledWhy_;
   QTimer* driveTimer_ = nullptr;  // coalesces slider drags into one drive command per 50 ms
   bool updating_ = false;         // set while controls are moved programmatically
 };

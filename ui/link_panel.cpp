@@ -8,30 +8,55 @@
 #include <QPushButton>
 #include <QVBoxLayout>
 
+#include <algorithm>
+
 namespace sp {
 
 namespace {
 
-QString coloured(const QString& text, const char* colour) {
-  return QStringLiteral("<b style='color:%1'>%2</b>").arg(QLatin1String(colour), text.toHtmlEscaped());
-}
-
 }  // namespace
+
+/// A one-line label that elides its text to the width it is given, with the
+/// whole text as its tooltip: a long error or robot name never widens the
+/// dock.
+class ElidedLabel : public QLabel {
+ public:
+  ElidedLabel() {
+    setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Preferred);
+    setMinimumWidth(40);
+    setTextInteractionFlags(Qt::TextSelectableByMouse);
+  }
+  void show(const QString& text, const char* colour = nullptr) {
+    full_ = text;
+    setStyleSheet(colour ? QStringLiteral("QLabel { color: %1; font-weight: bold; }").arg(QLatin1String(colour)) : QString());
+    setToolTip(text);
+    elide();
+  }
+  QString fullText() const { return full_; }
+
+ protected:
+  void resizeEvent(QResizeEvent* event) override {
+    QLabel::resizeEvent(event);
+    elide();
+  }
+
+ private:
+  void elide() { setText(fontMetrics().elidedText(full_, Qt::ElideRight, std::max(width(), 40))); }
+  QString full_;
+};
 
 LinkPanel::LinkPanel(QWidget* parent) : QWidget(parent) {
   auto* layout = new QVBoxLayout(this);
   auto* form = new QFormLayout;
-  endpoint_ = new QLabel;
-  state_ = new QLabel;
-  rtt_ = new QLabel;
-  rate_ = new QLabel;
-  loss_ = new QLabel;
-  lease_ = new QLabel;
-  latches_ = new QLabel;
-  deadman_ = new QLabel;
+  endpoint_ = new ElidedLabel;
+  state_ = new ElidedLabel;
+  rtt_ = new ElidedLabel;
+  rate_ = new ElidedLabel;
+  loss_ = new ElidedLabel;
+  lease_ = new ElidedLabel;
+  latches_ = new ElidedLabel;
+  deadman_ = new ElidedLabel;
   deadman_->setToolTip(tr("The robot's deadman: it stops (failsafe) when the controller's keep-alives stop arriving for this long"));
-  for (QLabel* l : {endpoint_, state_, rtt_, rate_, loss_, lease_, latches_, deadman_})
-    l->setTextInteractionFlags(Qt::TextSelectableByMouse);
   form->addRow(tr("robot"), endpoint_);
   form->addRow(tr("link"), state_);
   form->addRow(tr("round trip"), rtt_);
@@ -56,10 +81,14 @@ LinkPanel::LinkPanel(QWidget* parent) : QWidget(parent) {
   estop_->setStyleSheet(QStringLiteral("QPushButton { background: #c62828; color: white; font-weight: bold; }"));
   estop_->setToolTip(tr("Emergency stop: the robot stops and stays stopped until re-armed. Key Esc works anywhere in the console."));
   rearm_ = new QPushButton(tr("Re-arm"));
+  rearm_->setObjectName(QStringLiteral("rearmButton"));
   rearm_->setToolTip(tr("Clear a latched failsafe or e-stop (the lease holder only)"));
   row2->addWidget(estop_, 2);
   row2->addWidget(rearm_, 1);
   layout->addLayout(row2);
+  // Buttons never take the keyboard: Space and arrows are drive keys, and
+  // Space must never re-arm or release through a focused button.
+  for (QPushButton* b : {connect_, control_, estop_, rearm_}) b->setFocusPolicy(Qt::NoFocus);
   events_ = new QPlainTextEdit;
   events_->setReadOnly(true);
   events_->setMaximumBlockCount(1000);  // a long session keeps its latest events
@@ -76,30 +105,33 @@ LinkPanel::LinkPanel(QWidget* parent) : QWidget(parent) {
   showLatches(false, false);
 }
 
-void LinkPanel::setEndpoint(const QString& endpoint) { endpoint_->setText(endpoint); }
+void LinkPanel::setEndpoint(const QString& endpoint) { endpoint_->show(endpoint); }
 
 void LinkPanel::appendEvent(const QString& text) {
   events_->appendPlainText(QTime::currentTime().toString(QStringLiteral("HH:mm:ss.zzz  ")) + text);
 }
 
+QString LinkPanel::stateText() const { return state_->fullText(); }
+QString LinkPanel::latchesText() const { return latches_->fullText(); }
+
 QStringList LinkPanel::events() const { return events_->toPlainText().split(QLatin1Char('\n'), Qt::SkipEmptyParts); }
 
 void LinkPanel::showStats(const net::RobotClientStats& s) {
   if (!s.connected) {
-    rtt_->setText(QStringLiteral("–"));
-    rate_->setText(QStringLiteral("–"));
+    rtt_->show(QStringLiteral("–"));
+    rate_->show(QStringLiteral("–"));
   } else {
-    rtt_->setText(tr("%1 ms (mean %2, max %3)")
+    rtt_->show(tr("%1 ms (mean %2, max %3)")
                       .arg(s.rttMs, 0, 'f', 1)
                       .arg(s.rttMeanMs, 0, 'f', 1)
                       .arg(s.rttMaxMs, 0, 'f', 1));
-    rate_->setText(tr("%1 Hz of %2").arg(s.telemetryRateHz, 0, 'f', 1).arg(s.telemetryRateAnnounced, 0, 'f', 0));
+    rate_->show(tr("%1 Hz of %2").arg(s.telemetryRateHz, 0, 'f', 1).arg(s.telemetryRateAnnounced, 0, 'f', 0));
   }
-  deadman_->setText(s.robotDeadman > 0 ? tr("%1 ms (the robot's)").arg(s.robotDeadman * 1000, 0, 'f', 0)
+  deadman_->show(s.robotDeadman > 0 ? tr("%1 ms (the robot's)").arg(s.robotDeadman * 1000, 0, 'f', 0)
                                        : tr("not announced"));
   const uint64_t total = s.telemetryFrames + s.telemetryLost;
   const double percent = total ? 100.0 * static_cast<double>(s.telemetryLost) / static_cast<double>(total) : 0.0;
-  loss_->setText(tr("%1 frames (%2 %), robot dropped %3, %4 reconnects")
+  loss_->show(tr("%1 frames (%2 %), robot dropped %3, %4 reconnects")
                      .arg(s.telemetryLost)
                      .arg(percent, 0, 'f', 2)
                      .arg(s.robotDropped)
@@ -114,7 +146,7 @@ void LinkPanel::showConnection(net::ConnectionState state, const QString& detail
                        : state == net::ConnectionState::Refused ? "#c62828"
                        : state == net::ConnectionState::Stopped ? "#555555"
                                                                  : "#ef6c00";
-  state_->setText(coloured(text, colour));
+  state_->show(text, colour);
   connect_->setText(open_ ? tr("Disconnect") : tr("Connect"));
   control_->setEnabled(state == net::ConnectionState::Ready);
   rearm_->setEnabled(state == net::ConnectionState::Ready);
@@ -123,21 +155,21 @@ void LinkPanel::showConnection(net::ConnectionState state, const QString& detail
 
 void LinkPanel::showLease(const net::LeaseStateMsg& lease) {
   leaseHeld_ = lease.yours;
-  if (lease.yours) lease_->setText(coloured(tr("yours"), "#2e7d32"));
-  else if (!lease.holder.empty()) lease_->setText(coloured(tr("held by %1").arg(QString::fromStdString(lease.holder)), "#ef6c00"));
-  else lease_->setText(tr("free (monitoring)"));
+  if (lease.yours) lease_->show(tr("yours"), "#2e7d32");
+  else if (!lease.holder.empty()) lease_->show(tr("held by %1").arg(QString::fromStdString(lease.holder)), "#ef6c00");
+  else lease_->show(tr("free (monitoring)"));
   control_->setText(lease.yours ? tr("Release control") : tr("Take control"));
 }
 
 void LinkPanel::showLatches(bool failsafe, bool estop) {
   if (!failsafe && !estop) {
-    latches_->setText(coloured(tr("clear"), "#2e7d32"));
+    latches_->show(tr("clear"), "#2e7d32");
     return;
   }
   QStringList on;
   if (estop) on << tr("E-STOP");
   if (failsafe) on << tr("FAILSAFE");
-  latches_->setText(coloured(on.join(QStringLiteral(" + ")) + tr(" latched: re-arm"), "#c62828"));
+  latches_->show(on.join(QStringLiteral(" + ")) + tr(" latched: re-arm"), "#c62828");
 }
 
 }  // namespace sp

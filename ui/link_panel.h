@@ -16,6 +16,8 @@ class QPushButton;
 
 namespace sp {
 
+class ElidedLabel;
+
 class LinkPanel : public QWidget {
   Q_OBJECT
 
@@ -34,6 +36,9 @@ class LinkPanel : public QWidget {
   /// connection changes), stamped with the wall-clock time.
   void appendEvent(const QString& text);
   QStringList events() const;  ///< the list's lines, oldest first
+  /// The whole texts of the link and latch fields (they show elided).
+  QString stateText() const;
+  QString latchesText() const;
 
   bool leaseHeld() const { return leaseHeld_; }
 
@@ -46,14 +51,14 @@ class LinkPanel : public QWidget {
   void rearmRequested();
 
  private:
-  QLabel* endpoint_ = nullptr;
-  QLabel* state_ = nullptr;
-  QLabel* rtt_ = nullptr;
-  QLabel* rate_ = nullptr;
-  QLabel* loss_ = nullptr;
-  QLabel* lease_ = nullptr;
-  QLabel* latches_ = nullptr;
-  QLabel* deadman_ = nullptr;  // the robot's, from WELCOME
+  ElidedLabel* endpoint_ = nullptr;
+  ElidedLabel* state_ = nullptr;
+  ElidedLabel* rtt_ = nullptr;
+  ElidedLabel* rate_ = nullptr;
+  ElidedLabel* loss_ = nullptr;
+  ElidedLabel* lease_ = nullptr;
+  ElidedLabel* latches_ = nullptr;
+  ElidedLabel* deadman_ = nullptr;  // the robot's, from WELCOME
   QPushButton* connect_ = nullptr;
   QPushButton* control_ = nullptr;
   QPushButton* estop_ = nullptr;

@@ -8,7 +8,12 @@
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QInputDialog>
+#include <QAbstractSpinBox>
 #include <QKeyEvent>
+#include <QLineEdit>
+#include <QPlainTextEdit>
+#include <QPushButton>
+#include <QTextEdit>
 #include <QLabel>
 #include <QMenuBar>
 #include <QMessageBox>
@@ -25,6 +30,7 @@
 #include "app/console_session.h"
 #include "ui/control_panel.h"
 #include "ui/link_panel.h"
+#include "ui/limit_spin_box.h"
 #include "ui/live_plots.h"
 #include "ui/robot_connection.h"
 #include "ui/robot_feed.h"
@@ -74,7 +80,12 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   scene_->setFocusPolicy(Qt::StrongFocus);
   scene_->setToolTip(tr("Drag to orbit, wheel to zoom, right-drag to pan. Keys: arrows or WASD drive, Space stops, F follows, Esc e-stops."));
   scene_->installEventFilter(this);
+  staleLabel_ = new QLabel;
+  staleLabel_->setObjectName(QStringLiteral("staleLabel"));
+  staleLabel_->setStyleSheet(QStringLiteral("QLabel { background: #616161; color: white; font-weight: bold; padding: 4px; }"));
+  staleLabel_->hide();
   layout->addWidget(banner_);
+  layout->addWidget(staleLabel_);
   layout->addWidget(scene_, 1);
   setCentralWidget(central);
 
@@ -89,9 +100,31 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
     if (kind == QLatin1String("refused") || kind == QLatin1String("error")) statusBar()->showMessage(text, 5000);
   });
   connect(feed_, &RobotFeed::stateChanged, this, [this] { updateBanner(); });
-  connect(connection_, &RobotConnection::lease, this, [this](const net::LeaseStateMsg& lease) { link_->showLease(lease); });
-  connect(connection_, &RobotConnection::connectionChanged, this,
-          [this](net::ConnectionState s, const QString& d) { link_->showConnection(s, d); });
+  connect(connection_, &RobotConnection::lease, this, [this](const net::LeaseStateMsg& lease) {
+    link_->showLease(lease);
+    // Losing or giving up control stops the robot: the controls show that.
+    if (leaseHeld_ && !lease.yours) controls_->syncToRobot(modelPositions_);
+    leaseHeld_ = lease.yours;
+    updateControlsEnabled();
+  });
+  connect(connection_, &RobotConnection::connectionChanged, this, [this](net::ConnectionState s, const QString& d) {
+    link_->showConnection(s, d);
+    connectionState_ = s;
+    connectionDetail_ = d;
+    if (s != net::ConnectionState::Ready && leaseHeld_) {
+      leaseHeld_ = false;
+      controls_->syncToRobot(modelPositions_);
+    }
+    updateControlsEnabled();
+    updateBanner();
+  });
+  connect(connection_, &RobotConnection::event, this, [this](const net::EventMsg& m) {
+    // The robot says why it stopped; the banner repeats it.
+    if (m.kind == net::EventKind::Failsafe) failsafeText_ = qs(m.text);
+    if (m.kind == net::EventKind::Failsafe || m.kind == net::EventKind::Estop || m.kind == net::EventKind::Rearmed)
+      controls_->syncToRobot(modelPositions_);
+    updateBanner();
+  });
 
   buildDocks();
   buildMenus();
@@ -120,6 +153,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
       controls_->showMeasured(modelPositions_);
       measuredDirty_ = false;
     }
+    updateStale();
     if (++panelTicks_ % 3 == 0) refreshStatus();
     scene_->update();
   });
@@ -155,6 +189,11 @@ MainWindow::~MainWindow() {
 void MainWindow::buildDocks() {
   controls_ = new ControlPanel;
   connect(controls_, &ControlPanel::command, this, &MainWindow::sendCommand);
+  connect(controls_, &ControlPanel::refused, this, [this](const QString& why) {
+    statusBar()->showMessage(why, 6000);
+    link_->appendEvent(why);
+  });
+  controls_->setControlsEnabled(false, tr("Take control first (Robot ▸ Take control)"));
   controlsDock_ = new QDockWidget(tr("Controls"), this);
   controlsDock_->setObjectName(QStringLiteral("controlsDock"));
   controlsDock_->setWidget(controls_);
@@ -186,10 +225,7 @@ void MainWindow::buildDocks() {
   connect(link_, &LinkPanel::takeControlRequested, connection_, &RobotConnection::acquireLease);
   connect(link_, &LinkPanel::releaseControlRequested, connection_, &RobotConnection::releaseLease);
   connect(link_, &LinkPanel::estopRequested, this, &MainWindow::emergencyStop);
-  connect(link_, &LinkPanel::rearmRequested, this, [this] {
-    link_->appendEvent(tr("re-arm sent"));
-    connection_->rearm();
-  });
+  connect(link_, &LinkPanel::rearmRequested, this, &MainWindow::rearm);
 }
 
 void MainWindow::buildMenus() {
@@ -230,7 +266,7 @@ void MainWindow::buildMenus() {
   // Esc itself is caught by the application filter; the menu shows the key.
   QAction* estop = robot->addAction(tr("&E-stop\tEsc"), this, &MainWindow::emergencyStop);
   estop->setToolTip(tr("Emergency stop"));
-  robot->addAction(tr("Re-&arm"), connection_, &RobotConnection::rearm);
+  robot->addAction(tr("Re-&arm…"), this, &MainWindow::rearm);
 
   QMenu* view = menuBar()->addMenu(tr("&View"));
   QAction* follow = view->addAction(tr("&Follow the robot"));
@@ -353,6 +389,46 @@ void MainWindow::emergencyStop() {
   statusBar()->showMessage(tr("E-STOP sent"), 5000);
 }
 
+void MainWindow::rearm() {
+  // Deliberate: a confirmation whose default is No, so that no stray Enter
+  // or Space re-arms a stopped robot.
+  QMessageBox box(QMessageBox::Question, tr("Re-arm"),
+                  tr("Re-arm the robot?\n\nThe latch clears; the robot stays stopped until the next command, "
+                     "and the deadman counts from now."),
+                  QMessageBox::NoButton, this);
+  box.setObjectName(QStringLiteral("rearmConfirm"));
+  QPushButton* yes = box.addButton(tr("Re-arm"), QMessageBox::AcceptRole);
+  QPushButton* no = box.addButton(tr("Cancel"), QMessageBox::RejectRole);
+  box.setDefaultButton(no);
+  box.exec();
+  if (box.clickedButton() != yes) return;
+  controls_->syncToRobot(modelPositions_);
+  linkEvent(QStringLiteral("rearm"), tr("re-arm sent"));
+  connection_->rearm();
+}
+
+void MainWindow::updateControlsEnabled() {
+  QString why;
+  if (connectionState_ != net::ConnectionState::Ready) why = tr("Not connected to the robot");
+  else if (!leaseHeld_) why = tr("Take control first (Robot ▸ Take control)");
+  else if (estop_ || failsafe_) why = tr("The robot is stopped and latched: re-arm first");
+  controls_->setControlsEnabled(why.isEmpty(), why);
+}
+
+void MainWindow::updateStale() {
+  const double staleAfter = session_->params().consoleStaleAfter;
+  const bool connected = connectionState_ == net::ConnectionState::Ready;
+  const double age = haveFrame_ ? static_cast<double>(lastFrameClock_.elapsed()) / 1000.0 : 0;
+  const bool stale = connected && haveFrame_ && age > staleAfter;
+  if (stale) staleLabel_->setText(tr("no data %1 s: the robot drawn is where it was %1 s ago").arg(formatFixed(age, 1)));
+  staleLabel_->setVisible(stale);
+  if (stale != stale_) {
+    stale_ = stale;
+    scene_->setStale(stale);
+    refreshStatus();
+  }
+}
+
 void MainWindow::sendCommand(const Command& command) {
   if (const std::string why = session_->commandRefusal(link_->leaseHeld()); !why.empty()) {
     statusBar()->showMessage(qs(why), 4000);
@@ -369,7 +445,21 @@ bool MainWindow::eventFilter(QObject* watched, QEvent* event) {
       if (!key->isAutoRepeat()) emergencyStop();
       return true;
     }
-    if (watched == scene_ && controls_->handleKey(key->key())) return true;
+    // Drive keys wherever the focus is in this window, except where keys
+    // are typed (a number box, a text field): no button or slider with the
+    // focus ever turns Space into a click or an arrow into a step.
+    auto* widget = qobject_cast<QWidget*>(watched);
+    const auto* line = qobject_cast<QLineEdit*>(watched);
+    const auto* plain = qobject_cast<QPlainTextEdit*>(watched);
+    const auto* rich = qobject_cast<QTextEdit*>(watched);
+    const bool typing = qobject_cast<QAbstractSpinBox*>(watched) || (line && !line->isReadOnly()) ||
+                        (plain && !plain->isReadOnly()) || (rich && !rich->isReadOnly());
+    if (widget && widget->window() == this && !typing && key->modifiers() == Qt::NoModifier &&
+        isDriveKey(key->key())) {
+      if (controls_->controlsEnabled()) controls_->handleKey(key->key());
+      else if (!key->isAutoRepeat()) statusBar()->showMessage(controls_->toolTipWhenDisabled(), 3000);
+      return true;
+    }
   }
   return QMainWindow::eventFilter(watched, event);
 }
@@ -383,6 +473,9 @@ void MainWindow::closeEvent(QCloseEvent* event) {
 
 void MainWindow::onFrame(const RobotFrame& f) {
   if (!session_->robot()) return;
+  lastFrameClock_.restart();
+  haveFrame_ = true;
+  if (stale_) updateStale();
   modelPositions_ = f.jointPositions;
   scene_->setRobotState(f.base, modelPositions_);
   std::vector<NamedPose> objects;
@@ -391,10 +484,13 @@ void MainWindow::onFrame(const RobotFrame& f) {
   measuredDirty_ = true;  // shown by the panel timer
   wheelPlot_->addSample(f.time, f.wheelNormal);
   if (f.failsafe != failsafe_ || f.estop != estop_ || qs(f.health) != healthText_) {
+    // A latch that comes on stopped the robot: the controls show it.
+    if ((f.failsafe && !failsafe_) || (f.estop && !estop_)) controls_->syncToRobot(modelPositions_);
     failsafe_ = f.failsafe;
     estop_ = f.estop;
     healthText_ = qs(f.health);
     link_->showLatches(failsafe_, estop_);
+    updateControlsEnabled();
     updateBanner();
   }
 }
@@ -416,6 +512,8 @@ void MainWindow::refreshStatus() {
     rtfLabel_->setText(tr("RTF –"));
   }
   if (!healthText_.isEmpty()) health_->setText(QStringLiteral("<b style='color:#c62828'>%1</b>").arg(tr("diverged")));
+  else if (stale_) health_->setText(QStringLiteral("<b style='color:#616161'>%1</b>").arg(tr("no data")));
+  else if (connectionState_ != net::ConnectionState::Ready) health_->setText(tr("not connected"));
   else if (last) health_->setText(QStringLiteral("<span style='color:#2e7d32'>%1</span>").arg(tr("healthy")));
   else health_->setText(tr("no telemetry"));
   health_->setToolTip(healthText_);
@@ -431,7 +529,12 @@ void MainWindow::updateBanner() {
   QStringList lines;
   if (!healthText_.isEmpty()) lines << tr("The twin diverged and stopped: %1").arg(healthText_);
   if (estop_) lines << tr("E-STOP latched: the robot is stopped. Re-arm to continue.");
-  if (failsafe_) lines << tr("FAILSAFE latched: the link was lost and the robot stopped. Re-arm to continue.");
+  if (failsafe_)
+    lines << (failsafeText_.isEmpty()
+                  ? tr("FAILSAFE latched: the robot stopped itself. Re-arm to continue.")
+                  : tr("FAILSAFE latched: %1; the robot stopped. Re-arm to continue.").arg(failsafeText_));
+  if (connectionState_ == net::ConnectionState::Waiting || connectionState_ == net::ConnectionState::Refused)
+    lines << tr("Robot link down (%1): the robot's own deadman stops it; reconnecting.").arg(connectionDetail_);
   banner_->setText(lines.join(QLatin1Char('\n')));
   banner_->setVisible(!lines.isEmpty());
 }

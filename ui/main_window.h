@@ -13,6 +13,7 @@
 // the link client's worker thread reach the window only through queued
 // signals (RobotConnection).
 
+#include <QElapsedTimer>
 #include <QMainWindow>
 #include <QString>
 #include <QStringList>
@@ -24,6 +25,7 @@
 
 #include "app/robot_frame.h"
 #include "net/message.h"
+#include "net/robot_client.h"
 #include "sim/robot_model.h"
 
 class QLabel;
@@ -94,6 +96,9 @@ class MainWindow : public QMainWindow {
 
  public slots:
   void emergencyStop();
+  /// Asks the operator to confirm, then re-arms (clears a latched failsafe
+  /// or e-stop) and zeroes the controls.
+  void rearm();
 
  protected:
   bool eventFilter(QObject* watched, QEvent* event) override;
@@ -112,6 +117,10 @@ class MainWindow : public QMainWindow {
   void sendCommand(const Command& command);
   void refreshStatus();
   void updateBanner();
+  /// Controls enabled only while connected, holding the lease and unlatched.
+  void updateControlsEnabled();
+  /// No telemetry for console.stale_after: the robot greys, the status says so.
+  void updateStale();
   void showLoadErrors(const QString& title, const QString& text);
   /// An event of the console's own (e-stop sent, re-arm sent), shown in the
   /// link dock and logged.
@@ -132,6 +141,7 @@ class MainWindow : public QMainWindow {
   QDockWidget* plotsDock_ = nullptr;
   QDockWidget* linkDock_ = nullptr;
   QLabel* banner_ = nullptr;
+  QLabel* staleLabel_ = nullptr;
   QLabel* simTime_ = nullptr;
   QLabel* rtfLabel_ = nullptr;
   QLabel* health_ = nullptr;
@@ -141,6 +151,12 @@ class MainWindow : public QMainWindow {
   bool measuredDirty_ = false;  // modelPositions_ changed since the controls showed them
   int64_t panelTicks_ = 0;
   bool failsafe_ = false, estop_ = false;
+  bool leaseHeld_ = false;
+  net::ConnectionState connectionState_ = net::ConnectionState::Stopped;
+  QString connectionDetail_;
+  QString failsafeText_;  // the robot's EVENT text: why it stopped
+  QElapsedTimer lastFrameClock_;
+  bool haveFrame_ = false, stale_ = false;
   QString healthText_;
 };
 

@@ -371,6 +371,9 @@ struct SceneView::Impl {
   std::vector<double> laserRanges;
   bool laserDirty = false;
   bool laserVisible = true;
+  // Stale data: the robot drawn grey (an override material on its group).
+  bool stale = false, staleShown = false;
+  osg::ref_ptr<osg::Material> staleTint;
 
   // Orbit camera around `centre`, z up.
   osg::Vec3d centre;
@@ -542,6 +545,22 @@ void SceneView::Impl::sync() {
     ghostDirty = false;
   }
   ghostNode->setNodeMask(ghostVisible && hasRobot ? ~0u : 0u);
+  if (stale != staleShown) {
+    osg::StateSet* st = robotNode->getOrCreateStateSet();
+    if (stale) {
+      if (!staleTint) {
+        staleTint = new osg::Material;
+        staleTint->setColorMode(osg::Material::OFF);
+        staleTint->setDiffuse(osg::Material::FRONT_AND_BACK, {0.55f, 0.55f, 0.55f, 1});
+        staleTint->setAmbient(osg::Material::FRONT_AND_BACK, {0.25f, 0.25f, 0.25f, 1});
+        staleTint->setSpecular(osg::Material::FRONT_AND_BACK, {0, 0, 0, 1});
+      }
+      st->setAttributeAndModes(staleTint, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+    } else {
+      st->removeAttribute(staleTint.get());
+    }
+    staleShown = stale;
+  }
   if (objectsDirty) {
     for (auto& [name, o] : objects) o.transform->setMatrix(toMatrix(o.pose));
     objectsDirty = false;
@@ -713,6 +732,8 @@ Pose SceneView::drawnBasePose() const {
 }
 
 void SceneView::setLaserVisible(bool visible) { m_->laserVisible = visible; }
+void SceneView::setStale(bool stale) { m_->stale = stale; }
+bool SceneView::stale() const { return m_->stale; }
 bool SceneView::laserVisible() const { return m_->laserVisible; }
 
 void SceneView::setFollow(bool on) {

@@ -87,6 +87,10 @@ class SceneView : public QOpenGLWidget {
   /// Shows or hides the laser scan (shown by default).
   void setLaserVisible(bool visible);
   bool laserVisible() const;
+  /// Draws the robot grey while its data is stale (no telemetry lately):
+  /// the operator must not take an old pose for the present one.
+  void setStale(bool stale);
+  bool stale() const;
 
   /// Follow mode keeps the orbit centre on the robot base (default on).
   void setFollow(bool on);

@@ -56,6 +56,7 @@ SimParams allChanged() {
   p.linkLeaseConfirm = 20;
   p.linkMaxConnections = 500;
   p.linkHelloTimeout = 3;
+  p.consoleStaleAfter = 4;
   p.maxLinearSpeed = 5;
   p.maxAngularSpeed = 6;
   p.maxJointError = 7;
@@ -135,7 +136,7 @@ void TestParams::tableDefaultsAreSimParamsDefaults() {
   std::set<std::string> seen;
   const QRegularExpression keyPattern("^[a-z]+(\\.[a-z_]+)+$");
   const std::vector<ParamInfo> table = paramTable();
-  QCOMPARE(table.size(), size_t(32));
+  QCOMPARE(table.size(), size_t(33));
   for (const ParamInfo& info : table) {
     QVERIFY2(seen.insert(info.key).second, info.key.c_str());
     QVERIFY2(keyPattern.match(q(info.key)).hasMatch(), info.key.c_str());

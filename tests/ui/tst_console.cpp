@@ -3,6 +3,11 @@
 // e-stop, plots, file errors and remembered docks.
 
 #include <QDockWidget>
+#include <QLabel>
+#include <QPlainTextEdit>
+#include <QPushButton>
+#include <QRegularExpression>
+#include <QStatusBar>
 #include <QDoubleSpinBox>
 #include <QMessageBox>
 #include <QTimer>
@@ -13,7 +18,10 @@
 #include <QTemporaryDir>
 #include <QtTest>
 
+#include <signal.h>
+
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <fstream>
 
@@ -57,6 +65,18 @@ double planarSpeedOver(MainWindow& w, int millis) {
   const Pose b = w.lastTelemetry()->pose;
   const double dt = w.lastTelemetry()->time - t0;
   return dt > 0 ? std::hypot(b.p.x - a.p.x, b.p.y - a.p.y) / dt : 0;
+}
+
+/// Answers the re-arm confirmation that `ask` opens: presses "Re-arm" (or
+/// Cancel) as soon as the dialog is up.
+void answerRearm(const std::function<void()>& ask, bool confirm) {
+  QTimer::singleShot(50, [confirm] {
+    auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget());
+    if (!box) return;
+    for (QAbstractButton* b : box->buttons())
+      if (b->text() == (confirm ? QStringLiteral("Re-arm") : QStringLiteral("Cancel"))) b->click();
+  });
+  ask();
 }
 
 }  // namespace
@@ -164,7 +184,7 @@ class TestConsole : public QObject {
     QTRY_VERIFY_WITH_TIMEOUT(w.bannerText().contains(QLatin1String("E-STOP")), 3000);
     QTest::qWait(1000);  // braking
     QVERIFY2(planarSpeedOver(w, 500) < 0.02, "still moving after the e-stop");
-    w.linkPanel()->rearmRequested();
+    answerRearm([&] { w.linkPanel()->rearmRequested(); }, true);
     QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->estop, 3000);
     QTRY_VERIFY(w.bannerText().isEmpty());
     // Re-arming does not restart the motion.
@@ -183,9 +203,102 @@ class TestConsole : public QObject {
     QVERIFY(w.lastTelemetry()->failsafe);
     w.linkPanel()->takeControlRequested();
     QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld(), 3000);
-    w.linkPanel()->rearmRequested();
+    answerRearm([&] { w.linkPanel()->rearmRequested(); }, true);
     QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->failsafe, 3000);
     QTRY_VERIFY(w.bannerText().isEmpty());
+  }
+
+  // The controls show what the robot does, not the last set-point: after an
+  // e-stop the speed reads 0 and the controls are disabled (keys too, with
+  // the focus on a button: Space must not re-arm); re-arm asks first, and
+  // one Up press after it asks for 0.05 m/s, not the old speed plus 0.05.
+  void controlsMirrorTheRobot() {
+    MainWindow& w = *window_;
+    ControlPanel* controls = w.controlPanel();
+    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld() && controls->controlsEnabled(), 3000);
+    w.sceneView()->setFocus();
+    for (int i = 0; i < 6; ++i) QTest::keyClick(w.sceneView(), Qt::Key_Up);
+    QCOMPARE(controls->speed(), 0.3);
+    w.emergencyStop();
+    QTRY_VERIFY_WITH_TIMEOUT(w.lastTelemetry()->estop, 3000);
+    QTRY_COMPARE(controls->speed(), 0.0);
+    QTRY_VERIFY(!controls->controlsEnabled());
+    // Focus on a button, then Space and Up: nothing is clicked, nothing driven.
+    auto* rearmButton = w.linkPanel()->findChild<QPushButton*>(QStringLiteral("rearmButton"));
+    QVERIFY(rearmButton);
+    QCOMPARE(rearmButton->focusPolicy(), Qt::NoFocus);
+    rearmButton->setFocus();
+    QTest::keyClick(QApplication::focusWidget() ? QApplication::focusWidget() : rearmButton, Qt::Key_Space);
+    QTest::keyClick(QApplication::focusWidget() ? QApplication::focusWidget() : rearmButton, Qt::Key_Up);
+    QTest::qWait(500);
+    QVERIFY(w.lastTelemetry()->estop);
+    QCOMPARE(controls->speed(), 0.0);
+    // Cancel leaves it latched; confirming re-arms.
+    answerRearm([&] { w.rearm(); }, false);
+    QTest::qWait(500);
+    QVERIFY(w.lastTelemetry()->estop);
+    answerRearm([&] { w.rearm(); }, true);
+    QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->estop, 3000);
+    QTRY_VERIFY(controls->controlsEnabled());
+    // Drive keys work wherever the focus is (here the link's event list).
+    auto* events = w.linkPanel()->findChild<QPlainTextEdit*>();
+    QVERIFY(events);
+    events->setFocus();
+    QTest::keyClick(events, Qt::Key_Up);
+    QCOMPARE(controls->speed(), 0.05);
+    QTest::keyClick(events, Qt::Key_Space);
+    QCOMPARE(controls->speed(), 0.0);
+  }
+
+  // Stale data shows: a robot that stops sending (SIGSTOP, its connection
+  // still open) is greyed with "no data" within a second and the status no
+  // longer says healthy; when it sends again, that clears.
+  void staleDataIsVisible() {
+    QProcess robot;
+    robot.setProcessChannelMode(QProcess::MergedChannels);
+    const QString token = QStringLiteral("00112233445566778899aabbccddeeff");
+    robot.start(QStringLiteral(SP_ROBOT_EXE), {QStringLiteral("--world"), options_.world, QStringLiteral("--port"),
+                                               QStringLiteral("0"), QStringLiteral("--token"), token,
+                                               QStringLiteral("--no-log")});
+    QVERIFY(robot.waitForStarted());
+    QString port;
+    QByteArray out;
+    for (int i = 0; i < 300 && port.isEmpty(); ++i) {
+      robot.waitForReadyRead(100);
+      out += robot.readAll();
+      const QRegularExpression re(QStringLiteral("listening on 127\\.0\\.0\\.1:(\\d+)"));
+      if (const auto m = re.match(QString::fromUtf8(out)); m.hasMatch()) port = m.captured(1);
+    }
+    QVERIFY2(!port.isEmpty(), out.constData());
+    ConsoleOptions o = options_;
+    o.connectTo = QStringLiteral("127.0.0.1:") + port;
+    o.token = token;
+    o.takeControl = false;
+    o.log = false;
+    {
+      MainWindow remote(o);
+      QCOMPARE(remote.start(), QString());
+      remote.show();
+      QTRY_VERIFY_WITH_TIMEOUT(remote.telemetryReceived() > 10, 5000);
+      auto* stale = remote.findChild<QLabel*>(QStringLiteral("staleLabel"));
+      QVERIFY(stale);
+      QVERIFY(!stale->isVisible());
+      QVERIFY(!remote.sceneView()->stale());
+      ::kill(static_cast<pid_t>(robot.processId()), SIGSTOP);
+      QTRY_VERIFY_WITH_TIMEOUT(stale->isVisible(), 1500);
+      QVERIFY(stale->text().startsWith(QLatin1String("no data")));
+      QVERIFY(remote.sceneView()->stale());
+      QTest::qWait(400);
+      QVERIFY(!remote.statusBar()->findChildren<QLabel*>().isEmpty());
+      bool saysHealthy = false;
+      for (QLabel* l : remote.statusBar()->findChildren<QLabel*>()) saysHealthy |= l->text().contains(QLatin1String("healthy"));
+      QVERIFY(!saysHealthy);
+      ::kill(static_cast<pid_t>(robot.processId()), SIGCONT);
+      QTRY_VERIFY_WITH_TIMEOUT(!stale->isVisible(), 3000);
+      QVERIFY(!remote.sceneView()->stale());
+    }
+    robot.terminate();
+    QVERIFY(robot.waitForFinished(5000));
   }
 
   // A broken world file is refused with its file:line error; the session

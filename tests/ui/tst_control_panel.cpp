@@ -14,6 +14,7 @@
 #include "headless_default.h"
 #include "sim/model_loader.h"
 #include "ui/control_panel.h"
+#include "ui/limit_spin_box.h"
 
 using namespace sp;
 
@@ -106,10 +107,10 @@ class TestControlPanel : public QObject {
     QCOMPARE(sent<JointTargetCmd>().back().joint, std::string("elbow_l"));
     QVERIFY(std::abs(sent<JointTargetCmd>().back().position - degToRad(45)) < 1e-12);
 
-    auto* finger = panel_->findChild<QDoubleSpinBox*>(QStringLiteral("target_finger_l1"));
+    auto* finger = panel_->findChild<LimitSpinBox*>(QStringLiteral("target_finger_l1"));
     QVERIFY(finger);
     QCOMPARE(finger->suffix(), QStringLiteral(" mm"));
-    const double mm = std::min(finger->maximum(), 10.0);
+    const double mm = std::min(finger->upper(), 10.0);
     finger->setValue(mm);
     QVERIFY(std::abs(sent<JointTargetCmd>().back().position - mm / 1000) < 1e-12);
 
@@ -117,6 +118,66 @@ class TestControlPanel : public QObject {
     measured[static_cast<size_t>(robot_.findJoint("elbow_l"))] = degToRad(30);
     panel_->showMeasured(measured);
     QCOMPARE(panel_->findChild<QLabel*>(QStringLiteral("measured_elbow_l"))->text(), QStringLiteral("30.0 °"));
+  }
+
+  // A typed value beyond the joint's limits is refused visibly and sent
+  // nowhere (a plain spin box made "99" into "9"); one within is sent.
+  void typedValueBeyondLimitsIsRefused() {
+    auto* elbow = panel_->findChild<LimitSpinBox*>(QStringLiteral("target_elbow_l"));
+    QVERIFY(elbow);
+    QSignalSpy refused(panel_.get(), &ControlPanel::refused);
+    const double before = elbow->value();
+    const QString tooFar = QString::number(std::floor(elbow->upper()) + 60);
+    elbow->setFocus();
+    elbow->selectAll();
+    QTest::keyClicks(elbow, tooFar);
+    QTest::keyClick(elbow, Qt::Key_Return);
+    QCOMPARE(refused.count(), 1);
+    const QString why = refused.at(0).at(0).toString();
+    QVERIFY2(why.contains(tooFar) && why.contains(QLatin1String("elbow_l")), qPrintable(why));
+    QCOMPARE(elbow->value(), before);
+    QVERIFY(sent<JointTargetCmd>().empty());
+    // The control: a value within the limits goes out as typed.
+    const QString within = QString::number(std::floor((elbow->lower() + elbow->upper()) / 2));
+    elbow->selectAll();
+    QTest::keyClicks(elbow, within);
+    QTest::keyClick(elbow, Qt::Key_Return);
+    QCOMPARE(refused.count(), 1);
+    QCOMPARE(sent<JointTargetCmd>().size(), size_t{1});
+    QVERIFY(std::abs(sent<JointTargetCmd>().back().position - degToRad(within.toDouble())) < 1e-12);
+  }
+
+  // "-0.0" never shows: a tiny negative measured or set value reads 0.0.
+  void negativeZeroNeverShows() {
+    std::vector<double> measured(robot_.joints.size(), -1e-4);
+    panel_->showMeasured(measured);
+    QCOMPARE(panel_->findChild<QLabel*>(QStringLiteral("measured_elbow_l"))->text(), QStringLiteral("0.0 °"));
+    auto* elbow = panel_->findChild<LimitSpinBox*>(QStringLiteral("target_elbow_l"));
+    elbow->setValue(-0.01);
+    QCOMPARE(elbow->text(), QStringLiteral("0.0 °"));
+    QCOMPARE(formatFixed(-0.04, 1), QStringLiteral("0.0"));
+    QCOMPARE(formatFixed(-0.06, 1), QStringLiteral("-0.1"));
+  }
+
+  // After a stop the controls show what the robot does: speed 0, the
+  // articulation and joint targets where measured; nothing is sent.
+  void syncToRobotShowsTheRobot() {
+    for (int i = 0; i < 6; ++i) panel_->handleKey(Qt::Key_Up);
+    QVERIFY(panel_->speed() > 0.25);
+    QTest::qWait(120);  // the coalesced drive command goes out
+    commands_.clear();
+    std::vector<double> measured(robot_.joints.size(), 0.0);
+    measured[static_cast<size_t>(robot_.drive->articulation)] = degToRad(10);
+    measured[static_cast<size_t>(robot_.findJoint("elbow_l"))] = degToRad(20);
+    panel_->syncToRobot(measured);
+    QCOMPARE(panel_->speed(), 0.0);
+    QVERIFY(std::abs(panel_->articulation() - degToRad(10)) < 1e-9);
+    QCOMPARE(panel_->findChild<LimitSpinBox*>(QStringLiteral("target_elbow_l"))->value(), 20.0);
+    QTest::qWait(120);
+    QVERIFY(commands_.empty());
+    // One key press now starts from zero.
+    panel_->handleKey(Qt::Key_Up);
+    QCOMPARE(panel_->speed(), 0.05);
   }
 
   // Choosing a gait sends it and zeroes the drive; driving again shows

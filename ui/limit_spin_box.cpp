@@ -1,0 +1,64 @@
+#include "ui/limit_spin_box.h"
+
+#include <QTimer>
+
+#include <algorithm>
+#include <cmath>
+
+namespace sp {
+
+namespace {
+constexpr double kTypingRange = 1e6;  // what may be typed, whatever the limits
+}
+
+QString formatFixed(double value, int decimals) {
+  const double scale = std::pow(10.0, decimals);
+  if (std::round(value * scale) == 0) value = 0;  // drops the sign of a negative zero too
+  return QString::number(value, 'f', decimals);
+}
+
+LimitSpinBox::LimitSpinBox(QWidget* parent) : QDoubleSpinBox(parent) {
+  QDoubleSpinBox::setRange(-kTypingRange, kTypingRange);
+  setKeyboardTracking(false);  // one value per commit, not one per digit
+  connect(this, &QDoubleSpinBox::valueChanged, this, &LimitSpinBox::onValueChanged);
+}
+
+void LimitSpinBox::setLimits(double lower, double upper) {
+  lower_ = lower;
+  upper_ = upper;
+}
+
+QString LimitSpinBox::textFromValue(double value) const {
+  return locale().toString(formatFixed(value, decimals()).toDouble(), 'f', decimals());
+}
+
+void LimitSpinBox::stepBy(int steps) {
+  // Steps stop at the limits rather than stepping into a refusal.
+  const double next = std::clamp(value() + steps * singleStep(), lower_, upper_);
+  setValue(next);
+  selectAll();
+}
+
+void LimitSpinBox::onValueChanged(double v) {
+  // The display rounds to decimals(); compare what is shown.
+  const double tolerance = 0.5 * std::pow(10.0, -decimals());
+  if (v < lower_ - tolerance || v > upper_ + tolerance) {
+    const QString unit = suffix().trimmed();
+    const QString why = tr("%1 %2 %3 is outside the limits [%4, %5] %3: not sent")
+                            .arg(what_.isEmpty() ? tr("value") : what_, formatFixed(v, decimals()), unit,
+                                 formatFixed(lower_, decimals()), formatFixed(upper_, decimals()));
+    {
+      const QSignalBlocker block(this);
+      setValue(last_);
+    }
+    setStyleSheet(QStringLiteral("QDoubleSpinBox { background: #ffcdd2; }"));
+    setToolTip(why);
+    QTimer::singleShot(2000, this, [this] { setStyleSheet({}); });
+    emit refused(why);
+    return;
+  }
+  last_ = v;
+  emit accepted(v);
+}
+
+}  // namespace sp
