@@ -49,19 +49,62 @@ std::string ConsoleSession::start() {
   std::optional<WorldModel> world = loadWorld(options_.world, diag);
   if (!world) return text(diag);
   if (world->robots.empty()) return options_.world + ": error: the world has no <robot>";
-  const size_t colon = options_.connectTo.rfind(':');
-  uint32_t port = 0;
-  bool ok = colon != std::string::npos && colon > 0 && colon + 1 < options_.connectTo.size();
-  for (size_t i = colon + 1; ok && i < options_.connectTo.size(); ++i) {
-    const char c = options_.connectTo[i];
-    ok = c >= '0' && c <= '9' && port <= 65535;
-    port = port * 10 + static_cast<uint32_t>(c - '0');
-  }
-  if (!ok || port == 0 || port > 65535) return "--connect: expected HOST:PORT, got '" + options_.connectTo + "'";
-  endpoint_ = {options_.connectTo.substr(0, colon), static_cast<uint16_t>(port), options_.token, options_.connectTo};
+  std::string error;
+  const std::optional<RobotEndpoint> endpoint = parseEndpoint(options_.connectTo, options_.token, error);
+  if (!endpoint) return "--connect: " + error;
+  endpoint_ = *endpoint;
   worldFile_ = options_.world;
   setWorld(std::move(*world));
   openRemoteLog();
+  return {};
+}
+
+std::optional<RobotEndpoint> parseEndpoint(const std::string& hostPort, const std::string& token, std::string& error) {
+  const size_t colon = hostPort.rfind(':');
+  uint32_t port = 0;
+  bool ok = colon != std::string::npos && colon > 0 && colon + 1 < hostPort.size();
+  for (size_t i = colon + 1; ok && i < hostPort.size(); ++i) {
+    const char c = hostPort[i];
+    ok = c >= '0' && c <= '9' && port <= 65535;
+    port = port * 10 + static_cast<uint32_t>(c - '0');
+  }
+  if (!ok || port == 0 || port > 65535) {
+    error = "expected HOST:PORT, got '" + hostPort + "'";
+    return std::nullopt;
+  }
+  const bool hex = token.find_first_not_of("0123456789abcdefABCDEF") == std::string::npos;
+  if (!hex || token.size() < 32) {
+    error = "the token must have at least 32 hex digits (128 bits), got " +
+            (hex ? std::to_string(token.size()) + " digits" : std::string("other characters"));
+    return std::nullopt;
+  }
+  return RobotEndpoint{hostPort.substr(0, colon), static_cast<uint16_t>(port), token, hostPort};
+}
+
+std::string ConsoleSession::connectTo(const std::string& hostPort, const std::string& token) {
+  std::string error;
+  const std::optional<RobotEndpoint> endpoint = parseEndpoint(hostPort, token, error);
+  if (!endpoint) return error;
+  // The stand-in goes (its log complete); the drawing stays until the
+  // operator opens the remote robot's world.
+  if (standIn_) standIn_->stop();
+  standIn_.reset();
+  options_.connectTo = hostPort;
+  options_.token = token;
+  endpoint_ = *endpoint;
+  openRemoteLog();
+  return {};
+}
+
+std::string ConsoleSession::useStandIn() {
+  const std::string world = worldFile_.empty() ? options_.world : worldFile_;
+  const std::string previous = options_.connectTo;
+  options_.connectTo.clear();
+  if (std::string error = startStandIn(world, {}); !error.empty()) {
+    options_.connectTo = previous;
+    return error;
+  }
+  recorder_.reset();
   return {};
 }
 

@@ -50,6 +50,10 @@ struct RobotEndpoint {
   std::string label;  ///< for the operator, e.g. "127.0.0.1:41234 (stand-in, flat.world.xml)"
 };
 
+/// The endpoint HOST:PORT with `token` (>= 32 hex digits), or nullopt and
+/// `error` saying which of the two is wrong.
+std::optional<RobotEndpoint> parseEndpoint(const std::string& hostPort, const std::string& token, std::string& error);
+
 class ConsoleSession {
  public:
   explicit ConsoleSession(ConsoleSessionOptions options);
@@ -72,6 +76,12 @@ class ConsoleSession {
   std::string openRobot(const std::string& path);
 
   bool remote() const { return !options_.connectTo.empty(); }
+  /// Switches to the robot at HOST:PORT with `token`: the stand-in (if any)
+  /// stops with its log complete, a new log of what the console sees
+  /// starts. On a bad endpoint or token returns why and changes nothing.
+  std::string connectTo(const std::string& hostPort, const std::string& token);
+  /// Switches back to a stand-in on loopback running the drawn world.
+  std::string useStandIn();
   /// The world drawn (its robots[0] is the one controlled); null before start().
   const WorldModel* world() const { return world_ ? &*world_ : nullptr; }
   /// robots[0]'s model, or null.

@@ -7,6 +7,7 @@
 #include <QDir>
 #include <QElapsedTimer>
 #include <QFileInfo>
+#include <QRegularExpression>
 #include <QSurfaceFormat>
 #include <QTimer>
 
@@ -58,17 +59,20 @@ int main(int argc, char** argv) {
   format.setSwapInterval(0);  // the view paces itself with a timer
   QSurfaceFormat::setDefaultFormat(format);
 
-  QApplication app(argc, argv);
-  QApplication::setApplicationName(QStringLiteral("SimPartner"));
-  QApplication::setOrganizationName(QStringLiteral("SimPartner"));
-  QApplication::setApplicationVersion(QStringLiteral(SP_VERSION));
+  // The command line is read before any window system is touched: --help,
+  // --version and bad options work without a display (a GUI application
+  // aborts when it cannot open one).
+  std::optional<QCoreApplication> bare(std::in_place, argc, argv);
+  QCoreApplication::setApplicationName(QStringLiteral("SimPartner"));
+  QCoreApplication::setOrganizationName(QStringLiteral("SimPartner"));
+  QCoreApplication::setApplicationVersion(QStringLiteral(SP_VERSION));
 
   QCommandLineParser parser;
   parser.setApplicationDescription(QStringLiteral(
       "The SimPartner operator console. By default it starts the stand-in robot (the twin) on loopback "
       "and connects to it; --connect reaches any robot that speaks the link protocol."));
-  parser.addHelpOption();
-  parser.addVersionOption();
+  const QCommandLineOption helpOption = parser.addHelpOption();
+  const QCommandLineOption versionOption = parser.addVersionOption();
   const QCommandLineOption world({QStringLiteral("w"), QStringLiteral("world")}, QStringLiteral("World file (default terrains/flat.world.xml)."), QStringLiteral("FILE"), QStringLiteral("terrains/flat.world.xml"));
   const QCommandLineOption params(QStringLiteral("params"), QStringLiteral("Parameters file for the stand-in."), QStringLiteral("FILE"));
   const QCommandLineOption set(QStringLiteral("set"), QStringLiteral("Parameter override KEY=VALUE (repeatable)."), QStringLiteral("KEY=VALUE"));
@@ -82,7 +86,30 @@ int main(int argc, char** argv) {
   const QCommandLineOption quitAfter(QStringLiteral("quit-after"), QStringLiteral("Quit after S seconds, printing the frame rate (for measurements)."), QStringLiteral("S"));
   const QCommandLineOption drive(QStringLiteral("drive"), QStringLiteral("Drive at SPEED m/s once in control (for demonstrations)."), QStringLiteral("SPEED"));
   parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, monitor, screenshot, quitAfter, drive});
-  parser.process(app);
+  if (!parser.parse(QCoreApplication::arguments())) {
+    std::cerr << "<command line>: error: " << parser.errorText().toStdString() << "\n";
+    return 2;
+  }
+  if (parser.isSet(helpOption)) {
+    std::cout << parser.helpText().toStdString();
+    return 0;
+  }
+  if (parser.isSet(versionOption)) {
+    std::cout << "SimPartner " << SP_VERSION << "\n";
+    return 0;
+  }
+  // A token that the robot can only refuse is refused here, at once, rather
+  // than after a connection attempt.
+  if (parser.isSet(token)) {
+    const QString t = parser.value(token);
+    static const QRegularExpression hex(QStringLiteral("^[0-9a-fA-F]*$"));
+    if (!hex.match(t).hasMatch() || t.size() < 32) {
+      std::cerr << "<command line>: error: --token: expected at least 32 hex digits (128 bits), got "
+                << (hex.match(t).hasMatch() ? std::to_string(t.size()) + " digits" : std::string("other characters"))
+                << "\n";
+      return 2;
+    }
+  }
 
   sp::ConsoleOptions options;
   options.world = findDataFile(parser.value(world));
@@ -101,6 +128,12 @@ int main(int argc, char** argv) {
   }
   if (parser.isSet(drive) && !(driveSpeed = numberOption(parser, drive, -10, 10))) return 2;
   if (parser.isSet(quitAfter) && !(quitSeconds = numberOption(parser, quitAfter, 0.1, 1e6))) return 2;
+
+  bare.reset();
+  QApplication app(argc, argv);
+  QApplication::setApplicationName(QStringLiteral("SimPartner"));
+  QApplication::setOrganizationName(QStringLiteral("SimPartner"));
+  QApplication::setApplicationVersion(QStringLiteral(SP_VERSION));
 
   sp::MainWindow window(options);
   if (const QString error = window.start(); !error.isEmpty()) {

@@ -39,7 +39,7 @@ ControlPanel::ControlPanel(QWidget* parent) : QWidget(parent) {
   driveBox_ = new QGroupBox(tr("Drive"), this);
   auto* drive = new QGridLayout(driveBox_);
   speedSlider_ = new QSlider(Qt::Horizontal);
-  speedSlider_->setMinimumWidth(90);
+  speedSlider_->setMinimumWidth(50);
   speedSpin_ = new LimitSpinBox;
   speedSpin_->setWhat(tr("speed"));
   speedSpin_->setSuffix(tr(" m/s"));
@@ -202,7 +202,7 @@ void ControlPanel::setRobot(const RobotModel& robot) {
     const double hi = joint.limited ? joint.upper * row.scale : (slider ? 1000.0 : 180.0);
     row.slider = new QSlider(Qt::Horizontal);
     row.slider->setRange(toTicks(lo), toTicks(hi));
-    row.slider->setMinimumWidth(90);
+    row.slider->setMinimumWidth(50);
     row.spin = new LimitSpinBox;
     row.spin->setLimits(lo, hi);
     row.spin->setWhat(tr("%1 target").arg(QString::fromStdString(joint.name)));
@@ -250,7 +250,7 @@ void ControlPanel::setRobot(const RobotModel& robot) {
   gl->setColumnStretch(1, 1);
   jointsLayout_->addWidget(grid);
   // Rows scroll vertically only: the area is as wide as a row.
-  scroll_->setMinimumWidth(grid->sizeHint().width() + scroll_->verticalScrollBar()->sizeHint().width() + 4);
+  scroll_->setMinimumWidth(grid->minimumSizeHint().width() + scroll_->verticalScrollBar()->sizeHint().width() + 4);
   jointsLayout_->addStretch(1);
 }
 

@@ -26,10 +26,31 @@ LimitSpinBox::LimitSpinBox(QWidget* parent) : QDoubleSpinBox(parent) {
 void LimitSpinBox::setLimits(double lower, double upper) {
   lower_ = lower;
   upper_ = upper;
+  updateGeometry();
 }
 
 QString LimitSpinBox::textFromValue(double value) const {
   return locale().toString(formatFixed(value, decimals()).toDouble(), 'f', decimals());
+}
+
+int LimitSpinBox::excessWidth() const {
+  const QFontMetrics fm(font());
+  const auto width = [&](double v) { return fm.horizontalAdvance(textFromValue(v) + suffix()); };
+  const int typing = std::max(width(minimum()), width(maximum()));
+  const int limits = std::max(width(lower_), width(upper_));
+  return std::max(0, typing - limits);
+}
+
+QSize LimitSpinBox::sizeHint() const {
+  QSize hint = QDoubleSpinBox::sizeHint();
+  hint.rwidth() -= excessWidth();
+  return hint;
+}
+
+QSize LimitSpinBox::minimumSizeHint() const {
+  QSize hint = QDoubleSpinBox::minimumSizeHint();
+  hint.rwidth() -= excessWidth();
+  return hint;
 }
 
 void LimitSpinBox::stepBy(int steps) {

@@ -34,10 +34,15 @@ class LimitSpinBox : public QDoubleSpinBox {
 
  protected:
   QString textFromValue(double value) const override;
+  /// As wide as the limits' values need, not the typing range's.
+  QSize sizeHint() const override;
+  QSize minimumSizeHint() const override;
   void stepBy(int steps) override;
 
  private:
   void onValueChanged(double value);
+  /// How much narrower the limits' longest text is than the typing range's [px].
+  int excessWidth() const;
 
   double lower_ = -1e9, upper_ = 1e9;
   double last_ = 0;

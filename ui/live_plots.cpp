@@ -106,7 +106,7 @@ LivePlot::LivePlot(QWidget* parent) : QWidget(parent) {
 
   auto* view = new QChartView(chart_, this);  // takes the chart
   view->setRenderHint(QPainter::Antialiasing);
-  view->setMinimumSize(240, 180);
+  view->setMinimumSize(200, 120);  // small enough for the 3D view to get half the window at 1280x800
 
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);

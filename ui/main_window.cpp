@@ -28,6 +28,7 @@
 #include <cmath>
 
 #include "app/console_session.h"
+#include "ui/connect_dialog.h"
 #include "ui/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/limit_spin_box.h"
@@ -128,6 +129,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
 
   buildDocks();
   buildMenus();
+  updateActions();
 
   simTime_ = new QLabel;
   rtfLabel_ = new QLabel;
@@ -168,12 +170,37 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   resize(1280, 800);
   QSettings settings;
   restoreGeometry(settings.value(QStringLiteral("window/geometry")).toByteArray());
-  if (!restoreState(settings.value(QStringLiteral("window/state")).toByteArray()))
-    QTimer::singleShot(0, this, [this] {
-      resizeDocks({controlsDock_, linkDock_}, {380, 330}, Qt::Horizontal);
-      resizeDocks({plotsDock_}, {320}, Qt::Vertical);
-    });
+  const bool restored = restoreState(settings.value(QStringLiteral("window/state")).toByteArray());
+  QTimer::singleShot(0, this, [this, restored] {
+    if (!restored) return defaultLayout();
+    // A layout saved while squeezed (a small window, a dock dragged wide)
+    // must not come back squeezed: the 3D view is what the console is for.
+    if (viewShare() < kMinViewShare) {
+      defaultLayout();
+      statusBar()->showMessage(tr("The saved layout left the 3D view too small: the default layout is back."), 8000);
+    }
+  });
   refreshStatus();
+}
+
+double MainWindow::viewShare() const {
+  const double window = static_cast<double>(width()) * height();
+  return window > 0 ? static_cast<double>(scene_->width()) * scene_->height() / window : 0;
+}
+
+void MainWindow::defaultLayout() {
+  // Controls over the link on the right, full height; the plots under the
+  // 3D view only. At 1280x800 the view gets over half the window.
+  for (QDockWidget* dock : {controlsDock_, linkDock_, plotsDock_}) {
+    dock->setFloating(false);
+    dock->show();
+  }
+  addDockWidget(Qt::RightDockWidgetArea, controlsDock_);
+  splitDockWidget(controlsDock_, linkDock_, Qt::Vertical);
+  addDockWidget(Qt::BottomDockWidgetArea, plotsDock_);
+  resizeDocks({controlsDock_}, {320}, Qt::Horizontal);
+  resizeDocks({controlsDock_, linkDock_}, {height() / 2, height() / 2}, Qt::Vertical);
+  resizeDocks({plotsDock_}, {178}, Qt::Vertical);
 }
 
 MainWindow::~MainWindow() {
@@ -197,7 +224,11 @@ void MainWindow::buildDocks() {
   controlsDock_ = new QDockWidget(tr("Controls"), this);
   controlsDock_->setObjectName(QStringLiteral("controlsDock"));
   controlsDock_->setWidget(controls_);
-  addDockWidget(Qt::LeftDockWidgetArea, controlsDock_);
+  // The right docks run the window's full height; the plots sit under the
+  // 3D view only (defaultLayout()).
+  setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
+  setCorner(Qt::TopRightCorner, Qt::RightDockWidgetArea);
+  addDockWidget(Qt::RightDockWidgetArea, controlsDock_);
 
   auto* plots = new QSplitter(Qt::Horizontal);
   wheelPlot_ = new WheelForcePlot;
@@ -218,7 +249,7 @@ void MainWindow::buildDocks() {
   linkDock_ = new QDockWidget(tr("Link"), this);
   linkDock_->setObjectName(QStringLiteral("linkDock"));
   linkDock_->setWidget(link_);
-  addDockWidget(Qt::RightDockWidgetArea, linkDock_);
+  splitDockWidget(controlsDock_, linkDock_, Qt::Vertical);
 
   connect(link_, &LinkPanel::connectRequested, this, &MainWindow::connectToRobot);
   connect(link_, &LinkPanel::disconnectRequested, connection_, &RobotConnection::close);
@@ -257,16 +288,17 @@ void MainWindow::buildMenus() {
   file->addAction(tr("&Quit"), QKeySequence::Quit, this, &QWidget::close);
 
   QMenu* robot = menuBar()->addMenu(tr("&Robot"));
-  robot->addAction(tr("&Connect"), this, &MainWindow::connectToRobot);
-  robot->addAction(tr("&Disconnect"), connection_, &RobotConnection::close);
+  robot->addAction(tr("&Connect to…"), this, &MainWindow::openConnectDialog);
+  reconnectAction_ = robot->addAction(tr("&Reconnect"), this, &MainWindow::connectToRobot);
+  disconnectAction_ = robot->addAction(tr("&Disconnect"), connection_, &RobotConnection::close);
   robot->addSeparator();
-  robot->addAction(tr("&Take control"), connection_, &RobotConnection::acquireLease);
-  robot->addAction(tr("&Release control"), connection_, &RobotConnection::releaseLease);
+  takeAction_ = robot->addAction(tr("&Take control"), connection_, &RobotConnection::acquireLease);
+  releaseAction_ = robot->addAction(tr("Re&lease control"), connection_, &RobotConnection::releaseLease);
   robot->addSeparator();
   // Esc itself is caught by the application filter; the menu shows the key.
   QAction* estop = robot->addAction(tr("&E-stop\tEsc"), this, &MainWindow::emergencyStop);
   estop->setToolTip(tr("Emergency stop"));
-  robot->addAction(tr("Re-&arm…"), this, &MainWindow::rearm);
+  rearmAction_ = robot->addAction(tr("Re-&arm…"), this, &MainWindow::rearm);
 
   QMenu* view = menuBar()->addMenu(tr("&View"));
   QAction* follow = view->addAction(tr("&Follow the robot"));
@@ -407,7 +439,38 @@ void MainWindow::rearm() {
   connection_->rearm();
 }
 
+void MainWindow::openConnectDialog() {
+  ConnectDialog dialog(this, [](const QString& hostPort, const QString& token) {
+    std::string error;
+    return parseEndpoint(hostPort.toStdString(), token.toStdString(), error) ? QString() : qs(error);
+  });
+  if (dialog.exec() != QDialog::Accepted) return;
+  connection_->close();
+  const std::string error = dialog.standIn() ? session_->useStandIn()
+                                             : session_->connectTo(dialog.hostPort().toStdString(), dialog.token().toStdString());
+  if (!error.empty()) {
+    showLoadErrors(tr("Cannot connect"), qs(error));
+    connectToRobot();  // back to where the console was
+    return;
+  }
+  if (!dialog.standIn()) ConnectDialog::remember(dialog.hostPort());
+  options_.connectTo = dialog.standIn() ? QString() : dialog.hostPort();
+  linkEvent(QStringLiteral("link"), tr("connecting to %1").arg(qs(session_->endpoint().label)));
+  sessionChanged();
+}
+
+void MainWindow::updateActions() {
+  const bool ready = connectionState_ == net::ConnectionState::Ready;
+  const bool open = connectionState_ != net::ConnectionState::Stopped;
+  reconnectAction_->setEnabled(!open);
+  disconnectAction_->setEnabled(open);
+  takeAction_->setEnabled(ready && !leaseHeld_);
+  releaseAction_->setEnabled(ready && leaseHeld_);
+  rearmAction_->setEnabled(ready && (failsafe_ || estop_));
+}
+
 void MainWindow::updateControlsEnabled() {
+  updateActions();
   QString why;
   if (connectionState_ != net::ConnectionState::Ready) why = tr("Not connected to the robot");
   else if (!leaseHeld_) why = tr("Take control first (Robot ▸ Take control)");

@@ -28,6 +28,7 @@
 #include "net/robot_client.h"
 #include "sim/robot_model.h"
 
+class QAction;
 class QLabel;
 class QDockWidget;
 
@@ -83,6 +84,12 @@ class MainWindow : public QMainWindow {
   QString logPath() const;
   /// The achieved real-time factor over the last second of telemetry.
   double realTimeFactor() const;
+  /// The share of the window's area the 3D view has (0..1).
+  double viewShare() const;
+  /// Below this share a restored layout is replaced by the default one.
+  static constexpr double kMinViewShare = 0.35;
+  /// The first-run layout: controls over link on the right, plots below.
+  void defaultLayout();
   /// The text of the banner over the 3D view ("" when nothing is latched).
   QString bannerText() const;
 
@@ -99,6 +106,8 @@ class MainWindow : public QMainWindow {
   /// Asks the operator to confirm, then re-arms (clears a latched failsafe
   /// or e-stop) and zeroes the controls.
   void rearm();
+  /// Robot > Connect to…: a robot's HOST:PORT and token, or the stand-in.
+  void openConnectDialog();
 
  protected:
   bool eventFilter(QObject* watched, QEvent* event) override;
@@ -119,6 +128,8 @@ class MainWindow : public QMainWindow {
   void updateBanner();
   /// Controls enabled only while connected, holding the lease and unlatched.
   void updateControlsEnabled();
+  /// Menu items follow the state: what cannot be done now is greyed.
+  void updateActions();
   /// No telemetry for console.stale_after: the robot greys, the status says so.
   void updateStale();
   void showLoadErrors(const QString& title, const QString& text);
@@ -142,6 +153,11 @@ class MainWindow : public QMainWindow {
   QDockWidget* linkDock_ = nullptr;
   QLabel* banner_ = nullptr;
   QLabel* staleLabel_ = nullptr;
+  QAction* reconnectAction_ = nullptr;
+  QAction* disconnectAction_ = nullptr;
+  QAction* takeAction_ = nullptr;
+  QAction* releaseAction_ = nullptr;
+  QAction* rearmAction_ = nullptr;
   QLabel* simTime_ = nullptr;
   QLabel* rtfLabel_ = nullptr;
   QLabel* health_ = nullptr;

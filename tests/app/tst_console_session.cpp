@@ -1,6 +1,7 @@
 // Tests of sp::ConsoleSession (app/console_session.h): the console's session
 // without its window. A real stand-in robot on loopback, real session logs.
 
+#include <QFileInfo>
 #include <QtTest>
 
 #include <QTemporaryDir>
@@ -119,12 +120,41 @@ class TestConsoleSession : public QObject {
     QCOMPARE(session.endpoint().port, uint16_t{0});
   }
 
+  // Robot > Connect: a bad endpoint or token changes nothing; a good one
+  // stops the stand-in (its log complete) and logs what the console sees;
+  // back to a stand-in, a new one runs.
+  void connectToAndBack() {
+    ConsoleSessionOptions o = options("switch");
+    ConsoleSession session(o);
+    QCOMPARE(QString::fromStdString(session.start()), QString());
+    QVERIFY(session.standIn());
+    const RobotEndpoint before = session.endpoint();
+    const std::string standInLog = session.logPath();
+    QCOMPARE(QString::fromStdString(session.connectTo("robot.local:47800", "abc")),
+             QString("the token must have at least 32 hex digits (128 bits), got 3 digits"));
+    QCOMPARE(QString::fromStdString(session.connectTo("robot.local", "00112233445566778899aabbccddeeff")),
+             QString("expected HOST:PORT, got 'robot.local'"));
+    QVERIFY(session.standIn());
+    QCOMPARE(session.endpoint().port, before.port);
+    QCOMPARE(QString::fromStdString(session.connectTo("127.0.0.1:9", "00112233445566778899aabbccddeeff")), QString());
+    QVERIFY(session.remote());
+    QVERIFY(!session.standIn());
+    QCOMPARE(session.endpoint().port, uint16_t{9});
+    QVERIFY(session.logPath() != standInLog);
+    QVERIFY(QFileInfo::exists(QString::fromStdString(standInLog)));
+    QCOMPARE(QString::fromStdString(session.useStandIn()), QString());
+    QVERIFY(!session.remote());
+    QVERIFY(session.standIn());
+    QVERIFY(session.endpoint().port != 9);
+  }
+
   // Telemetry becomes a frame in the model's joint order, whatever order
   // the robot names its joints in; unknown names are ignored, joints not
   // reported read 0; latches and wheel forces pass through.
   void telemetryToModelOrder() {
     ConsoleSessionOptions o = options("remote");
     o.connectTo = "127.0.0.1:9";
+    o.token = "00112233445566778899aabbccddeeff";
     o.log = false;
     ConsoleSession session(o);
     QCOMPARE(QString::fromStdString(session.start()), QString());
@@ -152,6 +182,7 @@ class TestConsoleSession : public QObject {
   void realTimeFactor() {
     ConsoleSessionOptions o = options("rtf");
     o.connectTo = "127.0.0.1:9";
+    o.token = "00112233445566778899aabbccddeeff";
     o.log = false;
     ConsoleSession session(o);
     QCOMPARE(QString::fromStdString(session.start()), QString());
@@ -175,6 +206,7 @@ class TestConsoleSession : public QObject {
   void remoteSessionLogged() {
     ConsoleSessionOptions o = options("remote-log");
     o.connectTo = "127.0.0.1:9";
+    o.token = "00112233445566778899aabbccddeeff";
     std::string path;
     {
       ConsoleSession session(o);

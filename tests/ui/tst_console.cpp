@@ -2,7 +2,9 @@
 // world with its stand-in robot on loopback, the 3D view, telemetry, drive,
 // e-stop, plots, file errors and remembered docks.
 
+#include <QComboBox>
 #include <QDockWidget>
+#include <QLineEdit>
 #include <QLabel>
 #include <QPlainTextEdit>
 #include <QPushButton>
@@ -25,7 +27,9 @@
 #include <cmath>
 #include <fstream>
 
+#include "app/console_session.h"
 #include "app/session_log.h"
+#include "ui/connect_dialog.h"
 #include "ui/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/live_plots.h"
@@ -65,6 +69,27 @@ double planarSpeedOver(MainWindow& w, int millis) {
   const Pose b = w.lastTelemetry()->pose;
   const double dt = w.lastTelemetry()->time - t0;
   return dt > 0 ? std::hypot(b.p.x - a.p.x, b.p.y - a.p.y) / dt : 0;
+}
+
+const QString kRobotToken = QStringLiteral("00112233445566778899aabbccddeeff");
+
+/// Starts simpartner-robot on a free port of loopback with kRobotToken;
+/// returns the port ("" if it did not say within 30 s).
+QString startRobot(QProcess& robot) {
+  robot.setProcessChannelMode(QProcess::MergedChannels);
+  robot.start(QStringLiteral(SP_ROBOT_EXE), {QStringLiteral("--world"), QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml"),
+                                             QStringLiteral("--port"), QStringLiteral("0"), QStringLiteral("--token"),
+                                             kRobotToken, QStringLiteral("--no-log")});
+  if (!robot.waitForStarted()) return {};
+  QByteArray out;
+  const QRegularExpression re(QStringLiteral("listening on 127\\.0\\.0\\.1:(\\d+)"));
+  for (int i = 0; i < 300; ++i) {
+    robot.waitForReadyRead(100);
+    out += robot.readAll();
+    if (const auto m = re.match(QString::fromUtf8(out)); m.hasMatch()) return m.captured(1);
+  }
+  qWarning("%s", out.constData());
+  return {};
 }
 
 /// Answers the re-arm confirmation that `ask` opens: presses "Re-arm" (or
@@ -250,29 +275,70 @@ class TestConsole : public QObject {
     QCOMPARE(controls->speed(), 0.0);
   }
 
+  // Robot > Connect to…: a bad token is refused in the dialog (which stays
+  // open); a good address and token connect to that robot and remember it.
+  // Menu items follow: Take control only without the lease.
+  void connectDialogReachesARobot() {
+    QProcess robot;
+    const QString port = startRobot(robot);
+    QVERIFY(!port.isEmpty());
+    ConsoleOptions o = options_;
+    o.log = false;
+    o.takeControl = false;
+    MainWindow w(o);
+    QCOMPARE(w.start(), QString());
+    w.show();
+    QTRY_VERIFY_WITH_TIMEOUT(w.telemetryReceived() > 5, 5000);
+    QString shownError;
+    QTimer::singleShot(100, [&] {
+      auto* dialog = w.findChild<ConnectDialog*>(QStringLiteral("connectDialog"));
+      if (!dialog) return;
+      dialog->addressBox()->setCurrentText(QStringLiteral("127.0.0.1:") + port);
+      dialog->tokenBox()->setText(QStringLiteral("abc"));
+      for (QPushButton* b : dialog->findChildren<QPushButton*>())
+        if (b->text() == QStringLiteral("Connect")) b->click();
+      shownError = dialog->errorText();
+      dialog->tokenBox()->setText(kRobotToken);
+      for (QPushButton* b : dialog->findChildren<QPushButton*>())
+        if (b->text() == QStringLiteral("Connect")) b->click();
+    });
+    w.openConnectDialog();
+    QVERIFY2(shownError.contains(QLatin1String("32 hex digits")), qPrintable(shownError));
+    QVERIFY(w.session()->remote());
+    QCOMPARE(w.session()->endpoint().port, port.toUShort());
+    QVERIFY(ConnectDialog::recentRobots().contains(QStringLiteral("127.0.0.1:") + port));
+    const int64_t before = w.telemetryReceived();
+    QTRY_VERIFY_WITH_TIMEOUT(w.telemetryReceived() > before + 10, 5000);
+    QCOMPARE(w.connection()->config().port, port.toUShort());
+    // Menu items follow the state.
+    QAction* take = nullptr;
+    QAction* release = nullptr;
+    for (QAction* a : w.findChildren<QAction*>()) {
+      if (a->text() == QStringLiteral("&Take control")) take = a;
+      if (a->text() == QStringLiteral("Re&lease control")) release = a;
+    }
+    QVERIFY(take && release);
+    QTRY_VERIFY(take->isEnabled() && !release->isEnabled());
+    take->trigger();
+    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld(), 3000);
+    QTRY_VERIFY(!take->isEnabled() && release->isEnabled());
+    release->trigger();
+    QTRY_VERIFY_WITH_TIMEOUT(!w.linkPanel()->leaseHeld(), 3000);
+    w.close();
+    robot.terminate();
+    QVERIFY(robot.waitForFinished(5000));
+  }
+
   // Stale data shows: a robot that stops sending (SIGSTOP, its connection
   // still open) is greyed with "no data" within a second and the status no
   // longer says healthy; when it sends again, that clears.
   void staleDataIsVisible() {
     QProcess robot;
-    robot.setProcessChannelMode(QProcess::MergedChannels);
-    const QString token = QStringLiteral("00112233445566778899aabbccddeeff");
-    robot.start(QStringLiteral(SP_ROBOT_EXE), {QStringLiteral("--world"), options_.world, QStringLiteral("--port"),
-                                               QStringLiteral("0"), QStringLiteral("--token"), token,
-                                               QStringLiteral("--no-log")});
-    QVERIFY(robot.waitForStarted());
-    QString port;
-    QByteArray out;
-    for (int i = 0; i < 300 && port.isEmpty(); ++i) {
-      robot.waitForReadyRead(100);
-      out += robot.readAll();
-      const QRegularExpression re(QStringLiteral("listening on 127\\.0\\.0\\.1:(\\d+)"));
-      if (const auto m = re.match(QString::fromUtf8(out)); m.hasMatch()) port = m.captured(1);
-    }
-    QVERIFY2(!port.isEmpty(), out.constData());
+    const QString port = startRobot(robot);
+    QVERIFY(!port.isEmpty());
     ConsoleOptions o = options_;
     o.connectTo = QStringLiteral("127.0.0.1:") + port;
-    o.token = token;
+    o.token = kRobotToken;
     o.takeControl = false;
     o.log = false;
     {
@@ -380,6 +446,26 @@ class TestConsole : public QObject {
     QTest::newRow("drive") << QStringList{"--drive", "99"} << 2 << "<command line>: error: --drive: expected a number in [-10, 10]";
     QTest::newRow("connect") << QStringList{"--connect", "nowhere"} << 1 << "--connect: expected HOST:PORT, got 'nowhere'";
     QTest::newRow("world") << QStringList{"--world", "missing.world.xml"} << 1 << "missing.world.xml: error: cannot open world file";
+    QTest::newRow("token") << QStringList{"--token", "abc"} << 2
+                           << "<command line>: error: --token: expected at least 32 hex digits (128 bits), got 3 digits";
+    QTest::newRow("unknown option") << QStringList{"--bogus"} << 2 << "<command line>: error: Unknown option 'bogus'";
+  }
+
+  // --help and a refused option need no display: run with none at all.
+  void helpWithoutDisplay() {
+    QProcess console;
+    QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+    env.remove(QStringLiteral("DISPLAY"));
+    env.remove(QStringLiteral("WAYLAND_DISPLAY"));
+    env.remove(QStringLiteral("QT_QPA_PLATFORM"));
+    console.setProcessEnvironment(env);
+    console.start(QStringLiteral(SP_CONSOLE_EXE), {QStringLiteral("--help")});
+    QVERIFY(console.waitForFinished(20000));
+    QCOMPARE(console.exitCode(), 0);
+    QVERIFY(QString::fromUtf8(console.readAllStandardOutput()).contains(QLatin1String("--connect")));
+    console.start(QStringLiteral(SP_CONSOLE_EXE), {QStringLiteral("--token"), QStringLiteral("abc")});
+    QVERIFY(console.waitForFinished(20000));
+    QCOMPARE(console.exitCode(), 2);
   }
   void badCommandLines() {
     QFETCH(QStringList, arguments);
@@ -393,6 +479,43 @@ class TestConsole : public QObject {
     const QString err = QString::fromUtf8(console.readAllStandardError());
     QVERIFY2(err.contains(message), qPrintable(err));
     QVERIFY2(!err.contains(QLatin1String("OpenGL")), qPrintable(err));
+  }
+
+  // The 3D view gets the space: at 1280x800 on a first run it has at least
+  // half the window; a layout saved squeezed does not come back squeezed.
+  void viewGetsTheSpace() {
+    QSettings().clear();
+    ConsoleOptions o = options_;
+    o.log = false;
+    {
+      MainWindow w(o);
+      QCOMPARE(w.start(), QString());
+      w.resize(1280, 800);
+      w.show();
+      QVERIFY(QTest::qWaitForWindowExposed(&w));
+      QTest::qWait(200);
+      qInfo("3D view %dx%d in %dx%d: %.0f %%", w.sceneView()->width(), w.sceneView()->height(), w.width(), w.height(),
+            w.viewShare() * 100);
+      auto* controls = w.findChild<QDockWidget*>(QStringLiteral("controlsDock"));
+      auto* plots = w.findChild<QDockWidget*>(QStringLiteral("plotsDock"));
+      auto* link = w.findChild<QDockWidget*>(QStringLiteral("linkDock"));
+      qInfo("controls %dx%d (min %dx%d), link min %dx%d, plots %dx%d (min %dx%d)", controls->width(), controls->height(),
+            controls->minimumSizeHint().width(), controls->minimumSizeHint().height(), link->minimumSizeHint().width(),
+            link->minimumSizeHint().height(), plots->width(), plots->height(), plots->minimumSizeHint().width(),
+            plots->minimumSizeHint().height());
+      QVERIFY(w.viewShare() >= 0.5);
+      w.resizeDocks({controls}, {900}, Qt::Horizontal);
+      w.resizeDocks({plots}, {450}, Qt::Vertical);
+      QTest::qWait(200);
+      qInfo("squeezed: %.0f %%", w.viewShare() * 100);
+      QVERIFY(w.viewShare() < MainWindow::kMinViewShare);  // the control: it was squeezed
+      w.close();
+    }
+    MainWindow again(o);
+    again.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&again));
+    QTRY_VERIFY(again.viewShare() >= 0.5);
+    again.close();
   }
 
   // Docks are remembered between runs: a hidden plots dock stays hidden.
