@@ -1,5 +1,6 @@
 #include "app/console_session.h"
 
+#include <cmath>
 #include <filesystem>
 
 #include "app/headless_runner.h"  // loadRunParams
@@ -127,6 +128,7 @@ std::string ConsoleSession::startStandIn(const std::string& worldFile, const std
   if (standIn_) standIn_->stop();
   standIn_ = std::move(standIn);
   worldFile_ = worldFile;
+  robotFile_ = robotFile;
   endpoint_ = {"127.0.0.1", standIn_->port(), standIn_->token(),
                "127.0.0.1:" + std::to_string(standIn_->port()) + " (stand-in, " +
                    std::filesystem::path(worldFile).filename().string() + ")"};
@@ -210,6 +212,27 @@ std::string ConsoleSession::commandRefusal(bool leaseHeld) const {
 
 void ConsoleSession::commandSent(const Command& command) {
   if (recorder_) recorder_->command(command, robot());
+}
+
+std::string ConsoleSession::resetRobot() {
+  if (remote() || !standIn_) return "a robot elsewhere is put back by hand: Reset restarts the stand-in only";
+  const std::string oldLog = standIn_->logPath();
+  standIn_->addNote("reset: the robot goes back to its start; the session continues in a new log");
+  if (std::string error = startStandIn(worldFile_, robotFile_); !error.empty()) return error;
+  standIn_->addNote(oldLog.empty() ? std::string("reset: the robot is back at its start")
+                                   : "reset: the robot is back at its start; the session before is in " + oldLog);
+  return {};
+}
+
+std::optional<double> ConsoleSession::edgeDistance(const Pose& base) const {
+  if (!world_ || world_->terrain.kind != TerrainSpec::Kind::Heightfield) return std::nullopt;
+  const TerrainSpec& t = world_->terrain;
+  // The grid is centred on the terrain's pose and turned by its yaw only.
+  const double yaw = std::atan2(2 * (t.pose.q.w * t.pose.q.z + t.pose.q.x * t.pose.q.y),
+                                1 - 2 * (t.pose.q.y * t.pose.q.y + t.pose.q.z * t.pose.q.z));
+  const double dx = base.p.x - t.pose.p.x, dy = base.p.y - t.pose.p.y;
+  const double x = std::cos(yaw) * dx + std::sin(yaw) * dy, y = -std::sin(yaw) * dx + std::cos(yaw) * dy;
+  return std::min(t.grid.width / 2 - std::abs(x), t.grid.depth / 2 - std::abs(y));
 }
 
 void ConsoleSession::note(const std::string& text) {

@@ -82,6 +82,13 @@ class ConsoleSession {
   std::string connectTo(const std::string& hostPort, const std::string& token);
   /// Switches back to a stand-in on loopback running the drawn world.
   std::string useStandIn();
+  /// Robot > Reset: the stand-in restarts with the robot at its start (the
+  /// old log notes it and is complete; the new one names the old). For a
+  /// robot elsewhere returns why not.
+  std::string resetRobot();
+  /// How far `base` is inside the edge of a heightfield terrain [m]
+  /// (negative: beyond it); nullopt on a plane, which has no edge.
+  std::optional<double> edgeDistance(const Pose& base) const;
   /// The world drawn (its robots[0] is the one controlled); null before start().
   const WorldModel* world() const { return world_ ? &*world_ : nullptr; }
   /// robots[0]'s model, or null.
@@ -130,6 +137,7 @@ class ConsoleSession {
   std::optional<WorldModel> world_;
   int worldVersion_ = 0;
   std::string worldFile_;  // the stand-in's world file
+  std::string robotFile_;  // the robot file replacing the world's, "" for the world's own
   std::unique_ptr<StandInRobot> standIn_;
   std::unique_ptr<TelemetryRecorder> recorder_;  // the log of a remote robot
   std::string recorderError_;

@@ -141,6 +141,9 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   statusBar()->addPermanentWidget(rtfLabel_);
   statusBar()->addPermanentWidget(health_);
   statusBar()->addPermanentWidget(logLabel_);
+  terrainLabel_ = new QLabel;
+  terrainLabel_->setObjectName(QStringLiteral("terrainLabel"));
+  statusBar()->insertPermanentWidget(0, terrainLabel_);
 
   // Everything around the 3D view is refreshed by one 100 ms timer, in one
   // event-loop pass together with a 3D frame: under software GL every window
@@ -299,6 +302,9 @@ void MainWindow::buildMenus() {
   QAction* estop = robot->addAction(tr("&E-stop\tEsc"), this, &MainWindow::emergencyStop);
   estop->setToolTip(tr("Emergency stop"));
   rearmAction_ = robot->addAction(tr("Re-&arm…"), this, &MainWindow::rearm);
+  robot->addSeparator();
+  resetAction_ = robot->addAction(tr("Re&set to the start"), this, &MainWindow::resetRobot);
+  resetAction_->setToolTip(tr("Restart the stand-in with the robot where the world file puts it (logged)"));
 
   QMenu* view = menuBar()->addMenu(tr("&View"));
   QAction* follow = view->addAction(tr("&Follow the robot"));
@@ -360,6 +366,17 @@ void MainWindow::connectToRobot() {
 
 void MainWindow::showWorld(const WorldModel& world) {
   shownWorld_ = session_->worldVersion();
+  if (terrainLabel_) {
+    const TerrainSpec& t = world.terrain;
+    const bool field = t.kind == TerrainSpec::Kind::Heightfield;
+    terrainLabel_->setText(field ? tr("terrain %1 × %2 m").arg(formatFixed(t.grid.width, 1), formatFixed(t.grid.depth, 1))
+                                 : tr("terrain: endless plane"));
+    terrainLabel_->setToolTip(field ? tr("The heightfield spans x %1..%2 m, y %3..%4 m around its centre; the console warns within %5 m of its edge")
+                                          .arg(formatFixed(t.pose.p.x - t.grid.width / 2, 1), formatFixed(t.pose.p.x + t.grid.width / 2, 1),
+                                               formatFixed(t.pose.p.y - t.grid.depth / 2, 1), formatFixed(t.pose.p.y + t.grid.depth / 2, 1),
+                                               formatFixed(kEdgeWarning, 1))
+                                    : QString());
+  }
   scene_->setWorld(world);
   if (!world.robots.empty()) {
     const RobotModel& robot = world.robots[0].model;
@@ -459,6 +476,20 @@ void MainWindow::openConnectDialog() {
   sessionChanged();
 }
 
+void MainWindow::resetRobot() {
+  connection_->close();
+  if (const std::string error = session_->resetRobot(); !error.empty()) {
+    statusBar()->showMessage(qs(error), 6000);
+    connectToRobot();
+    return;
+  }
+  linkEvent(QStringLiteral("note"), tr("reset: the robot is back at its start"));
+  feed_->clear();
+  wheelPlot_->clear();
+  edgeDistance_.reset();
+  sessionChanged();
+}
+
 void MainWindow::updateActions() {
   const bool ready = connectionState_ == net::ConnectionState::Ready;
   const bool open = connectionState_ != net::ConnectionState::Stopped;
@@ -467,6 +498,7 @@ void MainWindow::updateActions() {
   takeAction_->setEnabled(ready && !leaseHeld_);
   releaseAction_->setEnabled(ready && leaseHeld_);
   rearmAction_->setEnabled(ready && (failsafe_ || estop_));
+  resetAction_->setEnabled(!session_->remote());
 }
 
 void MainWindow::updateControlsEnabled() {
@@ -540,6 +572,16 @@ void MainWindow::onFrame(const RobotFrame& f) {
   haveFrame_ = true;
   if (stale_) updateStale();
   modelPositions_ = f.jointPositions;
+  // Near a heightfield's edge the operator is warned before the robot
+  // drives off into a fall (and a divergence).
+  const std::optional<double> edge = session_->edgeDistance(f.base);
+  const bool wasNear = edgeDistance_ && *edgeDistance_ < kEdgeWarning;
+  edgeDistance_ = edge;
+  if (wasNear != (edge && *edge < kEdgeWarning) ||
+      (edge && *edge < kEdgeWarning && std::abs(*edge - shownEdge_) > 0.1)) {
+    shownEdge_ = edge.value_or(0);
+    updateBanner();
+  }
   scene_->setRobotState(f.base, modelPositions_);
   std::vector<NamedPose> objects;
   for (const ObjectReadout& o : f.objects) objects.push_back({o.name, o.pose});
@@ -596,6 +638,14 @@ void MainWindow::updateBanner() {
     lines << (failsafeText_.isEmpty()
                   ? tr("FAILSAFE latched: the robot stopped itself. Re-arm to continue.")
                   : tr("FAILSAFE latched: %1; the robot stopped. Re-arm to continue.").arg(failsafeText_));
+  if (edgeDistance_ && *edgeDistance_ < kEdgeWarning) {
+    const TerrainSpec& t = session_->world()->terrain;
+    lines << (*edgeDistance_ < 0
+                  ? tr("The robot is off the terrain (%1 m beyond its edge): Robot ▸ Reset puts it back.")
+                        .arg(formatFixed(-*edgeDistance_, 1))
+                  : tr("Near the terrain's edge: %1 m left of the %2 × %3 m heightfield; beyond it the robot falls.")
+                        .arg(formatFixed(*edgeDistance_, 1), formatFixed(t.grid.width, 1), formatFixed(t.grid.depth, 1)));
+  }
   if (connectionState_ == net::ConnectionState::Waiting || connectionState_ == net::ConnectionState::Refused)
     lines << tr("Robot link down (%1): the robot's own deadman stops it; reconnecting.").arg(connectionDetail_);
   banner_->setText(lines.join(QLatin1Char('\n')));

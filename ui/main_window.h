@@ -108,6 +108,8 @@ class MainWindow : public QMainWindow {
   void rearm();
   /// Robot > Connect to…: a robot's HOST:PORT and token, or the stand-in.
   void openConnectDialog();
+  /// Robot > Reset to the start: restarts the stand-in (logged).
+  void resetRobot();
 
  protected:
   bool eventFilter(QObject* watched, QEvent* event) override;
@@ -158,6 +160,12 @@ class MainWindow : public QMainWindow {
   QAction* takeAction_ = nullptr;
   QAction* releaseAction_ = nullptr;
   QAction* rearmAction_ = nullptr;
+  QAction* resetAction_ = nullptr;
+  QLabel* terrainLabel_ = nullptr;
+  /// [m] within this of a heightfield's edge the banner warns.
+  static constexpr double kEdgeWarning = 1.5;
+  std::optional<double> edgeDistance_;  // of the last frame; nullopt on a plane
+  double shownEdge_ = 0;                // the distance the banner shows
   QLabel* simTime_ = nullptr;
   QLabel* rtfLabel_ = nullptr;
   QLabel* health_ = nullptr;

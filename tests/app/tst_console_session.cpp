@@ -6,6 +6,7 @@
 
 #include <QTemporaryDir>
 
+#include <algorithm>
 #include <memory>
 
 #include "app/console_session.h"
@@ -146,6 +147,60 @@ class TestConsoleSession : public QObject {
     QVERIFY(!session.remote());
     QVERIFY(session.standIn());
     QVERIFY(session.endpoint().port != 9);
+  }
+
+  // Reset restarts the stand-in with the robot at its start; both logs say
+  // so. A remote robot cannot be reset from here.
+  void resetRestartsTheStandIn() {
+    ConsoleSession session(options("reset"));
+    QCOMPARE(QString::fromStdString(session.start()), QString());
+    const std::string oldLog = session.logPath();
+    const uint16_t oldPort = session.endpoint().port;
+    QCOMPARE(QString::fromStdString(session.resetRobot()), QString());
+    QVERIFY(session.endpoint().port != oldPort);
+    QVERIFY(session.logPath() != oldLog);
+    // The old log is complete (its stand-in stopped) and says why it ends.
+    std::string error;
+    auto reader = SessionLogReader::open(oldLog, error);
+    QVERIFY2(reader, error.c_str());
+    const auto events = reader->events();
+    QVERIFY(std::any_of(events.begin(), events.end(), [](const LogEvent& e) { return e.text.find("reset:") == 0; }));
+    ConsoleSessionOptions o = options("reset-remote");
+    o.connectTo = "127.0.0.1:9";
+    o.token = "00112233445566778899aabbccddeeff";
+    ConsoleSession remote(o);
+    QCOMPARE(QString::fromStdString(remote.start()), QString());
+    QVERIFY(!remote.resetRobot().empty());
+  }
+
+  // The distance to a heightfield's edge, in the terrain's own frame; none
+  // on a plane.
+  void edgeDistanceOnHeightfields() {
+    ConsoleSessionOptions o = options("edge");
+    o.world = SP_SOURCE_DIR "/terrains/bumpy.world.xml";
+    o.connectTo = "127.0.0.1:9";
+    o.token = "00112233445566778899aabbccddeeff";
+    o.log = false;
+    ConsoleSession session(o);
+    QCOMPARE(QString::fromStdString(session.start()), QString());
+    const TerrainSpec& t = session.world()->terrain;
+    QCOMPARE(int(t.kind), int(TerrainSpec::Kind::Heightfield));
+    Pose at;
+    at.p = {t.pose.p.x, t.pose.p.y, 0};
+    QVERIFY(std::abs(*session.edgeDistance(at) - std::min(t.grid.width, t.grid.depth) / 2) < 1e-9);
+    at.p.x = t.pose.p.x + t.grid.width / 2 - 0.5;
+    at.p.y = t.pose.p.y;
+    QVERIFY(std::abs(*session.edgeDistance(at) - std::min(0.5, t.grid.depth / 2)) < 1e-9);
+    at.p.x = t.pose.p.x + t.grid.width / 2 + 2;
+    QVERIFY(*session.edgeDistance(at) < 0);
+    ConsoleSessionOptions flat = options("edge-flat");
+    flat.connectTo = o.connectTo;
+    flat.token = o.token;
+    flat.log = false;
+    flat.world = SP_SOURCE_DIR "/terrains/flat.world.xml";
+    ConsoleSession plane(flat);
+    QCOMPARE(QString::fromStdString(plane.start()), QString());
+    QVERIFY(!plane.edgeDistance(at));
   }
 
   // Telemetry becomes a frame in the model's joint order, whatever order

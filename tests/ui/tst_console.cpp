@@ -481,6 +481,43 @@ class TestConsole : public QObject {
     QVERIFY2(!err.contains(QLatin1String("OpenGL")), qPrintable(err));
   }
 
+  // On a heightfield the status bar gives the terrain's size and the banner
+  // warns near its edge; Robot > Reset restarts the robot at its start
+  // (a new log; the old one says why it ends) and the warning stays true.
+  void terrainEdgeWarnedAndReset() {
+    const QString world = dir_.filePath(QStringLiteral("edge.world.xml"));
+    std::ofstream(world.toStdString())
+        << "<world name=\"edge\" version=\"1\">\n  <material name=\"ground\"/>\n  <material name=\"rubber\"/>\n"
+        << "  <contact default=\"true\" mu=\"0.7\"/>\n"
+        << "  <terrain type=\"heightfield\" file=\"" SP_SOURCE_DIR "/terrains/bumpy.asc\" material=\"ground\"/>\n"
+        << "  <robot name=\"workpartner\" file=\"" SP_SOURCE_DIR "/robots/workpartner.xml\" xyz=\"9 0 0.3\"/>\n</world>\n";
+    ConsoleOptions o = options_;
+    o.world = world;
+    o.logDir = dir_.filePath(QStringLiteral("edge"));
+    MainWindow w(o);
+    QCOMPARE(w.start(), QString());
+    w.show();
+    QTRY_VERIFY_WITH_TIMEOUT(w.telemetryReceived() > 5, 5000);
+    auto* terrain = w.findChild<QLabel*>(QStringLiteral("terrainLabel"));
+    QVERIFY(terrain);
+    QCOMPARE(terrain->text(), QStringLiteral("terrain 20.0 × 20.0 m"));
+    QTRY_VERIFY_WITH_TIMEOUT(w.bannerText().contains(QLatin1String("Near the terrain's edge")), 3000);
+    const QString firstLog = w.logPath();
+    w.resetRobot();
+    QVERIFY(w.logPath() != firstLog);
+    const int64_t before = w.telemetryReceived();
+    QTRY_VERIFY_WITH_TIMEOUT(w.telemetryReceived() > before + 5, 5000);
+    QTRY_VERIFY_WITH_TIMEOUT(std::abs(w.lastTelemetry()->pose.p.x - 9) < 0.5, 3000);
+    std::string error;
+    auto reader = SessionLogReader::open(firstLog.toStdString(), error);
+    QVERIFY2(reader, error.c_str());
+    const std::vector<LogEvent> events = reader->events();
+    QVERIFY(std::any_of(events.begin(), events.end(), [](const LogEvent& e) { return e.text.find("reset:") == 0; }));
+    // The control: on the flat world (a plane) there is no edge to warn of.
+    QVERIFY(!window_->bannerText().contains(QLatin1String("edge")));
+    w.close();
+  }
+
   // The 3D view gets the space: at 1280x800 on a first run it has at least
   // half the window; a layout saved squeezed does not come back squeezed.
   void viewGetsTheSpace() {
