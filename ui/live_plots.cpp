@@ -7,6 +7,8 @@
 #include <QLabel>
 #include <QPainter>
 #include <QPen>
+#include <QLegend>
+#include <QLegendMarker>
 #include <QPushButton>
 #include <QScrollBar>
 #include <QSignalBlocker>
@@ -287,7 +289,33 @@ std::pair<double, double> WheelForcePlot::yRange() const { return {yAxis_->min()
 
 QList<QPointF> WheelForcePlot::shownPoints(int wheel) const {
   if (wheel < 0 || wheel >= kWheels) return {};
-  return series_[static_cast<std::size_t>(wheel)]->points();
+  QList<QPointF> out = series_[static_cast<std::size_t>(wheel)]->points();
+  for (QLineSeries* more : gapSeries_[static_cast<std::size_t>(wheel)]) out += more->points();
+  return out;
+}
+
+int WheelForcePlot::shownSegments(int wheel) const {
+  if (wheel < 0 || wheel >= kWheels) return 0;
+  const auto w = static_cast<std::size_t>(wheel);
+  int n = series_[w]->count() > 0 ? 1 : 0;
+  for (QLineSeries* more : gapSeries_[w]) n += more->count() > 0 ? 1 : 0;
+  return n;
+}
+
+QLineSeries* WheelForcePlot::segmentSeries(std::size_t wheel, std::size_t k) {
+  if (k == 0) return series_[wheel];
+  std::vector<QLineSeries*>& more = gapSeries_[wheel];
+  while (more.size() < k) {
+    // Same colour, no legend entry: one wheel, drawn in pieces.
+    auto* series = new QLineSeries;
+    series->setPen(series_[wheel]->pen());
+    chart_->addSeries(series);
+    series->attachAxis(xAxis_);
+    series->attachAxis(yAxis_);
+    for (QLegendMarker* marker : chart_->legend()->markers(series)) marker->setVisible(false);
+    more.push_back(series);
+  }
+  return more[k - 1];
 }
 
 std::size_t WheelForcePlot::firstIndex(double t, bool after) const {
@@ -432,10 +460,25 @@ bool WheelForcePlot::replot(bool force) {
   // its geometry, which for the old points is wasted (half the cost of a
   // replot at 4 x 1000 points, measured).
   for (QLineSeries* series : series_) series->clear();
+  for (auto& more : gapSeries_)
+    for (QLineSeries* series : more) series->clear();
   setAxis(xAxis_, span.first, span.second, tickSpacing(window_, areaWidth / 100));
   const std::pair<double, double> y = autoY_ ? fittedYRange(points) : yRange();
   setYAxis(y.first, y.second);  // also when fixed: the plot's height may have changed
-  for (std::size_t k = 0; k < series_.size(); ++k) series_[k]->replace(points[k]);
+  // Where telemetry stopped for a while the line breaks: a straight line
+  // across the silence would show forces nobody measured. A gap is a step
+  // in robot time above kGap, or above two pixel columns when thinned.
+  const double gap = std::max(kGap, 2.0 * (span.second - span.first) / columns);
+  for (std::size_t w = 0; w < series_.size(); ++w) {
+    const QList<QPointF>& all = points[w];
+    std::size_t segment = 0;
+    qsizetype start = 0;
+    for (qsizetype i = 1; i <= all.size(); ++i)
+      if (i == all.size() || all[i].x() - all[i - 1].x() > gap) {
+        segmentSeries(w, segment++)->replace(all.mid(start, i - start));
+        start = i;
+      }
+  }
   updateScrollBar();
   return true;
 }

@@ -146,6 +146,10 @@ class WheelForcePlot : public LivePlot {
   /// What the series of `wheel` (0..3: FL, FR, RL, RR) shows now, as
   /// (time [s], force [N]); empty for another index.
   QList<QPointF> shownPoints(int wheel) const;
+  /// Pieces the line of `wheel` is drawn in: more than one where telemetry
+  /// stopped for longer than kGap of robot time.
+  int shownSegments(int wheel) const;
+  static constexpr double kGap = 0.25;  ///< [s] of robot time without samples that breaks the line
 
  protected:
   bool replot(bool force) override;
@@ -185,6 +189,10 @@ class WheelForcePlot : public LivePlot {
   bool viewDirty_ = true;  ///< the shown span or data changed (not just the history)
 
   std::array<QLineSeries*, kWheels> series_{};
+  /// Further pieces of each wheel's line after gaps (made on demand).
+  std::array<std::vector<QLineSeries*>, kWheels> gapSeries_{};
+  /// The series drawing piece `k` of `wheel`'s line (0: series_[wheel]).
+  QLineSeries* segmentSeries(std::size_t wheel, std::size_t k);
   QValueAxis* xAxis_ = nullptr;
   QValueAxis* yAxis_ = nullptr;
   QDoubleSpinBox* windowBox_ = nullptr;

@@ -434,6 +434,20 @@ class TestLivePlots : public QObject {
     QCOMPARE(plot->shownPoints(2).size(), 10);
   }
 
+  // Where telemetry stopped (a gap in robot time above kGap) the line
+  // breaks instead of joining across; without a gap it is one piece.
+  void gapsBreakTheLine() {
+    auto plot = shownWheelPlot();
+    feed(*plot, 0, 300);  // 3 s at 100 Hz
+    QVERIFY(waitForReplot(*plot, 0));
+    plot->replotNow();
+    QCOMPARE(plot->shownSegments(0), 1);  // the control: no gap, one piece
+    feed(*plot, 500, 700);                // 2 s without samples, then 2 s more
+    plot->replotNow();
+    for (int w = 0; w < WheelForcePlot::kWheels; ++w) QCOMPARE(plot->shownSegments(w), 2);
+    QCOMPARE(plot->shownPoints(0).size(), 500);  // every sample still drawn
+  }
+
   // The ring buffer keeps only the newest `capacity` samples.
   void bufferIsBounded() {
     auto plot = shownWheelPlot(100);
