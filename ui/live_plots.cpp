@@ -79,6 +79,12 @@ QValueAxis* makeAxis(const QString& title) {
   axis->setLinePenColor(QColor(0x55, 0x55, 0x55));
   axis->setLabelsColor(Qt::black);
   axis->setTitleBrush(Qt::black);
+  // A size smaller than the window's text: a docked plot is short, and
+  // labels that do not fit are elided to "...".
+  QFont small = axis->labelsFont();
+  small.setPointSizeF(small.pointSizeF() * 0.85);
+  axis->setLabelsFont(small);
+  axis->setTitleFont(small);
   return axis;
 }
 
@@ -98,7 +104,7 @@ LivePlot::LivePlot(QWidget* parent) : QWidget(parent) {
   chart_->setAnimationOptions(QChart::NoAnimation);
   chart_->setBackgroundRoundness(0);
   chart_->setDropShadowEnabled(false);
-  chart_->setMargins(QMargins(4, 4, 4, 4));
+  chart_->setMargins(QMargins(2, 0, 2, 0));
   chart_->legend()->setAlignment(Qt::AlignTop);
   chart_->legend()->setLabelColor(Qt::black);
   QFont titleFont = font();
@@ -147,6 +153,7 @@ void LivePlot::tick() {
 WheelForcePlot::WheelForcePlot(QWidget* parent, std::size_t capacity)
     : LivePlot(parent), capacity_(std::max<std::size_t>(capacity, 2)) {
   chart_->setTitle(tr("Wheel normal forces"));
+  chart_->legend()->setAlignment(Qt::AlignRight);  // beside the plot: height is what a docked plot lacks
   xAxis_ = makeAxis(tr("robot time [s]"));
   yAxis_ = makeAxis(tr("normal force [N]"));
   chart_->addAxis(xAxis_, Qt::AlignBottom);
@@ -487,6 +494,9 @@ bool WheelForcePlot::replot(bool force) {
 
 LaserPlot::LaserPlot(QWidget* parent) : LivePlot(parent), farthest_(std::numeric_limits<double>::infinity()) {
   chart_->setTitle(tr("Laser scan (sensor frame)"));
+  // No legend: a docked plot is short, and dots and a triangle say enough.
+  chart_->legend()->hide();
+  setToolTip(tr("Dots: laser hits; triangle: the sensor, pointing forward"));
   leftAxis_ = makeAxis(tr("y, left [m]"));
   leftAxis_->setReverse(true);  // seen from above with x up, +y is to the left
   forwardAxis_ = makeAxis(tr("x, forward [m]"));
