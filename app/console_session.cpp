@@ -184,6 +184,11 @@ RobotFrame ConsoleSession::telemetry(const net::TelemetryMsg& t, double wall) {
   RobotFrame f;
   f.time = t.time;
   f.base = t.pose;
+  if (t.baseVelocity.size() == 6) {
+    f.hasBaseVelocity = true;
+    f.baseLinearVelocity = {t.baseVelocity[0], t.baseVelocity[1], t.baseVelocity[2]};
+    f.baseAngularVelocity = {t.baseVelocity[3], t.baseVelocity[4], t.baseVelocity[5]};
+  }
   f.wheelNormal = t.wheelNormal;
   f.roll = t.roll;
   f.pitch = t.pitch;

@@ -21,6 +21,8 @@ struct RobotModel;
 struct RobotFrame {
   double time = 0;                     ///< [s] robot time
   Pose base;                           ///< link 0 in the world
+  bool hasBaseVelocity = false;        ///< the robot reported its base's twist
+  Vec3 baseLinearVelocity, baseAngularVelocity;  ///< world frame [m/s], [rad/s]
   std::vector<double> jointPositions;  ///< model joint order [rad or m]; 0 where unknown
   std::vector<double> jointRates;      ///< model joint order; 0 where unknown
   std::array<double, 4> wheelNormal{};  ///< [N] FL FR RL RR

@@ -86,6 +86,8 @@ void TwinHost::publish() {
   net::RobotState s;
   s.time = r.time;
   s.pose = r.base;
+  s.baseLinearVelocity = r.baseLinearVelocity;
+  s.baseAngularVelocity = r.baseAngularVelocity;
   s.jointNames = jointNames_;
   s.jointPositions = r.jointPositions;
   s.jointVelocities = r.jointRates;

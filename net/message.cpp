@@ -184,6 +184,7 @@ void forEachField(M& m, F& f) {
     f("seq", m.seq, R);
     f("time", m.time, R);
     f("pose", m.pose, R);
+    f("base_velocity", m.baseVelocity, Need::Optional);
     f("joint_names", m.jointNames, R);
     f("joint_positions", m.jointPositions, R);
     f("joint_velocities", m.jointVelocities, R);
@@ -293,6 +294,8 @@ struct Validator {
     };
     if (std::string e = count("joint_positions", m.jointPositions.size()); !e.empty()) return e;
     if (std::string e = count("joint_velocities", m.jointVelocities.size()); !e.empty()) return e;
+    if (!m.baseVelocity.empty() && m.baseVelocity.size() != 6)
+      return "key 'base_velocity': expected 6 numbers (vx vy vz wx wy wz), got " + std::to_string(m.baseVelocity.size());
     for (size_t i = 0; i < m.objects.size(); ++i) {
       const std::string& name = m.objects[i].name;
       if (name.empty() || name.find(' ') != std::string::npos)
@@ -362,7 +365,8 @@ struct Encoder {
   void operator()(const char* key, const std::array<double, 4>& v, Need) {
     line(key, [&] { numbers(v.begin(), v.end()); });
   }
-  void operator()(const char* key, const std::vector<double>& v, Need) {
+  void operator()(const char* key, const std::vector<double>& v, Need need) {
+    if (need == Need::Optional && v.empty()) return;
     line(key, [&] { numbers(v.begin(), v.end()); });
   }
   void operator()(const char* key, const std::vector<std::string>& v, Need) {

@@ -143,6 +143,11 @@ struct TelemetryMsg {
   uint64_t seq = 0;    ///< increasing per connection; gaps are lost frames
   double time = 0;     ///< [s] robot (twin) time of the state
   Pose pose;           ///< main body in the world: [m], unit quaternion (`x y z qw qx qy qz`)
+  /// The main body's twist (optional key `base_velocity`: `vx vy vz wx wy wz`,
+  /// world frame, of its frame's origin [m/s] and [rad/s]); empty when not
+  /// reported. With the joints' rates it lets a client rebuild the whole
+  /// state (the predictive ghost).
+  std::vector<double> baseVelocity;
   std::vector<std::string> jointNames;   ///< non-empty, without spaces
   std::vector<double> jointPositions;    ///< [rad or m], one per name
   std::vector<double> jointVelocities;   ///< [rad/s or m/s], one per name

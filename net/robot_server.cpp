@@ -360,6 +360,8 @@ void RobotServer::onTimer() {
     TelemetryMsg m;
     m.time = st.time;
     m.pose = st.pose;
+    m.baseVelocity = {st.baseLinearVelocity.x,  st.baseLinearVelocity.y,  st.baseLinearVelocity.z,
+                      st.baseAngularVelocity.x, st.baseAngularVelocity.y, st.baseAngularVelocity.z};
     m.jointNames = std::move(st.jointNames);
     m.jointPositions = std::move(st.jointPositions);
     m.jointVelocities = std::move(st.jointVelocities);

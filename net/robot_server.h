@@ -32,6 +32,7 @@ namespace sp::net {
 struct RobotState {
   double time = 0;
   Pose pose;
+  Vec3 baseLinearVelocity, baseAngularVelocity;  ///< world frame, of the base frame's origin
   std::vector<std::string> jointNames;
   std::vector<double> jointPositions, jointVelocities;
   std::array<double, 4> wheelNormal{}, wheelTangential{};

@@ -20,4 +20,19 @@ namespace sp {
 /// to the base. Uses the same sign conventions as World::jointPosition.
 std::vector<Pose> linkPoses(const RobotModel& robot, const Pose& base, std::span<const double> jointPositions);
 
+/// Where a link is and how it moves, in the world: its frame's pose and the
+/// linear velocity of its origin and its angular velocity.
+struct LinkMotion {
+  Pose pose;
+  Vec3 linear;   ///< [m/s] of the link frame's origin
+  Vec3 angular;  ///< [rad/s]
+};
+
+/// linkPoses() plus velocity propagation: every link's motion from the
+/// base's pose and twist (of link 0's origin, world frame) and every joint's
+/// position and rate (robot.joints order; missing values count as zero).
+/// What a robot reports (telemetry) is enough to rebuild its whole state.
+std::vector<LinkMotion> linkMotions(const RobotModel& robot, const Pose& base, Vec3 baseLinear, Vec3 baseAngular,
+                                    std::span<const double> jointPositions, std::span<const double> jointRates);
+
 }  // namespace sp

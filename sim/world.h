@@ -18,6 +18,7 @@
 #include "sim/command.h"
 #include "sim/diagnostics.h"
 #include "sim/gait.h"
+#include "sim/kinematics.h"
 #include "sim/params.h"
 #include "sim/robot_model.h"
 #include "sim/sensors.h"
@@ -154,6 +155,15 @@ class World {
   /// model, a non-finite state, a time off this world's step grid, or a world
   /// whose physics engine failed (EngineFailure: build a new one).
   std::string restore(const Snapshot& snapshot);
+  /// Puts robot `robot`'s links where `links` says (robot.links order: each
+  /// frame's pose and its origin's velocities, e.g. from linkMotions()) and
+  /// the dynamic objects named in `objects` at those poses, at rest: the
+  /// state a robot reports, rebuilt into this twin (the predictive ghost
+  /// re-anchors so). Time, controllers and sensors are left as they are.
+  /// Returns "" or why not (a size that does not fit, a value not finite);
+  /// nothing is changed then.
+  std::string setRobotMotion(int robot, const std::vector<LinkMotion>& links,
+                             const std::vector<std::pair<std::string, Pose>>& objects = {});
   /// A 64-bit hash of the dynamic state (bodies bit for bit, controllers,
   /// random states, step), to compare runs.
   uint64_t stateHash() const;

@@ -3,6 +3,8 @@
 
 #include "sim/world_impl.h"
 
+#include <cmath>
+
 #include "sim/hash.h"
 
 namespace sp {
@@ -92,6 +94,48 @@ std::string World::restore(const Snapshot& s) {
   }
   m.queue = s.pending;
   steps_ = newSteps;
+  health_ = {};
+  return {};
+}
+
+std::string World::setRobotMotion(int robot, const std::vector<LinkMotion>& links,
+                                  const std::vector<std::pair<std::string, Pose>>& objects) {
+  Impl& m = *impl_;
+  if (robot < 0 || robot >= robotCount()) return "no robot " + std::to_string(robot);
+  Impl::Robot& rt = m.robots[static_cast<size_t>(robot)];
+  if (links.size() != rt.bodies.size())
+    return "expected " + std::to_string(rt.bodies.size()) + " links, got " + std::to_string(links.size());
+  for (const LinkMotion& l : links) {
+    const double v[] = {l.pose.p.x, l.pose.p.y, l.pose.p.z, l.pose.q.w, l.pose.q.x, l.pose.q.y, l.pose.q.z,
+                        l.linear.x,  l.linear.y,  l.linear.z,  l.angular.x, l.angular.y, l.angular.z};
+    if (!finite(v, 13)) return "a link's pose or velocity is not finite";
+  }
+  ensureOdeThread();
+  // ODE holds each body at its centre of mass; a link frame's origin is
+  // comOffset behind it.
+  const auto set = [&](dBodyID body, const Pose& frame, Vec3 com, Vec3 linear, Vec3 angular) {
+    const Vec3 offset = rotate(frame.q, com);
+    const Vec3 p = frame.p + offset;
+    const double qn = std::sqrt(frame.q.w * frame.q.w + frame.q.x * frame.q.x + frame.q.y * frame.q.y + frame.q.z * frame.q.z);
+    const Quat q{frame.q.w / qn, frame.q.x / qn, frame.q.y / qn, frame.q.z / qn};
+    const dQuaternion dq = {q.w, q.x, q.y, q.z};
+    const Vec3 v = linear + cross(angular, offset);
+    dBodySetPosition(body, p.x, p.y, p.z);
+    dBodySetQuaternion(body, dq);
+    dBodySetLinearVel(body, v.x, v.y, v.z);
+    dBodySetAngularVel(body, angular.x, angular.y, angular.z);
+    dBodyEnable(body);
+    for (size_t i = 0; i < m.allBodies.size(); ++i)
+      if (m.allBodies[i] == body) {
+        m.preimage[i] = {q.w, q.x, q.y, q.z};
+        m.previous[i] = readBody(body);
+      }
+  };
+  for (size_t l = 0; l < links.size(); ++l)
+    set(rt.bodies[l], links[l].pose, rt.comOffset[l], links[l].linear, links[l].angular);
+  for (const auto& [name, pose] : objects)
+    for (size_t o = 0; o < model_.objects.size(); ++o)
+      if (model_.objects[o].name == name && m.objectBodies[o]) set(m.objectBodies[o], pose, m.objectComOffset[o], {}, {});
   health_ = {};
   return {};
 }

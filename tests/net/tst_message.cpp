@@ -114,6 +114,7 @@ void TestMessage::fanOutEqualsEncodeMessage() {
   TelemetryMsg m = telemetry();
   m.objects = {{"pole", Pose{{2.5, 0, 0.94}, {0.5, 0.5, -0.5, 0.5}}}};
   m.health = "diverged";
+  m.baseVelocity = {0.5, 0, 0, 0, 0, -0.1};
   const TelemetryFanOut telemetryOut(m);
   for (const auto& [seq, rtt, lost] : {std::tuple<uint64_t, double, uint64_t>{1, 0, 0}, {42, 12.3, 3},
                                        {18446744073709551615u, 1e-300, 7}, {5, std::nan(""), 0}}) {
@@ -163,6 +164,9 @@ void TestMessage::roundTrip_data() {
   withObjects.objects = {{"pole", Pose{{2.5, 0, 0.94}, {0.7071067811865476, 0.7071067811865475, 0, 0}}},
                          {"crate.2", Pose{{-1e-300, 1.5, -0.25}, {1, 0, 0, 0}}}};
   QTest::newRow("TELEMETRY with objects") << Message(withObjects);
+  TelemetryMsg withTwist = telemetry();
+  withTwist.baseVelocity = {0.5, -0.01, 1e-9, 0, 0, 0.25};
+  QTest::newRow("TELEMETRY with base velocity") << Message(withTwist);
   QTest::newRow("LASER") << Message(LaserMsg{3, 1.25, -2.356194490192345, 0.004363323129985824, {1.5, 0.25, 30}});
   QTest::newRow("HEARTBEAT") << Message(HeartbeatMsg{9, 1234.000001});
   QTest::newRow("ESTOP") << Message(EstopMsg{"operator pressed e-stop"});
@@ -411,6 +415,10 @@ void TestMessage::encodeErrors_data() {
                                << "CHALLENGE: key 'nonce': expected at least 32 hex digits (128 bits), got 4";
   QTest::newRow("limits list too short") << Message(LimitsMsg{{"a", "b"}, {0, 0}, {1, 1}, {1}, {1, 1}, 0, 0, ""})
                                          << "LIMITS: key 'max_velocity': expected 2 numbers (one per joint), got 1";
+  TelemetryMsg shortTwist = telemetry();
+  shortTwist.baseVelocity = {1, 2, 3, 4, 5};
+  QTest::newRow("base velocity of 5") << Message(shortTwist)
+                                      << "TELEMETRY: key 'base_velocity': expected 6 numbers (vx vy vz wx wy wz), got 5";
   QTest::newRow("zero expiry") << Message(CommandMsg{1, 0, "stop"}) << "COMMAND: key 'expires_ms': must be > 0";
   QTest::newRow("bad enum") << Message(ReplyMsg{1, static_cast<ReplyStatus>(99), ""})
                             << "REPLY: key 'status': bad enum value 99";

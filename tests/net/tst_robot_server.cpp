@@ -267,6 +267,11 @@ class TestRobotServer : public QObject {
     QVERIFY(limits->driveSpeed > 0 && std::isfinite(limits->driveSpeed));
     QVERIFY(!limits->articulation.empty());
     QVERIFY(limits->joints.size() > 10);
+    // Telemetry carries the base's twist (for a client's own twin).
+    const auto t = c.waitFor<TelemetryMsg>(2.0);
+    QVERIFY(t);
+    QCOMPARE(t->baseVelocity.size(), size_t{6});
+    QVERIFY(std::all_of(t->baseVelocity.begin(), t->baseVelocity.end(), [](double v) { return std::isfinite(v); }));
   }
 
   // Garbage and an oversize frame close only their own connections; a
@@ -339,8 +344,10 @@ class TestRobotServer : public QObject {
       auto lastPacket = Clock::now();
       const auto t0 = Clock::now();
       while (seconds(t0) < silentAfter) {
-        holder.send(LeaseKeepaliveMsg{});
+        // Stamped before sending: the robot may read the packet before
+        // send() returns here, and the deadman counts from its arrival.
         lastPacket = Clock::now();
+        holder.send(LeaseKeepaliveMsg{});
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
       // Silent from here, connection still open.
