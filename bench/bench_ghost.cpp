@@ -1,0 +1,140 @@
+// Benchmark of the predictive ghost's physics (issue 13): how long a 5 s
+// prediction takes and how far it lands from the full-fidelity twin, for
+// ghost profiles (physics step, solver iterations). Prints a table, asserts
+// nothing.
+//
+//   build/bench/bench_ghost [--quick]
+//
+// For each world (flat ground, test track) and motion (straight, turning):
+// the "robot" (1 ms step, 50 iterations: the defaults) drives for 2 s; its
+// read-out (what telemetry carries) anchors a ghost built with the profile
+// (linkMotions + World::setRobotMotion, the same commands submitted); the
+// ghost runs 5 s alone on this thread and the robot 5 s too. Reported: the
+// ghost's wall time for the 5 s (median of the runs) and its base position
+// and heading error against the robot at the end. Profiles alternate so that
+// machine load hits them alike.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim/kinematics.h"
+#include "sim/model_loader.h"
+#include "sim/readout.h"
+#include "sim/world.h"
+
+using namespace sp;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+struct Profile {
+  double step;
+  int iterations;
+};
+
+struct Outcome {
+  double wallMs = 0, position = 0, headingDeg = 0;
+  bool healthy = true;
+};
+
+std::unique_ptr<World> build(const WorldModel& model, SimParams params = {}) {
+  Diagnostics diag;
+  auto w = World::create(model, params, diag);
+  if (!w) {
+    std::fprintf(stderr, "%s", diag.format().c_str());
+    std::exit(1);
+  }
+  return w;
+}
+
+double yawOf(const Quat& q) { return std::atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z)); }
+
+void run(World& w, double seconds) {
+  const auto n = std::llround(seconds / w.params().step);
+  for (int64_t i = 0; i < n && w.step(); ++i) {
+  }
+}
+
+Outcome predict(const WorldModel& model, const Command& drive, const Profile& p, double horizon) {
+  auto robot = build(model);
+  robot->submit(drive);
+  run(*robot, 2.0);
+  const RobotReadout r = readRobot(*robot);
+  SimParams params;
+  params.step = p.step;
+  params.iterations = p.iterations;
+  auto ghost = build(model, params);
+  ghost->submit(drive);
+  ghost->step();  // the command takes effect; then the state is the robot's
+  std::vector<std::pair<std::string, Pose>> objects;
+  for (const ObjectReadout& o : r.objects) objects.emplace_back(o.name, o.pose);
+  const std::string error = ghost->setRobotMotion(
+      0, linkMotions(robot->robotModel(0), r.base, r.baseLinearVelocity, r.baseAngularVelocity, r.jointPositions, r.jointRates),
+      objects);
+  if (!error.empty()) {
+    std::fprintf(stderr, "anchor: %s\n", error.c_str());
+    std::exit(1);
+  }
+  const auto t0 = Clock::now();
+  run(*ghost, horizon);
+  Outcome o;
+  o.wallMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  o.healthy = ghost->health().healthy();
+  run(*robot, horizon);
+  const Pose a = robot->linkPose(0, 0), b = ghost->linkPose(0, 0);
+  o.position = std::hypot(a.p.x - b.p.x, a.p.y - b.p.y);
+  double dyaw = yawOf(a.q) - yawOf(b.q);
+  dyaw = std::remainder(dyaw, 2 * kPi);
+  o.headingDeg = std::abs(radToDeg(dyaw));
+  return o;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  const std::string root = SP_SOURCE_DIR;
+  const std::vector<std::pair<const char*, std::string>> worlds = {{"flat", root + "/terrains/flat.world.xml"},
+                                                                   {"test track", root + "/terrains/test_track.world.xml"}};
+  const std::vector<std::pair<const char*, Command>> motions = {{"straight 0.5 m/s", DriveCmd{0.5, 0}},
+                                                                {"turning 0.5 m/s, 12 deg", DriveCmd{0.5, degToRad(12)}}};
+  const std::vector<Profile> profiles = {{0.001, 50}, {0.002, 50}, {0.002, 20}, {0.003, 20},
+                                         {0.004, 20}, {0.004, 10}, {0.002, 10}};
+  const int rounds = quick ? 1 : 3;
+  const double horizon = 5.0;
+  std::printf("SimPartner ghost benchmark: %.0f s predictions anchored from the robot's read-out at 2 s; "
+              "errors against the 1 ms / 50-iteration robot; wall time of the ghost alone, median of %d\n",
+              horizon, rounds);
+  std::printf("%-11s %-24s %-15s %10s %12s %12s\n", "world", "motion", "profile", "wall [ms]", "position [m]",
+              "heading [deg]");
+  for (const auto& [worldName, file] : worlds) {
+    Diagnostics diag;
+    const std::optional<WorldModel> model = loadWorld(file, diag);
+    if (!model) {
+      std::fprintf(stderr, "%s", diag.format().c_str());
+      return 1;
+    }
+    for (const auto& [motionName, drive] : motions) {
+      std::vector<std::vector<Outcome>> results(profiles.size());
+      for (int r = 0; r < rounds; ++r)
+        for (size_t p = 0; p < profiles.size(); ++p) results[p].push_back(predict(*model, drive, profiles[p], horizon));
+      for (size_t p = 0; p < profiles.size(); ++p) {
+        std::vector<double> walls;
+        for (const Outcome& o : results[p]) walls.push_back(o.wallMs);
+        std::sort(walls.begin(), walls.end());
+        const Outcome& last = results[p].back();  // deterministic: every round lands the same
+        char profile[32];
+        std::snprintf(profile, sizeof profile, "%.0f ms / %d it", profiles[p].step * 1000, profiles[p].iterations);
+        std::printf("%-11s %-24s %-15s %10.0f %12.4f %12.2f%s\n", worldName, motionName, profile,
+                    walls[walls.size() / 2], last.position, last.headingDeg, last.healthy ? "" : "  DIVERGED");
+      }
+    }
+  }
+  return 0;
+}
