@@ -700,10 +700,7 @@ LimitsMsg limitsOf(const RobotModel& robot) {
   }
   if (robot.drive) {
     out.driveSpeed = driveSpeedLimit(robot);
-    out.wheelSpeed = inf;
-    for (int w : robot.drive->wheels)
-      if (const int a = robot.findActuator(robot.joints[w].name); a >= 0)
-        out.wheelSpeed = std::min(out.wheelSpeed, robot.actuators[a].maxVelocity);
+    out.wheelSpeed = slowestWheelSpeed(robot);
     out.articulation = robot.joints[robot.drive->articulation].name;
   }
   return out;

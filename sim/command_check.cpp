@@ -186,13 +186,15 @@ struct Checker {
 
 }  // namespace
 
-double driveSpeedLimit(const RobotModel& robot) {
+double slowestWheelSpeed(const RobotModel& robot) {
   double top = std::numeric_limits<double>::infinity();
   for (int w : robot.drive->wheels)
     if (const int a = robot.findActuator(robot.joints[w].name); a >= 0)
-      top = std::min(top, robot.actuators[a].maxVelocity * robot.drive->wheelRadius);
+      top = std::min(top, robot.actuators[a].maxVelocity);
   return top;
 }
+
+double driveSpeedLimit(const RobotModel& robot) { return slowestWheelSpeed(robot) * robot.drive->wheelRadius; }
 
 CommandCheck checkCommand(const Command& command, const RobotModel& robot) {
   return std::visit(Checker{robot}, command);

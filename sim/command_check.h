@@ -24,9 +24,11 @@ struct CommandCheck {
   bool ok() const { return kind == Kind::Ok; }
 };
 
-/// [m/s] the fastest `drive` or `turn` the robot takes: the slowest wheel
-/// motor's max_velocity times the wheel radius (infinity without wheel
+/// [rad/s] the slowest wheel motor's max_velocity (infinity without wheel
 /// actuators). Needs robot.drive with valid joint indices.
+double slowestWheelSpeed(const RobotModel& robot);
+/// [m/s] the fastest `drive` or `turn` the robot takes: slowestWheelSpeed()
+/// times the wheel radius.
 double driveSpeedLimit(const RobotModel& robot);
 
 /// Checks one command (parsed with the same robot) against `robot`. Any thread.

@@ -2,6 +2,8 @@
 
 #include "ui/limit_spin_box.h"
 
+#include "sim/command_check.h"
+
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
@@ -144,17 +146,9 @@ void ControlPanel::setRobot(const RobotModel& robot) {
   maxSpeed_ = 0;
   maxArticulationDeg_ = 0;
   if (model_.drive) {
-    // The drive is as fast as its slowest wheel allows.
-    double omega = 0;
-    bool first = true;
-    for (int w : model_.drive->wheels) {
-      const int a = w >= 0 ? model_.findActuator(model_.joints[static_cast<size_t>(w)].name) : -1;
-      if (a < 0) continue;
-      const double m = model_.actuators[static_cast<size_t>(a)].maxVelocity;
-      omega = first ? m : std::min(omega, m);
-      first = false;
-    }
-    maxSpeed_ = omega * model_.drive->wheelRadius;
+    // The drive is as fast as its slowest wheel allows (what the robot checks).
+    const double top = driveSpeedLimit(model_);
+    maxSpeed_ = std::isfinite(top) ? top : 0;
     if (model_.drive->articulation >= 0) {
       const JointSpec& j = model_.joints[static_cast<size_t>(model_.drive->articulation)];
       maxArticulationDeg_ = j.limited ? radToDeg(std::min(std::abs(j.lower), std::abs(j.upper))) : 45.0;

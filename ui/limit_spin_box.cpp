@@ -11,10 +11,16 @@ namespace {
 constexpr double kTypingRange = 1e6;  // what may be typed, whatever the limits
 }
 
+namespace {
+// 0 for a value that shows as zero with `decimals` (dropping the sign of a
+// negative zero too); else the value.
+double withoutNegativeZero(double value, int decimals) {
+  return std::round(value * std::pow(10.0, decimals)) == 0 ? 0.0 : value;
+}
+}  // namespace
+
 QString formatFixed(double value, int decimals) {
-  const double scale = std::pow(10.0, decimals);
-  if (std::round(value * scale) == 0) value = 0;  // drops the sign of a negative zero too
-  return QString::number(value, 'f', decimals);
+  return QString::number(withoutNegativeZero(value, decimals), 'f', decimals);
 }
 
 LimitSpinBox::LimitSpinBox(QWidget* parent) : QDoubleSpinBox(parent) {
@@ -30,7 +36,7 @@ void LimitSpinBox::setLimits(double lower, double upper) {
 }
 
 QString LimitSpinBox::textFromValue(double value) const {
-  return locale().toString(formatFixed(value, decimals()).toDouble(), 'f', decimals());
+  return locale().toString(withoutNegativeZero(value, decimals()), 'f', decimals());
 }
 
 int LimitSpinBox::excessWidth() const {

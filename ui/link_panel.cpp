@@ -26,7 +26,7 @@ class ElidedLabel : public QLabel {
     setMinimumWidth(40);
     setTextInteractionFlags(Qt::TextSelectableByMouse);
   }
-  void show(const QString& text, const char* colour = nullptr) {
+  void setFullText(const QString& text, const char* colour = nullptr) {
     full_ = text;
     setStyleSheet(colour ? QStringLiteral("QLabel { color: %1; font-weight: bold; }").arg(QLatin1String(colour)) : QString());
     setToolTip(text);
@@ -105,7 +105,7 @@ LinkPanel::LinkPanel(QWidget* parent) : QWidget(parent) {
   showLatches(false, false);
 }
 
-void LinkPanel::setEndpoint(const QString& endpoint) { endpoint_->show(endpoint); }
+void LinkPanel::setEndpoint(const QString& endpoint) { endpoint_->setFullText(endpoint); }
 
 void LinkPanel::appendEvent(const QString& text) {
   events_->appendPlainText(QTime::currentTime().toString(QStringLiteral("HH:mm:ss.zzz  ")) + text);
@@ -118,20 +118,20 @@ QStringList LinkPanel::events() const { return events_->toPlainText().split(QLat
 
 void LinkPanel::showStats(const net::RobotClientStats& s) {
   if (!s.connected) {
-    rtt_->show(QStringLiteral("–"));
-    rate_->show(QStringLiteral("–"));
+    rtt_->setFullText(QStringLiteral("–"));
+    rate_->setFullText(QStringLiteral("–"));
   } else {
-    rtt_->show(tr("%1 ms (mean %2, max %3)")
+    rtt_->setFullText(tr("%1 ms (mean %2, max %3)")
                       .arg(s.rttMs, 0, 'f', 1)
                       .arg(s.rttMeanMs, 0, 'f', 1)
                       .arg(s.rttMaxMs, 0, 'f', 1));
-    rate_->show(tr("%1 Hz of %2").arg(s.telemetryRateHz, 0, 'f', 1).arg(s.telemetryRateAnnounced, 0, 'f', 0));
+    rate_->setFullText(tr("%1 Hz of %2").arg(s.telemetryRateHz, 0, 'f', 1).arg(s.telemetryRateAnnounced, 0, 'f', 0));
   }
-  deadman_->show(s.robotDeadman > 0 ? tr("%1 ms (the robot's)").arg(s.robotDeadman * 1000, 0, 'f', 0)
+  deadman_->setFullText(s.robotDeadman > 0 ? tr("%1 ms (the robot's)").arg(s.robotDeadman * 1000, 0, 'f', 0)
                                        : tr("not announced"));
   const uint64_t total = s.telemetryFrames + s.telemetryLost;
   const double percent = total ? 100.0 * static_cast<double>(s.telemetryLost) / static_cast<double>(total) : 0.0;
-  loss_->show(tr("%1 frames (%2 %), robot dropped %3, %4 reconnects")
+  loss_->setFullText(tr("%1 frames (%2 %), robot dropped %3, %4 reconnects")
                      .arg(s.telemetryLost)
                      .arg(percent, 0, 'f', 2)
                      .arg(s.robotDropped)
@@ -146,7 +146,7 @@ void LinkPanel::showConnection(net::ConnectionState state, const QString& detail
                        : state == net::ConnectionState::Refused ? "#c62828"
                        : state == net::ConnectionState::Stopped ? "#555555"
                                                                  : "#ef6c00";
-  state_->show(text, colour);
+  state_->setFullText(text, colour);
   connect_->setText(open_ ? tr("Disconnect") : tr("Connect"));
   control_->setEnabled(state == net::ConnectionState::Ready);
   rearm_->setEnabled(state == net::ConnectionState::Ready);
@@ -155,21 +155,21 @@ void LinkPanel::showConnection(net::ConnectionState state, const QString& detail
 
 void LinkPanel::showLease(const net::LeaseStateMsg& lease) {
   leaseHeld_ = lease.yours;
-  if (lease.yours) lease_->show(tr("yours"), "#2e7d32");
-  else if (!lease.holder.empty()) lease_->show(tr("held by %1").arg(QString::fromStdString(lease.holder)), "#ef6c00");
-  else lease_->show(tr("free (monitoring)"));
+  if (lease.yours) lease_->setFullText(tr("yours"), "#2e7d32");
+  else if (!lease.holder.empty()) lease_->setFullText(tr("held by %1").arg(QString::fromStdString(lease.holder)), "#ef6c00");
+  else lease_->setFullText(tr("free (monitoring)"));
   control_->setText(lease.yours ? tr("Release control") : tr("Take control"));
 }
 
 void LinkPanel::showLatches(bool failsafe, bool estop) {
   if (!failsafe && !estop) {
-    latches_->show(tr("clear"), "#2e7d32");
+    latches_->setFullText(tr("clear"), "#2e7d32");
     return;
   }
   QStringList on;
   if (estop) on << tr("E-STOP");
   if (failsafe) on << tr("FAILSAFE");
-  latches_->show(on.join(QStringLiteral(" + ")) + tr(" latched: re-arm"), "#c62828");
+  latches_->setFullText(on.join(QStringLiteral(" + ")) + tr(" latched: re-arm"), "#c62828");
 }
 
 }  // namespace sp
