@@ -37,6 +37,10 @@ void ConsoleSession::setWorld(WorldModel world) {
   positions_.reset();
   rates_.reset();
   rate_.reset();
+  ghost_.reset();
+  lastPrediction_.reset();
+  ghostError_.clear();
+  if (options_.ghost) ghost_ = Ghost::create(*world_, params_, options_.ghostOptions, ghostError_);
 }
 
 std::string ConsoleSession::start() {
@@ -120,6 +124,7 @@ std::string ConsoleSession::startStandIn(const std::string& worldFile, const std
   if (options_.rtf >= 0) o.realTimeFactor = options_.rtf;
   o.log = options_.log;
   o.logDir = options_.logDir;
+  o.emulation.delay = options_.delay;
   Diagnostics diag;
   std::unique_ptr<StandInRobot> standIn = StandInRobot::create(o, diag);
   if (!standIn) return text(diag);
@@ -180,7 +185,7 @@ std::string ConsoleSession::logError() const {
   return recorderError_;
 }
 
-RobotFrame ConsoleSession::telemetry(const net::TelemetryMsg& t, double wall) {
+RobotFrame ConsoleSession::telemetry(const net::TelemetryMsg& t, double wall, double roundTrip) {
   RobotFrame f;
   f.time = t.time;
   f.base = t.pose;
@@ -200,6 +205,10 @@ RobotFrame ConsoleSession::telemetry(const net::TelemetryMsg& t, double wall) {
     f.jointPositions = positions_.toModelOrder(t.jointNames, t.jointPositions, *model);
     f.jointRates = rates_.toModelOrder(t.jointNames, t.jointVelocities, *model);
     if (recorder_) recorder_->telemetry(t, *model);
+    if (ghost_) {
+      lastPrediction_ = ghost_->anchor(f, roundTrip > 0 ? roundTrip : t.rttMs / 1000);
+      if (lastPrediction_) logPrediction(*lastPrediction_);
+    }
   }
   rate_.add(wall, t.time);
   return f;
@@ -217,6 +226,19 @@ std::string ConsoleSession::commandRefusal(bool leaseHeld) const {
 
 void ConsoleSession::commandSent(const Command& command) {
   if (recorder_) recorder_->command(command, robot());
+  if (ghost_) ghost_->commandSent(command);
+}
+
+void ConsoleSession::logPrediction(const GhostError& e) {
+  LogPrediction p;
+  p.time = e.time;
+  p.made = e.made;
+  p.base = {e.predicted.p.x, e.predicted.p.y, e.predicted.p.z};
+  p.quat = {e.predicted.q.w, e.predicted.q.x, e.predicted.q.y, e.predicted.q.z};
+  p.positionError = e.position;
+  p.headingError = e.heading;
+  if (recorder_) recorder_->prediction(p);
+  else if (standIn_) standIn_->logPrediction(p);
 }
 
 std::string ConsoleSession::resetRobot() {
@@ -227,6 +249,22 @@ std::string ConsoleSession::resetRobot() {
   standIn_->addNote(oldLog.empty() ? std::string("reset: the robot is back at its start")
                                    : "reset: the robot is back at its start; the session before is in " + oldLog);
   return {};
+}
+
+std::string ConsoleSession::filesMismatch(const std::string& worldHash, const std::string& robotHash) const {
+  if (!world_ || world_->robots.empty()) return {};
+  std::string differs;
+  const auto check = [&](const std::string& announced, const std::string& file, const char* what) {
+    if (announced.empty() || announced == fileHash(file)) return;
+    if (!differs.empty()) differs += "; ";
+    differs += std::string("its ") + what + " file differs from " + file + " (robot " + announced + ", here " +
+               (fileHash(file).empty() ? "unreadable" : fileHash(file)) + ")";
+  };
+  check(worldHash, world_->file, "world");
+  check(robotHash, world_->robots[0].model.file, "robot");
+  if (differs.empty()) return {};
+  return "The robot runs other files than this console's twin: " + differs +
+         ". The ghost predicts from the console's files; open the robot's with File > Open world.";
 }
 
 std::optional<double> ConsoleSession::edgeDistance(const Pose& base) const {

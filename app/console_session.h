@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "app/ghost.h"
 #include "app/robot_frame.h"
 #include "net/message.h"
 #include "sim/params.h"
@@ -40,6 +41,9 @@ struct ConsoleSessionOptions {
   bool log = true;                     ///< log the session
   std::string logDir = "sessions";     ///< where new logs go
   double rtf = -1;                     ///< stand-in real-time factor; < 0 = the parameters'
+  double delay = 0;                    ///< [s] the stand-in's link emulates this one-way delay (each way)
+  bool ghost = true;                   ///< run the predictive ghost (app/ghost.h)
+  Ghost::Options ghostOptions;         ///< its options (tests' controls)
 };
 
 /// Where the console's link goes.
@@ -86,6 +90,10 @@ class ConsoleSession {
   /// old log notes it and is complete; the new one names the old). For a
   /// robot elsewhere returns why not.
   std::string resetRobot();
+  /// The robot announced (WELCOME) the hashes of the files it runs ("" =
+  /// not announced): "" when they match the files the console's twin and
+  /// ghost are built from, else what differs, for the operator.
+  std::string filesMismatch(const std::string& worldHash, const std::string& robotHash) const;
   /// How far `base` is inside the edge of a heightfield terrain [m]
   /// (negative: beyond it); nullopt on a plane, which has no edge.
   std::optional<double> edgeDistance(const Pose& base) const;
@@ -108,8 +116,19 @@ class ConsoleSession {
   std::string logError() const;
 
   /// A telemetry frame arrived at wall time `wall` [s]: the frame to draw
-  /// (joints in the model's order), logged when the robot is remote.
-  RobotFrame telemetry(const net::TelemetryMsg& message, double wall);
+  /// (joints in the model's order), logged when the robot is remote. It
+  /// re-anchors the ghost; what the ghost had predicted for the frame's
+  /// time is then lastPrediction(), and logged.
+  /// `roundTrip` [s] is the link's as the client measures it (0 = not
+  /// yet; the robot's own figure in the message is used then).
+  RobotFrame telemetry(const net::TelemetryMsg& message, double wall, double roundTrip = 0);
+  /// The predictive ghost of the drawn world's robot; null without one
+  /// (options.ghost false, or it could not be built: ghostError()).
+  const Ghost* ghost() const { return ghost_.get(); }
+  const std::string& ghostError() const { return ghostError_; }
+  /// The last telemetry frame against the ghost's prediction for its time;
+  /// nullopt when the ghost had shown nothing for that time.
+  const std::optional<GhostError>& lastPrediction() const { return lastPrediction_; }
   /// A laser scan arrived: the frame to draw, logged when remote.
   LaserFrame laser(const net::LaserMsg& message);
   /// The achieved real-time factor over the last second of telemetry.
@@ -119,7 +138,7 @@ class ConsoleSession {
   /// operator): only the lease holder commands.
   std::string commandRefusal(bool leaseHeld) const;
   /// A command went out: logged when the robot is remote (the stand-in logs
-  /// what it applies itself).
+  /// what it applies itself), and handed to the ghost.
   void commandSent(const Command& command);
   /// An operator note into the session log.
   void note(const std::string& text);
@@ -131,6 +150,7 @@ class ConsoleSession {
   std::string startStandIn(const std::string& worldFile, const std::string& robotFile);
   void setWorld(WorldModel world);
   void openRemoteLog();
+  void logPrediction(const GhostError& error);
 
   ConsoleSessionOptions options_;
   SimParams params_;
@@ -142,6 +162,9 @@ class ConsoleSession {
   std::unique_ptr<TelemetryRecorder> recorder_;  // the log of a remote robot
   std::string recorderError_;
   RobotEndpoint endpoint_;
+  std::unique_ptr<Ghost> ghost_;
+  std::string ghostError_;
+  std::optional<GhostError> lastPrediction_;
   JointNameMap positions_, rates_;
   RateMeter rate_;
 };

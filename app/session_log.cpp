@@ -25,9 +25,12 @@ CREATE INDEX laser_time ON laser(time);
 CREATE TABLE events(step INTEGER, time REAL, kind TEXT, text TEXT);
 CREATE TABLE snapshots(step INTEGER PRIMARY KEY, time REAL, hash INTEGER, data BLOB);
 CREATE TABLE hashes(step INTEGER PRIMARY KEY, hash INTEGER);
+CREATE TABLE predictions(time REAL, made REAL, base_x REAL, base_y REAL, base_z REAL,
+                         qw REAL, qx REAL, qy REAL, qz REAL, error_position REAL, error_heading REAL);
+CREATE INDEX predictions_time ON predictions(time);
 )sql";
 
-const char* const kStreams[] = {"meta", "commands", "samples", "laser", "events", "snapshots", "hashes"};
+const char* const kStreams[] = {"meta", "commands", "samples", "laser", "events", "snapshots", "hashes", "predictions"};
 
 // Doubles as little-endian bytes, and back.
 std::vector<uint8_t> packDoubles(const double* values, std::size_t n) {
@@ -150,9 +153,10 @@ struct SessionLogWriter::Statements {
         laser(db, "INSERT OR REPLACE INTO laser VALUES(?,?,?,?,?)"),
         event(db, "INSERT INTO events VALUES(?,?,?,?)"),
         snapshot(db, "INSERT OR REPLACE INTO snapshots VALUES(?,?,?,?)"),
-        hash(db, "INSERT OR REPLACE INTO hashes VALUES(?,?)") {}
-  bool ok() const { return command && sample && laser && event && snapshot && hash; }
-  Stmt command, sample, laser, event, snapshot, hash;
+        hash(db, "INSERT OR REPLACE INTO hashes VALUES(?,?)"),
+        prediction(db, "INSERT INTO predictions VALUES(?,?,?,?,?,?,?,?,?,?,?)") {}
+  bool ok() const { return command && sample && laser && event && snapshot && hash && prediction; }
+  Stmt command, sample, laser, event, snapshot, hash, prediction;
 };
 
 SessionLogWriter::SessionLogWriter(std::string path, const SessionLogOptions& options)
@@ -252,6 +256,7 @@ bool SessionLogWriter::logCommand(int64_t step, double time, const std::string& 
 }
 bool SessionLogWriter::logSample(LogSample sample) { return push(std::move(sample)); }
 bool SessionLogWriter::logLaser(LogLaser scan) { return push(std::move(scan)); }
+bool SessionLogWriter::logPrediction(const LogPrediction& prediction) { return push(prediction); }
 bool SessionLogWriter::logEvent(int64_t step, double time, std::string kind, std::string text) {
   return push(LogEvent{step, time, std::move(kind), std::move(text)});
 }
@@ -334,6 +339,13 @@ bool SessionLogWriter::writeBatch(std::deque<Item>& batch) {
     } else if (const auto* h = std::get_if<HashItem>(&item)) {
       s.hash.bind(1, h->step); s.hash.bind(2, static_cast<int64_t>(h->hash));
       rc = s.hash.exec();
+    } else if (const auto* p = std::get_if<LogPrediction>(&item)) {
+      Stmt& st = s.prediction;
+      st.bind(1, p->time); st.bind(2, p->made);
+      for (int i = 0; i < 3; ++i) st.bind(3 + i, p->base[static_cast<std::size_t>(i)]);
+      for (int i = 0; i < 4; ++i) st.bind(6 + i, p->quat[static_cast<std::size_t>(i)]);
+      st.bind(10, p->positionError); st.bind(11, p->headingError);
+      rc = st.exec();
     }
     if (rc != SQLITE_DONE) break;
   }
@@ -442,6 +454,27 @@ std::vector<LogLaser> SessionLogReader::laserBetween(double t0, double t1) const
   q.bind(1, t0);
   q.bind(2, t1);
   while (q.row()) out.push_back(LogLaser{q.i64(0), q.f64(1), q.f64(2), q.f64(3), q.doubles(4)});
+  return out;
+}
+
+std::vector<LogPrediction> SessionLogReader::predictionsBetween(double t0, double t1) const {
+  std::vector<LogPrediction> out;
+  Stmt q(db_,
+         "SELECT time, made, base_x, base_y, base_z, qw, qx, qy, qz, error_position, error_heading "
+         "FROM predictions WHERE time >= ? AND time <= ? ORDER BY time, rowid");
+  if (!q) return out;  // a log from before predictions were logged
+  q.bind(1, t0);
+  q.bind(2, t1);
+  while (q.row()) {
+    LogPrediction p;
+    p.time = q.f64(0);
+    p.made = q.f64(1);
+    for (int i = 0; i < 3; ++i) p.base[static_cast<std::size_t>(i)] = q.f64(2 + i);
+    for (int i = 0; i < 4; ++i) p.quat[static_cast<std::size_t>(i)] = q.f64(5 + i);
+    p.positionError = q.f64(9);
+    p.headingError = q.f64(10);
+    out.push_back(p);
+  }
   return out;
 }
 

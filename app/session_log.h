@@ -76,6 +76,19 @@ struct LogLaser {
   friend bool operator==(const LogLaser&, const LogLaser&) = default;
 };
 
+/// What the predictive ghost had shown for robot time `time` (app/ghost.h),
+/// and how far the robot turned out to be from it when its telemetry for
+/// that time arrived.
+struct LogPrediction {
+  double time = 0;  ///< [s] robot time predicted for
+  double made = 0;  ///< [s] robot time of the telemetry the prediction ran from
+  std::array<double, 3> base{};            ///< predicted base position, world [m]
+  std::array<double, 4> quat{1, 0, 0, 0};  ///< predicted base orientation w, x, y, z
+  double positionError = 0;  ///< [m] horizontal, against the telemetry
+  double headingError = 0;   ///< [rad] absolute yaw difference
+  friend bool operator==(const LogPrediction&, const LogPrediction&) = default;
+};
+
 /// A command as applied: its step, its source ("operator", "sequence",
 /// "rehearsal") and its sequence-file text (sp::toText).
 struct LogCommand {
@@ -136,6 +149,8 @@ class SessionLogWriter {
                   const RobotModel* robot = nullptr);
   bool logSample(LogSample sample);
   bool logLaser(LogLaser scan);
+  /// Safe from any thread (the console's, while the physics thread logs).
+  bool logPrediction(const LogPrediction& prediction);
   bool logEvent(int64_t step, double time, std::string kind, std::string text);
   /// A snapshot (encoded by the writer thread) with its World::stateHash().
   bool logSnapshot(Snapshot snapshot, double time, uint64_t hash);
@@ -163,7 +178,7 @@ class SessionLogWriter {
     int64_t step = 0;
     uint64_t hash = 0;
   };
-  using Item = std::variant<LogCommand, LogSample, LogLaser, LogEvent, SnapshotItem, HashItem>;
+  using Item = std::variant<LogCommand, LogSample, LogLaser, LogEvent, SnapshotItem, HashItem, LogPrediction>;
   struct Statements;
 
   SessionLogWriter(std::string path, const SessionLogOptions& options);
@@ -205,6 +220,9 @@ class SessionLogReader {
   /// Laser scans with t0 <= time <= t1 [s], in step order (uses the time
   /// index where the log has one: logs since laser_time was added).
   std::vector<LogLaser> laserBetween(double t0, double t1) const;
+  /// The ghost's predictions for robot times in [t0, t1]; none in a log
+  /// written before they were logged.
+  std::vector<LogPrediction> predictionsBetween(double t0, double t1) const;
   std::vector<LogCommand> commands() const;
   std::vector<LogEvent> events() const;
   /// (step, hash) of the periodic state hashes, in step order.

@@ -7,12 +7,21 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/resimulation.h"  // hashHex
+#include "sim/hash.h"
+
 namespace sp {
 std::string readWholeFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+std::string fileHash(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  return hashHex(fnv1a64(readWholeFile(path)));
 }
 
 std::unique_ptr<SessionLogWriter> openSessionLog(const std::string& path, const SessionSources& sources,

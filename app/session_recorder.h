@@ -30,6 +30,9 @@ struct SessionSources {
 
 /// The bytes of the file at `path` ("" if it cannot be read), for the meta.
 std::string readWholeFile(const std::string& path);
+/// FNV-1a 64 of a file's bytes as 16 hex digits (as the log's meta and
+/// WELCOME carry it); "" when the file cannot be read.
+std::string fileHash(const std::string& path);
 
 /// Creates the session log at `path` (an existing file is an error): meta
 /// with this program's version and each source file's name, whole contents

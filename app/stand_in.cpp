@@ -79,6 +79,8 @@ std::string StandInRobot::start() {
   config.link.robotName = world_.robots[0].name;
   config.link.token = token_;
   config.link.telemetryRate = params_.telemetryRate;
+  config.link.worldHash = fileHash(world_.file);
+  config.link.robotHash = fileHash(world_.robots[0].model.file);
   config.link.deadman = params_.linkDeadman;
   config.link.leaseConfirm = params_.linkLeaseConfirm;
   config.maxConnections = static_cast<size_t>(params_.linkMaxConnections);
@@ -149,5 +151,7 @@ std::string StandInRobot::logError() const { return host_->log() ? host_->log()-
 int64_t StandInRobot::logDropped() const { return host_->log() ? host_->log()->dropped() : 0; }
 
 void StandInRobot::addNote(std::string text) { host_->logEvent("note", std::move(text)); }
+
+void StandInRobot::logPrediction(const LogPrediction& prediction) { host_->logPrediction(prediction); }
 
 }  // namespace sp

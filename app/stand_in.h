@@ -36,6 +36,7 @@
 namespace sp {
 
 class TwinHost;
+struct LogPrediction;
 class SessionLogWriter;
 
 /// How to run the stand-in robot. Defaults: loopback, the parameters'
@@ -118,6 +119,8 @@ class StandInRobot {
   /// Writes an operator note (event kind "note") into the log at the twin's
   /// current step; dropped without a log. Never blocks on the disk.
   void addNote(std::string text);
+  /// Logs a prediction of the console's ghost; dropped without a log.
+  void logPrediction(const LogPrediction& prediction);
 
  private:
   struct Server;  // the io_context, RobotServer and its thread (Asio stays out of this header)

@@ -39,6 +39,8 @@ class TelemetryRecorder {
   void command(const Command& command, const RobotModel* robot);
   /// An event ("link", "estop", "note", ...) at the latest robot time.
   void event(const std::string& kind, const std::string& text);
+  /// What the console's ghost predicted for a frame (app/ghost.h).
+  void prediction(const LogPrediction& prediction) { writer_->logPrediction(prediction); }
 
   const SessionLogWriter& writer() const { return *writer_; }
   const std::string& path() const { return writer_->path(); }

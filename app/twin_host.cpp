@@ -55,6 +55,10 @@ void TwinHost::logEvent(std::string kind, std::string text) {
   events_.push_back({std::move(kind), std::move(text)});
 }
 
+void TwinHost::logPrediction(const LogPrediction& prediction) {
+  if (log_) log_->writer().logPrediction(prediction);
+}
+
 CommandCheck TwinHost::check(const Command& command) const {
   // The robot's side of the link takes robot commands only: a terrain edit
   // is the simulator's, and a real robot could not carry it out.

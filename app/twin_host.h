@@ -54,6 +54,9 @@ class TwinHost : public net::RobotPort {
   /// The log's writer, or null without one; its failed(), errorMessage()
   /// and dropped() may be read from any thread.
   const SessionLogWriter* log() const { return log_ ? &log_->writer() : nullptr; }
+  /// Logs what the console's ghost predicted (app/ghost.h); dropped without
+  /// a log. Thread: the owner's (not after stop()); never blocks on the disk.
+  void logPrediction(const LogPrediction& prediction);
 
   const RobotModel* model() const override { return &model_; }
   CommandCheck check(const Command& command) const override;

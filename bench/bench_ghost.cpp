@@ -53,8 +53,6 @@ std::unique_ptr<World> build(const WorldModel& model, SimParams params = {}) {
   return w;
 }
 
-double yawOf(const Quat& q) { return std::atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z)); }
-
 void run(World& w, double seconds) {
   const auto n = std::llround(seconds / w.params().step);
   for (int64_t i = 0; i < n && w.step(); ++i) {
@@ -89,7 +87,7 @@ Outcome predict(const WorldModel& model, const Command& drive, const Profile& p,
   run(*robot, horizon);
   const Pose a = robot->linkPose(0, 0), b = ghost->linkPose(0, 0);
   o.position = std::hypot(a.p.x - b.p.x, a.p.y - b.p.y);
-  double dyaw = yawOf(a.q) - yawOf(b.q);
+  double dyaw = heading(a.q) - heading(b.q);
   dyaw = std::remainder(dyaw, 2 * kPi);
   o.headingDeg = std::abs(radToDeg(dyaw));
   return o;

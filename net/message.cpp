@@ -168,6 +168,8 @@ void forEachField(M& m, F& f) {
     f("session", m.session, R);
     f("telemetry_rate", m.telemetryRate, R);
     f("deadman", m.deadman, Need::Optional);
+    f("world_hash", m.worldHash, Need::Optional);
+    f("robot_hash", m.robotHash, Need::Optional);
   } else if constexpr (std::is_same_v<T, LeaseStateMsg>) {
     f("holder", m.holder, R);
     f("yours", m.yours, R);
@@ -273,6 +275,11 @@ struct Validator {
       std::string s = "key 'telemetry_rate': must be finite and > 0, got ";
       appendNumber(s, m.telemetryRate);
       return s;
+    }
+    for (const auto& [key, value] : {std::pair{"world_hash", &m.worldHash}, std::pair{"robot_hash", &m.robotHash}}) {
+      if (value->empty()) continue;
+      if (std::string e = hexDigits(key, *value, 16, "16 hex digits"); !e.empty()) return e;
+      if (value->size() != 16) return std::string("key '") + key + "': expected 16 hex digits, got " + std::to_string(value->size());
     }
     return {};
   }

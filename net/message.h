@@ -91,6 +91,10 @@ struct WelcomeMsg {
   uint64_t session = 0;        ///< this connection's session id
   double telemetryRate = 50;   ///< [Hz], finite and > 0
   double deadman = 0;          ///< [s] the robot's deadman (optional key `deadman`; 0 = not announced)
+  /// FNV-1a 64 of the world and robot files the robot runs, 16 hex digits
+  /// each (optional keys `world_hash`, `robot_hash`; "" = not
+  /// announced): a console checks its own twin's files against them.
+  std::string worldHash, robotHash;
   friend bool operator==(const WelcomeMsg&, const WelcomeMsg&) = default;
 };
 /// LEASE_ACQUIRE: no keys.

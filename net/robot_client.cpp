@@ -459,6 +459,8 @@ class RobotClient::Impl {
       s.robot = m.robot;
       s.telemetryRateAnnounced = m.telemetryRate;
       s.robotDeadman = m.deadman;
+      s.robotWorldHash = m.worldHash;
+      s.robotRobotHash = m.robotHash;
     });
     // Keep-alives at least four per deadman period, so one late or lost
     // keep-alive never trips it.

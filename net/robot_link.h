@@ -41,6 +41,9 @@ struct RobotLinkConfig {
   /// that first arrival; the robot stands still meanwhile.
   double leaseConfirm = 10;
   double telemetryRate = 50;    ///< [Hz], announced in WELCOME
+  /// FNV-1a 64 of the world and robot files (16 hex digits; "" = not
+  /// announced), in WELCOME: a console checks its twin's files against them.
+  std::string worldHash = {}, robotHash = {};
   /// Whether a HELLO may carry the token in clear (`token`) instead of a
   /// proof over this connection's CHALLENGE: only for a robot listening on
   /// loopback, where nobody without the machine can read the link

@@ -23,6 +23,11 @@ Vec3 rotate(const Quat& q, Vec3 v) {
   return v + q.w * t + cross(u, t);
 }
 
+double heading(const Quat& q) {
+  const Vec3 x = rotate(q, {1, 0, 0});
+  return std::atan2(x.y, x.x);
+}
+
 Quat quatFromAxisAngle(Vec3 axis, double angle) {
   const Vec3 a = normalized(axis);
   const double s = std::sin(angle / 2);

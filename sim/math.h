@@ -41,6 +41,9 @@ Vec3 rotate(const Quat& q, Vec3 v);
 Quat quatFromRpy(Vec3 rpy);
 Vec3 rpyFromQuat(const Quat& q);
 Quat quatFromAxisAngle(Vec3 axis, double angle);
+/// Where the frame's x axis points in the ground plane [rad] about z
+/// (its yaw, well defined for any roll and pitch short of vertical).
+double heading(const Quat& q);
 
 /// A rigid transform: first rotate, then translate.
 struct Pose {

@@ -42,6 +42,10 @@ struct SimParams {
   int linkMaxConnections = 64;    ///< robot: connections open at once; one more is closed at once
   double linkHelloTimeout = 2;    ///< [s] robot: a connection without a good HELLO by then is closed
   double consoleStaleAfter = 0.5; ///< [s] console: no telemetry this long => the robot is drawn grey, "no data"
+  double ghostStep = 0.004;       ///< [s] console's predictive ghost: its physics step
+  int ghostIterations = 20;       ///< ghost: quick solver iterations
+  double ghostHorizon = 5;        ///< [s] ghost: how far the trail looks ahead of the ghost
+  double ghostAnchorRate = 15;    ///< [Hz] ghost: re-anchorings per second at most
   // Gaits (sim/gait.h); swings in degrees about the stance pose
   double caterpillarHipSwing = 12;   ///< [deg]
   double caterpillarPhaseTime = 1.0; ///< [s] per half cycle

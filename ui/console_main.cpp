@@ -84,8 +84,10 @@ int main(int argc, char** argv) {
   const QCommandLineOption monitor(QStringLiteral("monitor"), QStringLiteral("Do not take control on connecting."));
   const QCommandLineOption screenshot(QStringLiteral("screenshot"), QStringLiteral("Save a picture of the window after --quit-after seconds, then quit."), QStringLiteral("PNG"));
   const QCommandLineOption quitAfter(QStringLiteral("quit-after"), QStringLiteral("Quit after S seconds, printing the frame rate (for measurements)."), QStringLiteral("S"));
+  const QCommandLineOption delay(QStringLiteral("delay"), QStringLiteral("The stand-in's link delays every frame by S seconds each way (rehearse a slow link; the ghost spans it)."), QStringLiteral("S"));
+  const QCommandLineOption noGhost(QStringLiteral("no-ghost"), QStringLiteral("Do not run the predictive ghost."));
   const QCommandLineOption drive(QStringLiteral("drive"), QStringLiteral("Drive at SPEED m/s once in control (for demonstrations)."), QStringLiteral("SPEED"));
-  parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, monitor, screenshot, quitAfter, drive});
+  parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, delay, noGhost, monitor, screenshot, quitAfter, drive});
   if (!parser.parse(QCoreApplication::arguments())) {
     std::cerr << "<command line>: error: " << parser.errorText().toStdString() << "\n";
     return 2;
@@ -126,6 +128,12 @@ int main(int argc, char** argv) {
     if (!x) return 2;
     options.rtf = *x;
   }
+  if (parser.isSet(delay)) {
+    const std::optional<double> s = numberOption(parser, delay, 0, 60);
+    if (!s) return 2;
+    options.delay = *s;
+  }
+  options.ghost = !parser.isSet(noGhost);
   if (parser.isSet(drive) && !(driveSpeed = numberOption(parser, drive, -10, 10))) return 2;
   if (parser.isSet(quitAfter) && !(quitSeconds = numberOption(parser, quitAfter, 0.1, 1e6))) return 2;
 

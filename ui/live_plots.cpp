@@ -26,6 +26,7 @@
 #include <limits>
 
 #include "app/plot.h"  // plotSeriesColor: the report plots' palette
+#include "sim/math.h"
 
 namespace sp {
 
@@ -591,6 +592,69 @@ bool LaserPlot::replot(bool /*force*/) {
     }
   }
   hits_->replace(points);
+  return true;
+}
+
+PredictionErrorPlot::PredictionErrorPlot(QWidget* parent) : LivePlot(parent) {
+  chart_->setTitle(tr("Ghost prediction error"));
+  chart_->legend()->setAlignment(Qt::AlignRight);
+  xAxis_ = makeAxis(tr("robot time [s]"));
+  positionAxis_ = makeAxis(tr("position [cm]"));
+  headingAxis_ = makeAxis(tr("heading [°]"));
+  chart_->addAxis(xAxis_, Qt::AlignBottom);
+  chart_->addAxis(positionAxis_, Qt::AlignLeft);
+  chart_->addAxis(headingAxis_, Qt::AlignRight);
+  position_ = new QLineSeries;
+  position_->setName(tr("position"));
+  position_->setPen(QPen(QColor::fromRgb(static_cast<QRgb>(plotSeriesColor(0))), 1.5));
+  heading_ = new QLineSeries;
+  heading_->setName(tr("heading"));
+  heading_->setPen(QPen(QColor::fromRgb(static_cast<QRgb>(plotSeriesColor(1))), 1.5));
+  for (QLineSeries* s : {position_, heading_}) {
+    chart_->addSeries(s);
+    s->attachAxis(xAxis_);
+  }
+  position_->attachAxis(positionAxis_);
+  heading_->attachAxis(headingAxis_);
+  setAxis(xAxis_, 0, kWindow, 5);
+  setAxis(positionAxis_, 0, 5, 1);
+  setAxis(headingAxis_, 0, 1, 0.2);
+}
+
+void PredictionErrorPlot::addSample(double time, double position, double heading) {
+  ++received_;
+  if (!std::isfinite(time) || !std::isfinite(position) || !std::isfinite(heading)) return;
+  if (!samples_.empty() && time < samples_.back().time) samples_.clear();  // the robot restarted
+  samples_.push_back({time, position, heading});
+  while (samples_.front().time < time - kWindow) samples_.pop_front();
+  markDirty();
+}
+
+void PredictionErrorPlot::clear() {
+  samples_.clear();
+  markDirty();
+}
+
+int PredictionErrorPlot::shownPoints() const { return static_cast<int>(position_->count()); }
+
+bool PredictionErrorPlot::replot(bool) {
+  QList<QPointF> position, heading;
+  double maxPosition = 0, maxHeading = 0;
+  const double end = samples_.empty() ? 0 : samples_.back().time;
+  for (const Sample& s : samples_) {
+    position.append({s.time, s.position * 100});
+    heading.append({s.time, radToDeg(s.heading)});
+    maxPosition = std::max(maxPosition, s.position * 100);
+    maxHeading = std::max(maxHeading, radToDeg(s.heading));
+  }
+  position_->replace(position);
+  heading_->replace(heading);
+  const double start = std::max(0.0, end - kWindow);
+  setAxis(xAxis_, start, start + kWindow, 5);
+  // At least 5 cm and 1 deg tall: a good prediction reads as good.
+  const double pTop = std::max(5.0, maxPosition * 1.1), hTop = std::max(1.0, maxHeading * 1.1);
+  setAxis(positionAxis_, 0, pTop, tickSpacing(pTop, 4));
+  setAxis(headingAxis_, 0, hTop, tickSpacing(hTop, 4));
   return true;
 }
 

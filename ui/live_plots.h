@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstddef>
+#include <deque>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -260,6 +261,45 @@ class LaserPlot : public LivePlot {
   QScatterSeries* sensor_ = nullptr;
   QValueAxis* leftAxis_ = nullptr;     ///< horizontal, reversed: sensor y
   QValueAxis* forwardAxis_ = nullptr;  ///< vertical: sensor x
+};
+
+/// The predictive ghost's error (app/ghost.h): for each telemetry frame,
+/// how far the robot was from where the ghost had shown it for that time,
+/// in position [cm] (left axis) and heading [deg] (right axis), over the
+/// last 30 s of robot time (the status bar gives the median of 10 s).
+///
+/// Thread: GUI thread only, like every QWidget.
+class PredictionErrorPlot : public LivePlot {
+  Q_OBJECT
+
+ public:
+  static constexpr double kWindow = 30;  ///< [s] of robot time shown
+
+  explicit PredictionErrorPlot(QWidget* parent = nullptr);
+  /// One comparison: robot time [s], position error [m], heading error
+  /// [rad]. Non-finite values are dropped; a time earlier than the newest
+  /// means the robot restarted, and the plot starts over.
+  void addSample(double time, double position, double heading);
+  void clear();
+  /// Samples received (kept or not).
+  int64_t samplesReceived() const { return received_; }
+  /// The samples shown after the last replot (position series).
+  int shownPoints() const;
+
+ protected:
+  bool replot(bool force) override;
+
+ private:
+  struct Sample {
+    double time, position, heading;
+  };
+  std::deque<Sample> samples_;
+  int64_t received_ = 0;
+  QLineSeries* position_ = nullptr;
+  QLineSeries* heading_ = nullptr;
+  QValueAxis* xAxis_ = nullptr;
+  QValueAxis* positionAxis_ = nullptr;
+  QValueAxis* headingAxis_ = nullptr;
 };
 
 }  // namespace sp

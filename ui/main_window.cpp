@@ -57,6 +57,8 @@ ConsoleSessionOptions toSessionOptions(const ConsoleOptions& o) {
   s.log = o.log;
   s.logDir = (o.logDir.isEmpty() ? defaultSessionsDir() : o.logDir).toStdString();
   s.rtf = o.rtf;
+  s.delay = o.delay;
+  s.ghost = o.ghost;
   return s;
 }
 
@@ -95,6 +97,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   connection_ = new RobotConnection(this);
   feed_ = new LiveLinkFeed(connection_, session_.get(), this);
   connect(feed_, &RobotFeed::frame, this, &MainWindow::onFrame);
+  connect(scene_, &SceneView::frameStarting, this, &MainWindow::pullGhost);
   connect(feed_, &RobotFeed::laser, this, &MainWindow::onLaser);
   connect(feed_, &RobotFeed::event, this, [this](const QString& kind, const QString& text) {
     link_->appendEvent(text);
@@ -112,6 +115,12 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
     link_->showConnection(s, d);
     connectionState_ = s;
     connectionDetail_ = d;
+    if (s == net::ConnectionState::Ready) {
+      // The ghost is only as good as the files it is built from.
+      const net::RobotClientStats stats = connection_->stats();
+      filesMismatch_ = qs(session_->filesMismatch(stats.robotWorldHash, stats.robotRobotHash));
+      if (!filesMismatch_.isEmpty()) linkEvent(QStringLiteral("link"), filesMismatch_);
+    }
     if (s != net::ConnectionState::Ready && leaseHeld_) {
       leaseHeld_ = false;
       controls_->syncToRobot(modelPositions_);
@@ -137,6 +146,9 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   logLabel_ = new QLabel;
   logLabel_->setTextInteractionFlags(Qt::TextSelectableByMouse);
   for (QLabel* l : {simTime_, rtfLabel_, health_}) l->setMinimumWidth(l->fontMetrics().horizontalAdvance(QStringLiteral("t = 00000.00 s")));
+  ghostLabel_ = new QLabel;
+  ghostLabel_->setObjectName(QStringLiteral("ghostLabel"));
+  statusBar()->addPermanentWidget(ghostLabel_);
   statusBar()->addPermanentWidget(simTime_);
   statusBar()->addPermanentWidget(rtfLabel_);
   statusBar()->addPermanentWidget(health_);
@@ -154,6 +166,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   connect(panelTimer, &QTimer::timeout, this, [this] {
     wheelPlot_->tick();
     laserPlot_->tick();
+    errorPlot_->tick();
     if (measuredDirty_) {
       controls_->showMeasured(modelPositions_);
       measuredDirty_ = false;
@@ -236,13 +249,15 @@ void MainWindow::buildDocks() {
   auto* plots = new QSplitter(Qt::Horizontal);
   wheelPlot_ = new WheelForcePlot;
   laserPlot_ = new LaserPlot;
+  errorPlot_ = new PredictionErrorPlot;
   // The plots replot from the window's panel timer (see there), not their own.
-  wheelPlot_->setOwnTimer(false);
-  laserPlot_->setOwnTimer(false);
-  plots->addWidget(wheelPlot_);
-  plots->addWidget(laserPlot_);
+  for (LivePlot* p : std::initializer_list<LivePlot*>{wheelPlot_, laserPlot_, errorPlot_}) {
+    p->setOwnTimer(false);
+    plots->addWidget(p);
+  }
   plots->setStretchFactor(0, 3);
   plots->setStretchFactor(1, 2);
+  plots->setStretchFactor(2, 3);
   plotsDock_ = new QDockWidget(tr("Plots"), this);
   plotsDock_->setObjectName(QStringLiteral("plotsDock"));
   plotsDock_->setWidget(plots);
@@ -320,6 +335,14 @@ void MainWindow::buildMenus() {
   beams->setCheckable(true);
   beams->setChecked(true);
   connect(beams, &QAction::toggled, scene_, &SceneView::setLaserVisible);
+  ghostAction_ = view->addAction(tr("&Ghost: the robot predicted over the link's delay"));
+  ghostAction_->setCheckable(true);
+  ghostAction_->setChecked(options_.ghost);
+  ghostAction_->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_G));
+  ghostAction_->setToolTip(tr("A translucent robot where the robot will be when a command sent now arrives, "
+                              "and its path over the next seconds under the commands sent"));
+  connect(ghostAction_, &QAction::toggled, scene_, &SceneView::setGhostVisible);
+  scene_->setGhostVisible(ghostAction_->isChecked());
   view->addSeparator();
   for (QDockWidget* dock : {controlsDock_, plotsDock_, linkDock_}) view->addAction(dock->toggleViewAction());
 
@@ -388,7 +411,14 @@ void MainWindow::showWorld(const WorldModel& world) {
         break;
       }
   }
+  if (connectionState_ == net::ConnectionState::Ready) {
+    const net::RobotClientStats stats = connection_->stats();
+    filesMismatch_ = qs(session_->filesMismatch(stats.robotWorldHash, stats.robotRobotHash));
+  }
   wheelPlot_->clear();
+  errorPlot_->clear();
+  ghostVersion_ = -1;
+  ghostTrailTime_ = -1;
   feed_->clear();
   QString title = tr("SimPartner — %1").arg(QFileInfo(qs(world.file)).fileName());
   if (!options_.connectTo.isEmpty()) title += tr(" — robot at %1").arg(options_.connectTo);
@@ -583,6 +613,7 @@ void MainWindow::onFrame(const RobotFrame& f) {
     updateBanner();
   }
   scene_->setRobotState(f.base, modelPositions_);
+  if (const std::optional<GhostError>& e = session_->lastPrediction()) errorPlot_->addSample(e->time, e->position, e->heading);
   std::vector<NamedPose> objects;
   for (const ObjectReadout& o : f.objects) objects.push_back({o.name, o.pose});
   scene_->setObjectPoses(objects);
@@ -599,6 +630,22 @@ void MainWindow::onFrame(const RobotFrame& f) {
     updateBanner();
   }
 }
+
+void MainWindow::pullGhost() {
+  const Ghost* ghost = session_->ghost();
+  if (!ghost || !scene_->ghostVisible()) return;
+  if (ghost->viewVersion() == ghostVersion_) return;
+  const GhostView v = ghost->view();
+  ghostVersion_ = v.version;
+  if (v.version == 0) return;  // nothing predicted yet: the ghost stays where it is
+  scene_->setGhostState(v.base, v.jointPositions);
+  if (v.trailTime != ghostTrailTime_) {
+    ghostTrailTime_ = v.trailTime;
+    scene_->setGhostTrail(v.trail);
+  }
+}
+
+QString MainWindow::ghostStatus() const { return ghostLabel_->text(); }
 
 void MainWindow::onLaser(const LaserFrame& scan) {
   scene_->setLaser(scan.angleMin, scan.angleStep, scan.ranges);
@@ -622,6 +669,22 @@ void MainWindow::refreshStatus() {
   else if (last) health_->setText(QStringLiteral("<span style='color:#2e7d32'>%1</span>").arg(tr("healthy")));
   else health_->setText(tr("no telemetry"));
   health_->setToolTip(healthText_);
+  ghostLabel_->setToolTip(tr("The ghost: how far ahead of the newest telemetry it shows the robot (the link's round "
+                             "trip and the telemetry's age), and its error against the telemetry, median over 10 s"));
+  if (const Ghost* ghost = session_->ghost(); !ghost) {
+    ghostLabel_->setText(session_->ghostError().empty() ? tr("ghost off") : tr("ghost failed"));
+    if (!session_->ghostError().empty()) ghostLabel_->setToolTip(qs(session_->ghostError()));
+  } else if (const GhostView v = ghost->view(); !v.problem.empty()) {
+    ghostLabel_->setText(QStringLiteral("<b style='color:#c62828'>%1</b>").arg(tr("ghost stopped")));
+    ghostLabel_->setToolTip(qs(v.problem));
+  } else if (v.version == 0) {
+    ghostLabel_->setText(tr("ghost –"));
+  } else {
+    QString text = tr("ghost +%1 s").arg(v.span, 0, 'f', 2);
+    if (const auto median = ghost->errorMedian())
+      text += tr(", %1 cm / %2°").arg(median->first * 100, 0, 'f', 1).arg(radToDeg(median->second), 0, 'f', 2);
+    ghostLabel_->setText(text);
+  }
   const QString log = logPath();
   logLabel_->setText(log.isEmpty() ? tr("log: off") : tr("log: %1").arg(QFileInfo(log).fileName()));
   logLabel_->setToolTip(log);
@@ -646,6 +709,7 @@ void MainWindow::updateBanner() {
                   : tr("Near the terrain's edge: %1 m left of the %2 × %3 m heightfield; beyond it the robot falls.")
                         .arg(formatFixed(*edgeDistance_, 1), formatFixed(t.grid.width, 1), formatFixed(t.grid.depth, 1)));
   }
+  if (!filesMismatch_.isEmpty()) lines << filesMismatch_;
   if (connectionState_ == net::ConnectionState::Waiting || connectionState_ == net::ConnectionState::Refused)
     lines << tr("Robot link down (%1): the robot's own deadman stops it; reconnecting.").arg(connectionDetail_);
   banner_->setText(lines.join(QLatin1Char('\n')));

@@ -39,6 +39,7 @@ class ControlPanel;
 class LiveLinkFeed;
 class LaserPlot;
 class LinkPanel;
+class PredictionErrorPlot;
 class RobotConnection;
 class SceneView;
 class WheelForcePlot;
@@ -53,6 +54,8 @@ struct ConsoleOptions {
   bool log = true;            ///< log the session
   QString logDir;             ///< where logs go; "" = the user's data folder, `sessions/`
   double rtf = -1;            ///< stand-in real-time factor; < 0 = the parameters'
+  double delay = 0;           ///< [s] one-way delay the stand-in's link emulates (each way)
+  bool ghost = true;          ///< run and show the predictive ghost
   bool takeControl = true;    ///< ask for the lease as soon as connected
 };
 
@@ -73,6 +76,11 @@ class MainWindow : public QMainWindow {
   LinkPanel* linkPanel() const { return link_; }
   WheelForcePlot* wheelForcePlot() const { return wheelPlot_; }
   LaserPlot* laserPlot() const { return laserPlot_; }
+  PredictionErrorPlot* predictionErrorPlot() const { return errorPlot_; }
+  /// View > Ghost: shows or hides the predictive ghost and its trail.
+  QAction* ghostAction() const { return ghostAction_; }
+  /// The status bar's ghost text ("ghost +1.02 s, 1.3 cm / 0.2°").
+  QString ghostStatus() const;
   RobotConnection* connection() const { return connection_; }
   /// The console's session (robot, world, log).
   ConsoleSession* session() const { return session_.get(); }
@@ -125,6 +133,8 @@ class MainWindow : public QMainWindow {
   void connectToRobot();
   void onFrame(const RobotFrame& frame);
   void onLaser(const LaserFrame& scan);
+  /// At every 3D frame: the ghost's newest view into the scene.
+  void pullGhost();
   void sendCommand(const Command& command);
   void refreshStatus();
   void updateBanner();
@@ -150,6 +160,11 @@ class MainWindow : public QMainWindow {
   LinkPanel* link_ = nullptr;
   WheelForcePlot* wheelPlot_ = nullptr;
   LaserPlot* laserPlot_ = nullptr;
+  PredictionErrorPlot* errorPlot_ = nullptr;
+  QAction* ghostAction_ = nullptr;
+  QLabel* ghostLabel_ = nullptr;
+  int64_t ghostVersion_ = -1;     // of the view the scene shows
+  double ghostTrailTime_ = -1;    // of the trail the scene shows
   QDockWidget* controlsDock_ = nullptr;
   QDockWidget* plotsDock_ = nullptr;
   QDockWidget* linkDock_ = nullptr;
@@ -178,7 +193,8 @@ class MainWindow : public QMainWindow {
   bool leaseHeld_ = false;
   net::ConnectionState connectionState_ = net::ConnectionState::Stopped;
   QString connectionDetail_;
-  QString failsafeText_;  // the robot's EVENT text: why it stopped
+  QString failsafeText_;
+  QString filesMismatch_;  // the robot's files are not the console's ("" = same or not announced)  // the robot's EVENT text: why it stopped
   QElapsedTimer lastFrameClock_;
   bool haveFrame_ = false, stale_ = false;
   QString healthText_;

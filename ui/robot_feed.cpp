@@ -20,10 +20,10 @@ QString qs(const std::string& s) { return QString::fromStdString(s); }
 
 LiveLinkFeed::LiveLinkFeed(RobotConnection* connection, ConsoleSession* session, QObject* parent)
     : RobotFeed(parent), session_(session) {
-  connect(connection, &RobotConnection::telemetry, this, [this](const net::TelemetryMsg& t) {
+  connect(connection, &RobotConnection::telemetry, this, [this, connection](const net::TelemetryMsg& t) {
     ++telemetryCount_;
     lastTelemetry_ = t;
-    emit frame(session_->telemetry(t, wallSeconds()));
+    emit frame(session_->telemetry(t, wallSeconds(), connection->stats().rttMs / 1000));
   });
   connect(connection, &RobotConnection::laser, this, [this](const net::LaserMsg& m) {
     ++laserCount_;

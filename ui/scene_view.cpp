@@ -343,6 +343,11 @@ struct SceneView::Impl {
   std::vector<osg::ref_ptr<osg::MatrixTransform>> ghostLinks;
   osg::ref_ptr<osg::Geode> laserNode;
   osg::ref_ptr<osg::Geometry> beams, hits;
+  // The ghost's predicted path: a line strip of base positions.
+  osg::ref_ptr<osg::Geode> trailNode;
+  osg::ref_ptr<osg::Geometry> trail;
+  std::vector<Vec3> trailPoints;
+  bool trailDirty = false;
   osg::ref_ptr<osg::Fog> fog;
 
   // The robot as last set, and whether the graph still shows an older state.
@@ -425,6 +430,23 @@ SceneView::Impl::Impl() {
   }
   buildLaser();
   root->addChild(laserNode);
+  trailNode = new osg::Geode;
+  trail = newGeometry();
+  trail->setVertexArray(new osg::Vec3Array);
+  auto* trailColor = new osg::Vec4Array;
+  trailColor->push_back({0.30f, 0.80f, 1.00f, 0.85f});  // the ghost's tint
+  trail->setColorArray(trailColor, osg::Array::BIND_OVERALL);
+  trail->addPrimitiveSet(new osg::DrawArrays(GL_LINE_STRIP, 0, 0));
+  trail->setDataVariance(osg::Object::DYNAMIC);
+  trailNode->addDrawable(trail);
+  {
+    osg::StateSet* s = trailNode->getOrCreateStateSet();
+    s->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
+    s->setAttributeAndModes(new osg::LineWidth(3.0f));
+    makeTransparent(s);
+  }
+  trailNode->setNodeMask(0);
+  root->addChild(trailNode);
 
   osg::StateSet* s = root->getOrCreateStateSet();
   // Geometry colours drive ambient and diffuse; a little gloss on the shapes.
@@ -545,6 +567,17 @@ void SceneView::Impl::sync() {
     ghostDirty = false;
   }
   ghostNode->setNodeMask(ghostVisible && hasRobot ? ~0u : 0u);
+  if (trailDirty) {
+    auto* v = static_cast<osg::Vec3Array*>(trail->getVertexArray());
+    v->clear();
+    // A little above the base's path, so the ground does not hide it.
+    for (const Vec3& p : trailPoints) v->push_back(toOsg(p) + osg::Vec3(0, 0, 0.05f));
+    v->dirty();
+    static_cast<osg::DrawArrays*>(trail->getPrimitiveSet(0))->setCount(static_cast<GLsizei>(v->size()));
+    trail->dirtyBound();
+    trailDirty = false;
+  }
+  trailNode->setNodeMask(ghostVisible && hasRobot && trailPoints.size() > 1 ? ~0u : 0u);
   if (stale != staleShown) {
     osg::StateSet* st = robotNode->getOrCreateStateSet();
     if (stale) {
@@ -679,6 +712,8 @@ void SceneView::setWorld(const WorldModel& world) {
   m.ghostBase = m.base;
   m.ghostJoints = m.joints;
   m.ghostDirty = true;
+  m.trailPoints.clear();
+  m.trailDirty = true;
   m.laserRanges.clear();
   m.laserDirty = true;
   if (!m.hasRobot) m.centre = {};
@@ -697,6 +732,15 @@ void SceneView::setGhostState(const Pose& base, const std::vector<double>& joint
 }
 
 void SceneView::setGhostVisible(bool visible) { m_->ghostVisible = visible; }
+
+void SceneView::setGhostTrail(const std::vector<Vec3>& points) {
+  m_->trailPoints = points;
+  m_->trailDirty = true;
+}
+
+size_t SceneView::drawnTrailPoints() const {
+  return m_->trailNode->getNodeMask() ? m_->trailPoints.size() : 0;
+}
 bool SceneView::ghostVisible() const { return m_->ghostVisible; }
 
 Pose SceneView::drawnGhostBasePose() const {
@@ -775,6 +819,7 @@ void SceneView::resizeGL(int w, int h) {
 void SceneView::paintGL() {
   Impl& m = *m_;
   if (!isValid() || !m.viewer->isRealized()) return;
+  emit frameStarting();  // sources that change every frame (the ghost) set their state now
   // QOpenGLWidget draws into its own FBO, not 0 (shared/STACK.md).
   m.window->setDefaultFboId(defaultFramebufferObject());
   m.sync();

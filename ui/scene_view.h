@@ -66,6 +66,11 @@ class SceneView : public QOpenGLWidget {
   void setGhostState(const Pose& base, const std::vector<double>& jointPositions);
   void setGhostVisible(bool visible);
   bool ghostVisible() const;
+  /// The ghost's predicted path: a line through `points` (world frame),
+  /// shown while the ghost is.
+  void setGhostTrail(const std::vector<Vec3>& points);
+  /// Points of the trail drawn in the last frame (0 while hidden).
+  size_t drawnTrailPoints() const;
   /// Where the ghost's base link was drawn in the last frame; the identity
   /// while it is hidden.
   Pose drawnGhostBasePose() const;
@@ -117,6 +122,12 @@ class SceneView : public QOpenGLWidget {
   void mouseMoveEvent(QMouseEvent* event) override;
   void mouseReleaseEvent(QMouseEvent* event) override;
   void wheelEvent(QWheelEvent* event) override;
+
+ signals:
+  /// At the start of every frame, before the scene graph is brought up to
+  /// date: a source that changes every frame (the ghost) sets its state in
+  /// a direct connection and is drawn in this very frame.
+  void frameStarting();
 
  private:
   struct Impl;

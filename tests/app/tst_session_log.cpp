@@ -6,8 +6,10 @@
 #include <QElapsedTimer>
 #include <QTemporaryDir>
 #include <QtTest>
+
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "app/headless_runner.h"
 #include "app/session_log.h"
@@ -93,6 +95,12 @@ class TestSessionLog : public QObject {
         log->logHash(world->stepCount(), world->stateHash());
       }
     }
+    // The ghost's predictions come from another thread than the samples'.
+    const std::vector<LogPrediction> predictions = {{1.25, 0.5, {1, 2, 0.3}, {0.6, 0, 0, 0.8}, 0.04, 0.01},
+                                                    {2.5, 1.5, {3, 4, 0.3}, {1, 0, 0, 0}, 0.02, 0.003}};
+    std::thread([&] {
+      for (const LogPrediction& p : predictions) QVERIFY(log->logPrediction(p));
+    }).join();
     log->close();
     QCOMPARE(log->dropped(), int64_t{0});
     QVERIFY(!log->failed());
@@ -113,7 +121,7 @@ class TestSessionLog : public QObject {
 
     const std::vector<std::pair<std::string, int64_t>> expected = {
         {"meta", static_cast<int64_t>(meta.size())}, {"commands", 1}, {"samples", 2000}, {"laser", 40},
-        {"events", 1}, {"snapshots", 3}, {"hashes", 2}};
+        {"events", 1}, {"snapshots", 3}, {"hashes", 2}, {"predictions", 2}};
     QCOMPARE(reader->streams(), expected);
 
     QCOMPARE(reader->commands(), (std::vector<LogCommand>{{0, 0.0, "sequence", toText(drive)}}));
@@ -126,6 +134,8 @@ class TestSessionLog : public QObject {
     QCOMPARE(window.back(), samples[599]);
     QVERIFY(window.back().base[0] > samples.front().base[0]);  // it drove forwards
     QCOMPARE(reader->laserBetween(0, 10), scans);
+    QCOMPARE(reader->predictionsBetween(0, 10), predictions);
+    QCOMPARE(reader->predictionsBetween(2, 3), std::vector<LogPrediction>{predictions[1]});
     QCOMPARE(reader->snapshotSteps(), (std::vector<int64_t>{0, 1000, 2000}));
     QCOMPARE(reader->hashes().front(), (std::pair<int64_t, uint64_t>{1000, hashAt1s}));
 

@@ -146,7 +146,8 @@ void TestMessage::roundTrip_data() {
   limits.upper[0] = std::numeric_limits<double>::infinity();
   QTest::newRow("LIMITS unlimited joint") << Message(limits);
   QTest::newRow("LIMITS without drive") << Message(LimitsMsg{{"arm"}, {0}, {1}, {2}, {3}, 0, 0, ""});
-  QTest::newRow("WELCOME") << Message(WelcomeMsg{"workpartner", 18446744073709551615u, 50});
+  QTest::newRow("WELCOME") << Message(WelcomeMsg{"workpartner", 18446744073709551615u, 50, 0, "", ""});
+  QTest::newRow("WELCOME with files") << Message(WelcomeMsg{"workpartner", 3, 50, 0.5, "0123456789abcdef", "fedcba9876543210"});
   QTest::newRow("LEASE_ACQUIRE") << Message(LeaseAcquireMsg{});
   QTest::newRow("LEASE_KEEPALIVE") << Message(LeaseKeepaliveMsg{});
   QTest::newRow("LEASE_RELEASE") << Message(LeaseReleaseMsg{});
@@ -341,6 +342,10 @@ void TestMessage::decodeErrors_data() {
       "HELLO: key 'name': must not be empty");
   row("zero expiry", 7, "seq=1\nexpires_ms=0\ncommand=stop\n", "COMMAND: key 'expires_ms': must be > 0");
   row("empty command", 7, "seq=1\nexpires_ms=10\ncommand=\n", "COMMAND: key 'command': must not be empty");
+  row("short world hash", 2, "robot=r\nsession=1\ntelemetry_rate=50\nworld_hash=abc\n",
+      "WELCOME: key 'world_hash': expected 16 hex digits, got 3");
+  row("robot hash not hex", 2, "robot=r\nsession=1\ntelemetry_rate=50\nrobot_hash=0123456789abcdeg\n",
+      "WELCOME: key 'robot_hash': expected hex digits only");
   row("zero rate", 2, "robot=r\nsession=1\ntelemetry_rate=0\n",
       "WELCOME: key 'telemetry_rate': must be finite and > 0, got 0");
   row("nan rate", 2, "robot=r\nsession=1\ntelemetry_rate=nan\n",

@@ -367,6 +367,82 @@ class TestConsole : public QObject {
     QVERIFY(robot.waitForFinished(5000));
   }
 
+  // Over a 2 s round trip (the stand-in's link delays every frame 1 s each
+  // way): drive keys move the ghost within a frame or two while the
+  // reported robot stands still for the round trip; the ghost's trail runs
+  // ahead, and the error plot and the status bar get the ghost's error.
+  void ghostLeadsOverADelayedLink() {
+    ConsoleOptions o = options_;
+    o.delay = 1.0;
+    o.overrides = {QStringLiteral("link.deadman=0.5")};
+    o.log = false;
+    MainWindow w(o);
+    QCOMPARE(w.start(), QString());
+    w.resize(1280, 800);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld(), 20000);
+    const Ghost* ghost = w.session()->ghost();
+    QVERIFY(ghost);
+    QTRY_VERIFY_WITH_TIMEOUT(ghost->viewVersion() > 0 && w.telemetryReceived() > 50, 10000);
+    SceneView* scene = w.sceneView();
+    QVERIFY(scene->ghostVisible());
+    QTest::qWait(300);
+    const auto apart = [](const Pose& a, const Pose& b) { return std::hypot(a.p.x - b.p.x, a.p.y - b.p.y); };
+    const Pose ghost0 = scene->drawnGhostBasePose(), robot0 = scene->drawnBasePose();
+    QVERIFY2(apart(ghost0, robot0) < 0.01, qPrintable(QString::number(apart(ghost0, robot0))));  // standing: together
+
+    scene->setFocus();
+    // Each frame after the keys: the commands sent by then, and how many of
+    // them the ghost it drew had had.
+    std::vector<std::pair<uint64_t, uint64_t>> frames;  // (sent, had)
+    const uint64_t before = ghost->commandsSent();
+    const QMetaObject::Connection sampling = connect(scene, &QOpenGLWidget::frameSwapped, this, [&] {
+      frames.emplace_back(ghost->commandsSent(), ghost->view().commands);
+    });
+    for (int i = 0; i < 10; ++i) QTest::keyClick(scene, Qt::Key_Up);  // 10 x 0.05 m/s
+    QTRY_VERIFY_WITH_TIMEOUT(!frames.empty() && frames.back().first > before && frames.size() >= 6, 3000);
+    QTest::qWait(100);
+    disconnect(sampling);
+    // The first frame that began after a command was sent shows it (the
+    // frame a command is sent in began before it): at most one frame late.
+    size_t first = 0;
+    while (frames[first].first == before) ++first;
+    QVERIFY(first + 1 < frames.size());
+    qInfo("a command sent before frame %zu (%llu sent), the ghost drawn then had %llu, the next %llu", first,
+          static_cast<unsigned long long>(frames[first].first), static_cast<unsigned long long>(frames[first].second),
+          static_cast<unsigned long long>(frames[first + 1].second));
+    QVERIFY(frames[first + 1].second >= frames[first].first);
+    // Half a second later the ghost has driven on; the robot, a round trip
+    // away, has not moved yet.
+    QTest::qWait(500);
+    QVERIFY(apart(scene->drawnGhostBasePose(), ghost0) > 0.15);
+    QVERIFY2(apart(scene->drawnBasePose(), robot0) < 0.002, qPrintable(QString::number(apart(scene->drawnBasePose(), robot0))));
+    // The trail: the path ahead of the ghost under the commands sent.
+    QTRY_VERIFY_WITH_TIMEOUT(scene->drawnTrailPoints() > 40, 3000);
+    const GhostView v = ghost->view();
+    const Vec3 end = v.trail.back();
+    QVERIFY2(std::hypot(end.x - v.base.p.x, end.y - v.base.p.y) > 2.0, qPrintable(QString::number(end.x - v.base.p.x)));
+    // Once the robot drives, telemetry meets the ghost's predictions.
+    QTRY_VERIFY_WITH_TIMEOUT(apart(scene->drawnBasePose(), robot0) > 0.3, 5000);
+    PredictionErrorPlot* plot = w.predictionErrorPlot();
+    QTRY_VERIFY_WITH_TIMEOUT(plot->samplesReceived() > 20, 5000);
+    plot->replotNow();
+    QVERIFY(plot->shownPoints() > 20);
+    QTRY_VERIFY_WITH_TIMEOUT(w.ghostStatus().contains(QLatin1String(" cm")), 2000);
+    qInfo("status: %s", qPrintable(w.ghostStatus()));
+    const auto median = ghost->errorMedian();
+    QVERIFY(median);
+    QVERIFY2(median->first < 0.05, qPrintable(QString::number(median->first)));
+
+    // View > Ghost hides it and its trail.
+    w.ghostAction()->setChecked(false);
+    QTest::qWait(100);
+    QVERIFY(!scene->ghostVisible());
+    QCOMPARE(scene->drawnTrailPoints(), size_t{0});
+    QCOMPARE(scene->drawnGhostBasePose(), Pose{});
+  }
+
   // A broken world file is refused with its file:line error; the session
   // (its log, its robot) carries on untouched.
   void badWorldFileLeavesTheSession() {

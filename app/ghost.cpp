@@ -1,0 +1,422 @@
+#include "app/ghost.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "sim/kinematics.h"
+#include "sim/readout.h"
+
+namespace sp {
+
+struct Ghost::Base {
+  Snapshot snapshot;
+  double time = 0;       // robot time of the snapshot
+  uint64_t nextSeq = 0;  // the first command not in it
+  double made = 0;       // robot time of the telemetry it was anchored on
+  bool latched = false;  // that telemetry reported an e-stop or failsafe
+};
+
+struct Ghost::TrailRequest {
+  Snapshot snapshot;
+  double time = 0;
+  uint64_t nextSeq = 0;
+  bool latched = false;
+  bool urgent = false;  // commands changed: the trail running now is wrong
+};
+
+namespace {
+
+constexpr double kOffsetWindow = 2;   // [s] of arrivals the clock offset is the max over
+constexpr double kShownWindow = 20;   // [s] of robot time remembered for comparisons
+constexpr double kErrorWindow = 10;   // [s] of robot time the median is over
+constexpr double kMatchWindow = 0.1;  // [s] a shown state this close in time counts
+constexpr double kTrailPeriod = 0.25; // [s] between trails while nothing changes
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+double Ghost::now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& params, std::string& error) {
+  return create(world, params, Options{}, error);
+}
+
+std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& params, const Options& options,
+                                     std::string& error) {
+  if (world.robots.empty()) {
+    error = "the world has no robot to predict";
+    return nullptr;
+  }
+  SimParams profile = params;
+  profile.step = params.ghostStep;
+  profile.iterations = params.ghostIterations;
+  std::unique_ptr<Ghost> g(new Ghost(profile, options));
+  WorldOptions worldOptions;
+  worldOptions.sensors = false;  // the ghost draws the robot; the laser is the robot's
+  for (std::unique_ptr<World>* w : {&g->anchorWorld_, &g->presentWorld_, &g->trailWorld_}) {
+    Diagnostics diag;
+    *w = World::create(world, profile, diag, worldOptions);
+    if (!*w) {
+      error = "the ghost's world: " + diag.format();
+      return nullptr;
+    }
+  }
+  g->anchorThread_ = std::thread([raw = g.get()] { raw->anchorLoop(); });
+  g->presentThread_ = std::thread([raw = g.get()] { raw->presentLoop(); });
+  g->trailThread_ = std::thread([raw = g.get()] { raw->trailLoop(); });
+  return g;
+}
+
+Ghost::~Ghost() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  anchorWake_.notify_all();
+  presentWake_.notify_all();
+  trailWake_.notify_all();
+  for (std::thread* t : {&anchorThread_, &presentThread_, &trailThread_})
+    if (t->joinable()) t->join();
+}
+
+double Ghost::ghostTimeLocked(double wall) const {
+  return haveClock_ ? wall + offset_ + roundTrip_ : newestTime_;
+}
+
+double Ghost::ghostTime(double wall) const {
+  std::lock_guard lock(mutex_);
+  return ghostTimeLocked(wall);
+}
+
+std::optional<GhostError> Ghost::anchor(const RobotFrame& frame, double roundTrip) {
+  const double wall = now();
+  std::optional<GhostError> error;
+  {
+    std::lock_guard lock(mutex_);
+    if (frame_ && frame.time < newestTime_) {
+      // The robot's clock went back (it was reset): what was shown and
+      // sent belongs to the old run.
+      shown_.clear();
+      errors_.clear();
+      offsets_.clear();
+      commands_.clear();
+      ++epoch_;
+    }
+    offsets_.emplace_back(wall, frame.time - wall);
+    while (offsets_.front().first < wall - kOffsetWindow) offsets_.pop_front();
+    offset_ = offsets_.front().second;
+    for (const auto& [arrival, offset] : offsets_) offset_ = std::max(offset_, offset);
+    roundTrip_ = std::isfinite(roundTrip) && roundTrip > 0 ? roundTrip : 0;
+    haveClock_ = true;
+    newestTime_ = frame.time;
+    // Commands long in effect are in the anchor world's set-points already.
+    while (!commands_.empty() && commands_.front().time < frame.time - kErrorWindow) commands_.pop_front();
+
+    // What was shown for this frame's time, interpolated between the two
+    // shown states around it.
+    const auto after = std::lower_bound(shown_.begin(), shown_.end(), frame.time,
+                                        [](const Shown& s, double t) { return s.time < t; });
+    if (after != shown_.end() && after != shown_.begin() && after->time - frame.time <= kMatchWindow &&
+        frame.time - std::prev(after)->time <= kMatchWindow) {
+      const Shown& a = *std::prev(after);
+      const Shown& b = *after;
+      const double u = b.time > a.time ? (frame.time - a.time) / (b.time - a.time) : 1;
+      GhostError e;
+      e.time = frame.time;
+      e.made = u < 0.5 ? a.made : b.made;
+      e.predicted = u < 0.5 ? a.base : b.base;
+      e.predicted.p = a.base.p + u * (b.base.p - a.base.p);
+      e.position = std::hypot(e.predicted.p.x - frame.base.p.x, e.predicted.p.y - frame.base.p.y);
+      e.heading = std::abs(std::remainder(heading(e.predicted.q) - heading(frame.base.q), 2 * kPi));
+      errors_.push_back(e);
+      while (errors_.front().time < frame.time - kErrorWindow) errors_.pop_front();
+      error = e;
+    }
+    frame_ = frame;
+    ++frameVersion_;
+  }
+  anchorWake_.notify_one();
+  return error;
+}
+
+void Ghost::commandSent(const Command& command) {
+  {
+    std::lock_guard lock(mutex_);
+    commands_.push_back({nextSeq_++, ghostTimeLocked(now()), command});
+  }
+  presentWake_.notify_one();
+}
+
+GhostView Ghost::view() const {
+  std::lock_guard lock(mutex_);
+  return view_;
+}
+
+uint64_t Ghost::commandsSent() const {
+  std::lock_guard lock(mutex_);
+  return nextSeq_;
+}
+
+int64_t Ghost::viewVersion() const {
+  std::lock_guard lock(mutex_);
+  return view_.version;
+}
+
+std::optional<std::pair<double, double>> Ghost::errorMedian() const {
+  std::vector<double> position, heading;
+  {
+    std::lock_guard lock(mutex_);
+    if (errors_.empty()) return std::nullopt;
+    for (const GhostError& e : errors_) {
+      position.push_back(e.position);
+      heading.push_back(e.heading);
+    }
+  }
+  return std::pair{median(std::move(position)), median(std::move(heading))};
+}
+
+GhostStats Ghost::stats() const {
+  std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+std::vector<Ghost::SentCommand> Ghost::commandsFrom(uint64_t from) const {
+  std::vector<SentCommand> out;
+  for (const SentCommand& c : commands_)
+    if (c.seq >= from) out.push_back(c);
+  return out;
+}
+
+void Ghost::setProblem(const std::string& problem) {
+  std::lock_guard lock(mutex_);
+  view_.problem = problem;
+  ++view_.version;
+}
+
+bool Ghost::advance(World& world, double& t, double target, const std::vector<SentCommand>& commands, size_t& next,
+                    const std::function<bool()>& abort) const {
+  const double h = world.params().step;
+  int steps = 0;
+  while (t + 0.5 * h <= target) {
+    // A command acts from the first step boundary at or after its arrival,
+    // as on the robot.
+    while (next < commands.size() && commands[next].time <= t + 1e-9) world.submit(commands[next++].command);
+    if (!world.step()) return false;
+    t += h;
+    if (abort && ++steps % 64 == 0 && abort()) return false;
+  }
+  return true;
+}
+
+void Ghost::anchorLoop() {
+  World& w = *anchorWorld_;
+  const Snapshot initial = w.snapshot();
+  Snapshot anchored = initial;  // the last anchored state, commands in effect included
+  uint64_t seen = 0, applied = 0, epoch = 0;
+  double lastStart = -1e9;
+  for (;;) {
+    RobotFrame frame;
+    std::vector<SentCommand> effective, pending;
+    double target = 0;
+    {
+      std::unique_lock lock(mutex_);
+      anchorWake_.wait(lock, [&] { return stop_ || frameVersion_ != seen; });
+      // At most ghost.anchor_rate re-anchorings a second: the newest frame
+      // when the time comes.
+      anchorWake_.wait_until(lock,
+                             std::chrono::steady_clock::time_point(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                 std::chrono::duration<double>(lastStart + 1 / params_.ghostAnchorRate))),
+                             [&] { return stop_; });
+      if (stop_) return;
+      seen = frameVersion_;
+      frame = *frame_;
+      if (epoch != epoch_) {
+        epoch = epoch_;
+        w.restore(initial);
+        anchored = initial;
+        applied = nextSeq_;
+      }
+      for (SentCommand& c : commandsFrom(applied)) (c.time <= frame.time ? effective : pending).push_back(std::move(c));
+      target = options_.runAhead ? ghostTimeLocked(now()) : frame.time;
+    }
+    lastStart = now();
+    const bool latched = frame.estop || frame.failsafe;
+    if (!effective.empty()) applied = effective.back().seq + 1;
+    if (latched) {
+      // The robot holds still and refuses what it is sent meanwhile.
+      if (!pending.empty()) applied = pending.back().seq + 1;
+      effective.assign(1, SentCommand{0, frame.time, StopCmd{}});
+      pending.clear();
+    }
+    if (!options_.inFlight) pending.clear();
+    for (const SentCommand& c : effective) w.submit(c.command);
+    if (!effective.empty() && !w.step()) {
+      w.restore(anchored);
+      setProblem("the ghost diverged applying the commands in effect: " + w.health().message());
+      continue;
+    }
+    std::vector<std::pair<std::string, Pose>> objects;
+    for (const ObjectReadout& o : frame.objects) objects.emplace_back(o.name, o.pose);
+    const RobotModel& robot = w.robotModel(0);
+    const std::string error = w.setRobotMotion(
+        0,
+        linkMotions(robot, frame.base, frame.hasBaseVelocity ? frame.baseLinearVelocity : Vec3{},
+                    frame.hasBaseVelocity ? frame.baseAngularVelocity : Vec3{}, frame.jointPositions, frame.jointRates),
+        objects);
+    if (!error.empty()) {
+      w.restore(anchored);
+      setProblem("telemetry at " + std::to_string(frame.time) + " s does not fit the robot: " + error);
+      continue;
+    }
+    anchored = w.snapshot();
+    double t = frame.time;
+    size_t next = 0;
+    const bool ok = advance(w, t, target, pending, next);
+    auto base = std::make_shared<Base>();
+    base->time = t;
+    base->nextSeq = next < pending.size() ? pending[next].seq : (pending.empty() ? applied : pending.back().seq + 1);
+    base->made = frame.time;
+    base->latched = latched;
+    if (ok) base->snapshot = w.snapshot();
+    const std::string health = ok ? "" : w.health().message();
+    w.restore(anchored);
+    if (!ok) {
+      setProblem("the ghost diverged predicting from " + std::to_string(frame.time) + " s: " + health);
+      continue;
+    }
+    {
+      std::lock_guard lock(mutex_);
+      if (epoch != epoch_) continue;  // a reset came meanwhile
+      base_ = std::move(base);
+      ++baseVersion_;
+      ++stats_.anchors;
+      stats_.anchorMs = (now() - lastStart) * 1000;
+      stats_.anchorSpan = t - frame.time;
+    }
+    presentWake_.notify_one();
+  }
+}
+
+void Ghost::presentLoop() {
+  World& w = *presentWorld_;
+  std::shared_ptr<const Base> base;
+  uint64_t seenBase = 0, seenCommands = 0, next = 0;
+  double t = 0, lastTrail = -1e9;
+  const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(options_.frameInterval));
+  for (;;) {
+    std::vector<SentCommand> commands;
+    double target = 0;
+    bool newBase = false, newCommands = false;
+    {
+      std::unique_lock lock(mutex_);
+      presentWake_.wait_for(lock, period,
+                            [&] { return stop_ || baseVersion_ != seenBase || nextSeq_ != seenCommands; });
+      if (stop_) return;
+      if (baseVersion_ != seenBase) {
+        seenBase = baseVersion_;
+        base = base_;
+        newBase = true;
+        next = base->nextSeq;
+      }
+      newCommands = nextSeq_ != seenCommands;
+      seenCommands = nextSeq_;
+      if (!base) continue;
+      if (!base->latched && options_.inFlight) commands = commandsFrom(next);
+      target = options_.runAhead ? ghostTimeLocked(now()) : newestTime_;
+    }
+    if (newBase) {
+      w.restore(base->snapshot);
+      t = base->time;
+    }
+    size_t applied = 0;
+    if (!advance(w, t, target, commands, applied)) {
+      const std::string health = w.health().message();
+      w.restore(base->snapshot);
+      t = base->time;
+      next = base->nextSeq;
+      setProblem("the ghost diverged: " + health);
+      continue;
+    }
+    if (applied > 0) next = commands[applied - 1].seq + 1;
+    const RobotReadout r = readRobot(w);
+    const double wall = now();
+    std::shared_ptr<TrailRequest> trail;
+    if (newCommands || wall - lastTrail >= kTrailPeriod) {
+      trail = std::make_shared<TrailRequest>(TrailRequest{w.snapshot(), t, next, base->latched, newCommands});
+      lastTrail = wall;
+    }
+    {
+      std::lock_guard lock(mutex_);
+      GhostView& v = view_;
+      ++v.version;
+      v.time = t;
+      v.span = t - newestTime_;
+      v.base = r.base;
+      v.jointPositions = r.jointPositions;
+      v.objects = r.objects;
+      v.problem.clear();
+      v.commands = next;
+      ++stats_.views;
+      while (!shown_.empty() && shown_.back().time >= t) shown_.pop_back();  // superseded
+      shown_.push_back({t, base->made, r.base});
+      while (shown_.front().time < t - kShownWindow) shown_.pop_front();
+      if (trail) {
+        trailRequest_ = trail;
+        ++trailVersion_;
+      }
+    }
+    if (trail) trailWake_.notify_one();
+  }
+}
+
+void Ghost::trailLoop() {
+  World& w = *trailWorld_;
+  uint64_t seen = 0;
+  for (;;) {
+    std::shared_ptr<const TrailRequest> request;
+    std::vector<SentCommand> commands;
+    {
+      std::unique_lock lock(mutex_);
+      trailWake_.wait(lock, [&] { return stop_ || trailVersion_ != seen; });
+      if (stop_) return;
+      seen = trailVersion_;
+      request = trailRequest_;
+      if (!request->latched && options_.inFlight) commands = commandsFrom(request->nextSeq);
+    }
+    const double start = now();
+    w.restore(request->snapshot);
+    double t = request->time;
+    size_t next = 0;
+    std::vector<Vec3> points{w.linkPose(0, 0).p};
+    // Given up when the commands changed meanwhile; a newer request that
+    // only starts from a fresher state waits for this one to finish.
+    const auto superseded = [&] {
+      std::lock_guard lock(mutex_);
+      return stop_ || (trailVersion_ != seen && trailRequest_->urgent);
+    };
+    const int count = static_cast<int>(std::floor(params_.ghostHorizon / options_.trailSpacing + 1e-9));
+    bool complete = true;
+    for (int k = 1; k <= count && complete; ++k) {
+      complete = advance(w, t, request->time + k * options_.trailSpacing, commands, next, superseded);
+      if (complete) points.push_back(w.linkPose(0, 0).p);
+    }
+    if (!complete && superseded()) continue;
+    std::lock_guard lock(mutex_);
+    view_.trail = std::move(points);  // up to where it diverged, if it did
+    view_.trailTime = request->time;
+    ++view_.version;
+    ++stats_.trails;
+    stats_.trailMs = (now() - start) * 1000;
+  }
+}
+
+}  // namespace sp
