@@ -102,8 +102,8 @@ int main(int argc, char** argv) {
                                                                    {"test track", root + "/terrains/test_track.world.xml"}};
   const std::vector<std::pair<const char*, Command>> motions = {{"straight 0.5 m/s", DriveCmd{0.5, 0}},
                                                                 {"turning 0.5 m/s, 12 deg", DriveCmd{0.5, degToRad(12)}}};
-  const std::vector<Profile> profiles = {{0.001, 50}, {0.002, 50}, {0.002, 20}, {0.003, 20},
-                                         {0.004, 20}, {0.004, 10}, {0.002, 10}};
+  const std::vector<Profile> profiles = {{0.001, 50}, {0.002, 50}, {0.002, 20}, {0.003, 20}, {0.004, 20},
+                                         {0.004, 15}, {0.005, 20}, {0.004, 10}, {0.002, 10}};
   const int rounds = quick ? 1 : 3;
   const double horizon = 5.0;
   std::printf("SimPartner ghost benchmark: %.0f s predictions anchored from the robot's read-out at 2 s; "

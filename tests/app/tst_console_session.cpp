@@ -7,11 +7,15 @@
 #include <QTemporaryDir>
 
 #include <algorithm>
+#include <condition_variable>
 #include <memory>
+#include <mutex>
 
 #include "app/console_session.h"
 #include "app/session_log.h"
+#include "app/session_recorder.h"
 #include "app/stand_in.h"
+#include "net/robot_client.h"
 #include "sim/command_file.h"
 
 using namespace sp;
@@ -147,6 +151,46 @@ class TestConsoleSession : public QObject {
     QVERIFY(!session.remote());
     QVERIFY(session.standIn());
     QVERIFY(session.endpoint().port != 9);
+  }
+
+  // The robot announces the files it runs (WELCOME, over real TCP); the
+  // console's own files match the stand-in's, and a robot on another world
+  // is told apart, naming the file. Not announced: nothing to say.
+  void robotFilesChecked() {
+    ConsoleSession session(options("files"));
+    QCOMPARE(QString::fromStdString(session.start()), QString());
+    std::mutex mutex;
+    std::condition_variable ready;
+    bool welcomed = false;
+    net::RobotClientConfig config;
+    config.host = session.endpoint().host;
+    config.port = session.endpoint().port;
+    config.token = session.endpoint().token;
+    config.name = "files test";
+    net::RobotClientCallbacks callbacks;
+    callbacks.connection = [&](net::ConnectionState state, const std::string&) {
+      std::lock_guard lock(mutex);
+      welcomed = welcomed || state == net::ConnectionState::Ready;
+      ready.notify_all();
+    };
+    net::RobotClient client(config, callbacks);
+    client.start();
+    {
+      std::unique_lock lock(mutex);
+      QVERIFY(ready.wait_for(lock, std::chrono::seconds(10), [&] { return welcomed; }));
+    }
+    const net::RobotClientStats stats = client.stats();
+    client.stop();
+    QCOMPARE(stats.robotWorldHash, fileHash(session.world()->file));
+    QCOMPARE(stats.robotWorldHash.size(), size_t{16});
+    QCOMPARE(stats.robotRobotHash.size(), size_t{16});
+    QCOMPARE(QString::fromStdString(session.filesMismatch(stats.robotWorldHash, stats.robotRobotHash)), QString());
+    QCOMPARE(QString::fromStdString(session.filesMismatch("", "")), QString());
+    const std::string track = fileHash(std::string(SP_SOURCE_DIR) + "/terrains/test_track.world.xml");
+    const QString differs = QString::fromStdString(session.filesMismatch(track, stats.robotRobotHash));
+    QVERIFY2(differs.contains("its world file differs from " + QString::fromStdString(session.world()->file)),
+             qPrintable(differs));
+    QVERIFY(!differs.contains("robot file"));
   }
 
   // Reset restarts the stand-in with the robot at its start; both logs say
