@@ -16,6 +16,7 @@
 #include <memory>
 #include <optional>
 
+#include "app/console_session.h"
 #include "ui/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/live_plots.h"
@@ -183,7 +184,18 @@ int main(int argc, char** argv) {
                 << " fps; 3D view " << window.sceneView()->width() << "x" << window.sceneView()->height()
                 << " in a " << window.width() << "x" << window.height() << " window; real-time factor "
                 << window.realTimeFactor() << "; telemetry frames " << window.telemetryReceived() << ", wheel-force replots "
-                << window.wheelForcePlot()->replots() << ", laser replots " << window.laserPlot()->replots() << std::endl;
+                << window.wheelForcePlot()->replots() << ", laser replots " << window.laserPlot()->replots();
+      if (const sp::Ghost* ghost = window.session()->ghost()) {
+        const sp::GhostView v = ghost->view();
+        const sp::GhostStats g = ghost->stats();
+        std::cout << "; ghost +" << v.span << " s, " << g.anchors << " re-anchorings (last " << g.anchorMs << " ms), "
+                  << g.trails << " trails of " << v.trail.size() << " points (last " << g.trailMs << " ms), drawn "
+                  << window.sceneView()->drawnTrailPoints();
+        if (!v.trail.empty())
+          std::cout << " from " << v.trail.front().x << "," << v.trail.front().y << "," << v.trail.front().z << " to "
+                    << v.trail.back().x << "," << v.trail.back().y << "," << v.trail.back().z;
+      }
+      std::cout << std::endl;
       if (parser.isSet(screenshot)) window.grab().save(parser.value(screenshot));
       window.close();
     });
