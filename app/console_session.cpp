@@ -255,10 +255,12 @@ std::string ConsoleSession::filesMismatch(const std::string& worldHash, const st
   if (!world_ || world_->robots.empty()) return {};
   std::string differs;
   const auto check = [&](const std::string& announced, const std::string& file, const char* what) {
-    if (announced.empty() || announced == fileHash(file)) return;
+    if (announced.empty()) return;
+    const std::string here = fileHash(file);
+    if (announced == here) return;
     if (!differs.empty()) differs += "; ";
     differs += std::string("its ") + what + " file differs from " + file + " (robot " + announced + ", here " +
-               (fileHash(file).empty() ? "unreadable" : fileHash(file)) + ")";
+               (here.empty() ? "unreadable" : here) + ")";
   };
   check(worldHash, world_->file, "world");
   check(robotHash, world_->robots[0].model.file, "robot");

@@ -33,6 +33,11 @@ constexpr double kErrorWindow = 10;   // [s] of robot time the median is over
 constexpr double kMatchWindow = 0.1;  // [s] a shown state this close in time counts
 constexpr double kTrailPeriod = 0.25; // [s] between trails while nothing changes
 
+// Seconds as the steady clock's duration (Ghost::now() counts from its epoch).
+std::chrono::steady_clock::duration steady(double seconds) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
@@ -231,9 +236,7 @@ void Ghost::anchorLoop() {
       anchorWake_.wait(lock, [&] { return stop_ || frameVersion_ != seen; });
       // At most ghost.anchor_rate re-anchorings a second: the newest frame
       // when the time comes.
-      anchorWake_.wait_until(lock,
-                             std::chrono::steady_clock::time_point(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                 std::chrono::duration<double>(lastStart + 1 / params_.ghostAnchorRate))),
+      anchorWake_.wait_until(lock, std::chrono::steady_clock::time_point(steady(lastStart + 1 / params_.ghostAnchorRate)),
                              [&] { return stop_; });
       if (stop_) return;
       seen = frameVersion_;
@@ -310,8 +313,7 @@ void Ghost::presentLoop() {
   std::shared_ptr<const Base> base;
   uint64_t seenBase = 0, seenCommands = 0, next = 0;
   double t = 0, lastTrail = -1e9;
-  const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(options_.frameInterval));
+  const auto period = steady(options_.frameInterval);
   for (;;) {
     std::vector<SentCommand> commands;
     double target = 0;
