@@ -398,7 +398,13 @@ void Ghost::trailLoop() {
     w.restore(request->snapshot);
     double t = request->time;
     size_t next = 0;
-    std::vector<Vec3> points{w.linkPose(0, 0).p};
+    // The base's path on the ground: seen from behind the robot, a line at
+    // base height would run straight away from the eye and shrink to a dot.
+    const auto groundPoint = [&w] {
+      const Vec3 p = w.linkPose(0, 0).p;
+      return Vec3{p.x, p.y, w.terrainHeight(p.x, p.y)};
+    };
+    std::vector<Vec3> points{groundPoint()};
     // Given up when the commands changed meanwhile; a newer request that
     // only starts from a fresher state waits for this one to finish.
     const auto superseded = [&] {
@@ -409,7 +415,7 @@ void Ghost::trailLoop() {
     bool complete = true;
     for (int k = 1; k <= count && complete; ++k) {
       complete = advance(w, t, request->time + k * options_.trailSpacing, commands, next, superseded);
-      if (complete) points.push_back(w.linkPose(0, 0).p);
+      if (complete) points.push_back(groundPoint());
     }
     if (!complete && superseded()) continue;
     std::lock_guard lock(mutex_);

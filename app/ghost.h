@@ -70,7 +70,7 @@ struct GhostView {
   Pose base;                 ///< link 0 in the world
   std::vector<double> jointPositions;  ///< model joint order
   std::vector<ObjectReadout> objects;  ///< dynamic objects
-  std::vector<Vec3> trail;   ///< base positions from `time` on, every 0.1 s, over ghost.horizon
+  std::vector<Vec3> trail;   ///< the base's path on the ground (x, y, terrain height) from `time` on, every 0.1 s, over ghost.horizon
   double trailTime = 0;      ///< [s] robot time the trail starts at
   std::string problem;       ///< "" or why the ghost cannot predict (it diverged, a bad frame)
   uint64_t commands = 0;     ///< of the commands sent (commandsSent()), how many this state has had

@@ -434,7 +434,9 @@ SceneView::Impl::Impl() {
   trail = newGeometry();
   trail->setVertexArray(new osg::Vec3Array);
   auto* trailColor = new osg::Vec4Array;
-  trailColor->push_back({0.30f, 0.80f, 1.00f, 0.85f});  // the ghost's tint
+  // The ghost's hue, but saturated and opaque: a thin line in the ghost's
+  // pale tint vanishes against the sky and light ground.
+  trailColor->push_back({0.05f, 0.45f, 1.00f, 1.0f});
   trail->setColorArray(trailColor, osg::Array::BIND_OVERALL);
   trail->addPrimitiveSet(new osg::DrawArrays(GL_LINE_STRIP, 0, 0));
   trail->setDataVariance(osg::Object::DYNAMIC);
@@ -442,8 +444,7 @@ SceneView::Impl::Impl() {
   {
     osg::StateSet* s = trailNode->getOrCreateStateSet();
     s->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
-    s->setAttributeAndModes(new osg::LineWidth(3.0f));
-    makeTransparent(s);
+    s->setAttributeAndModes(new osg::LineWidth(4.0f));
   }
   trailNode->setNodeMask(0);
   root->addChild(trailNode);
@@ -570,7 +571,8 @@ void SceneView::Impl::sync() {
   if (trailDirty) {
     auto* v = static_cast<osg::Vec3Array*>(trail->getVertexArray());
     v->clear();
-    // A little above the base's path, so the ground does not hide it.
+    // A little above the given points (on the ground), so the ground does
+    // not hide the line.
     for (const Vec3& p : trailPoints) v->push_back(toOsg(p) + osg::Vec3(0, 0, 0.05f));
     v->dirty();
     static_cast<osg::DrawArrays*>(trail->getPrimitiveSet(0))->setCount(static_cast<GLsizei>(v->size()));

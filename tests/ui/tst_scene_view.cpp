@@ -199,6 +199,34 @@ class TstSceneView : public QObject {
     QVERIFY(countDiffering(alone, frame(*view), region) < region.width() * region.height() / 2000);
   }
 
+  // The ghost's trail is a line through its points, drawn while the ghost
+  // is shown: 3 m of path beside the robot change the image, and hiding the
+  // ghost takes the line away.
+  void ghostTrailDrawn() {
+    auto view = shownView(flat_);
+    QVERIFY(view);
+    view->setFollow(false);
+    const sp::RobotModel& robot = flat_.robots[0].model;
+    const sp::Pose base = flat_.robots[0].pose * robot.links[0].pose;
+    view->setRobotState(base, std::vector<double>(robot.joints.size(), 0.0));
+    view->setGhostState(base, std::vector<double>(robot.joints.size(), 0.0));
+    view->setGhostVisible(true);
+    QVERIFY(waitFrames(*view, 2));
+    const QImage without = frame(*view);
+    std::vector<sp::Vec3> trail;
+    for (int k = 0; k <= 30; ++k) trail.push_back({base.p.x + 0.1 * k, base.p.y - 1.0, base.p.z});
+    view->setGhostTrail(trail);
+    QVERIFY(waitFrames(*view, 2));
+    QCOMPARE(view->drawnTrailPoints(), trail.size());
+    const QImage with = frame(*view);
+    QVERIFY(with.save(QStringLiteral(SP_BINARY_DIR "/scene_view_trail.png")));
+    const int changed = countDiffering(without, with, with.rect());
+    QVERIFY2(changed > 300, qPrintable(QString::number(changed)));
+    view->setGhostVisible(false);
+    QVERIFY(waitFrames(*view, 2));
+    QCOMPARE(view->drawnTrailPoints(), size_t{0});
+  }
+
   // Bending joints changes the image too: the links follow linkPoses.
   void jointsMoveLinks() {
     auto view = shownView(flat_);
