@@ -58,6 +58,17 @@ int RobotModel::findActuator(std::string_view jointName) const {
   return -1;
 }
 
+double geomVolume(const GeomSpec& g) {
+  const double r = g.radius;
+  switch (g.type) {
+    case GeomType::Box: return g.size.x * g.size.y * g.size.z;
+    case GeomType::Cylinder: return kPi * r * r * g.length;
+    case GeomType::Capsule: return kPi * r * r * g.length + 4.0 / 3.0 * kPi * r * r * r;
+    case GeomType::Sphere: return 4.0 / 3.0 * kPi * r * r * r;
+  }
+  return 0;
+}
+
 double RobotModel::totalMass() const {
   double sum = 0;
   for (const LinkSpec& link : links) sum += link.mass;

@@ -32,8 +32,15 @@ struct GeomSpec {
   Pose pose;           ///< in the owning link's (or object's) frame
   std::string material;  ///< contact material name, "" = default
   Color color;
+  /// [kg] this geom's own share of its link's mass; < 0 (as loaded): the
+  /// link's mass is spread over its geoms by volume. Set by holdRigid(),
+  /// which gathers geoms of several links onto one.
+  double mass = -1;
   int line = 0;
 };
+
+/// The volume of a geom [m^3] (how a link's mass is spread over its geoms).
+double geomVolume(const GeomSpec& g);
 
 /// A rigid body. `pose` is the link frame in the robot frame with every
 /// joint at zero.

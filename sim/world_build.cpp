@@ -9,30 +9,22 @@ namespace sp {
 using namespace world_detail;
 namespace {
 
-double geomVolume(const GeomSpec& g) {
-  const double r = g.radius;
-  switch (g.type) {
-    case GeomType::Box: return g.size.x * g.size.y * g.size.z;
-    case GeomType::Cylinder: return kPi * r * r * g.length;
-    case GeomType::Capsule: return kPi * r * r * g.length + 4.0 / 3.0 * kPi * r * r * r;
-    case GeomType::Sphere: return 4.0 / 3.0 * kPi * r * r * r;
-  }
-  return 0;
-}
-
 /// Mass properties of `geoms` (in their owner's frame) with `total` mass
-/// spread by volume. A geom-less link gets a 5 cm sphere's inertia.
+/// spread by volume, or with each geom's own mass when every geom has one
+/// (a link holdRigid() merged). A geom-less link gets a 5 cm sphere's inertia.
 dMass massOf(const std::vector<GeomSpec>& geoms, double total) {
   dMass sum;
   dMassSetZero(&sum);
   double volume = 0;
   for (const GeomSpec& g : geoms) volume += geomVolume(g);
-  if (geoms.empty() || volume <= 0) {
+  const bool ownMasses =
+      !geoms.empty() && std::all_of(geoms.begin(), geoms.end(), [](const GeomSpec& g) { return g.mass >= 0; });
+  if (!ownMasses && (geoms.empty() || volume <= 0)) {
     dMassSetSphereTotal(&sum, total, 0.05);
     return sum;
   }
   for (const GeomSpec& g : geoms) {
-    const double m = total * geomVolume(g) / volume;
+    const double m = ownMasses ? g.mass : total * geomVolume(g) / volume;
     dMass part;
     switch (g.type) {
       case GeomType::Box: dMassSetBoxTotal(&part, m, g.size.x, g.size.y, g.size.z); break;

@@ -1,0 +1,53 @@
+#pragma once
+// Holding joints rigid: a robot whose held joints are welded at given
+// positions, each held subtree gathered onto the nearest link above it that
+// still moves (one ODE body instead of many: fewer constraint rows per
+// step). The gathered body keeps the held links' masses, centres and
+// inertias exactly (each geom carries its own share), so the robot's total
+// mass and centre of mass are those of the full robot in that pose.
+//
+// The predictive ghost holds the links the operator is not moving (arms,
+// head, torso) to run ahead faster (docs/performance.md, bench_ghost).
+//
+//   std::string error;
+//   auto rigid = holdRigid(robot, positions, {robot.findJoint("waist_yaw"), ...}, error);
+//   World built from rigid->model; rigid->jointOf maps its joints back.
+
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "sim/robot_model.h"
+
+namespace sp {
+
+struct RigidRobot {
+  RobotModel model;          ///< the robot with the held joints welded
+  std::vector<int> jointOf;  ///< model's joint index -> the full robot's
+  std::vector<int> linkOf;   ///< model's link index -> the full robot's
+  /// The full robot's link -> the model's link it moves with (itself or
+  /// the link it was gathered onto).
+  std::vector<int> ownerOf;
+  /// The full robot's joint positions the held ones are welded at.
+  std::vector<double> heldPositions;
+};
+
+/// `robot` with the joints `held` (indices) welded at `jointPositions`
+/// (one per joint, model order). Every joint below a held one must be held
+/// too, and neither the drive's articulation nor its wheels may be held;
+/// otherwise nullopt and `error` says which joint.
+std::optional<RigidRobot> holdRigid(const RobotModel& robot, std::span<const double> jointPositions,
+                                    const std::vector<int>& held, std::string& error);
+
+/// The full robot's joints from the rigid robot's: held ones at their
+/// welded positions (rates 0 for those when `rates`).
+std::vector<double> fullJoints(const RigidRobot& rigid, std::span<const double> modelJoints, bool rates = false);
+/// The rigid robot's joints taken from the full robot's.
+std::vector<double> rigidJoints(const RigidRobot& rigid, std::span<const double> fullJoints);
+
+/// The joints of `robot` at and below the joint named `name` (its subtree),
+/// in model order; empty if there is no such joint.
+std::vector<int> subtreeJoints(const RobotModel& robot, std::string_view name);
+
+}  // namespace sp
