@@ -10,6 +10,7 @@
 namespace sp {
 
 struct Ghost::Base {
+  std::shared_ptr<const Twin> twin;  // what the snapshot is of
   Snapshot snapshot;
   double time = 0;       // robot time of the snapshot
   uint64_t nextSeq = 0;  // the first command not in it
@@ -18,6 +19,7 @@ struct Ghost::Base {
 };
 
 struct Ghost::TrailRequest {
+  std::shared_ptr<const Twin> twin;
   Snapshot snapshot;
   double time = 0;
   uint64_t nextSeq = 0;
@@ -63,17 +65,21 @@ std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& p
   SimParams profile = params;
   profile.step = params.ghostStep;
   profile.iterations = params.ghostIterations;
-  std::unique_ptr<Ghost> g(new Ghost(profile, options));
-  WorldOptions worldOptions;
-  worldOptions.sensors = false;  // the ghost draws the robot; the laser is the robot's
-  for (std::unique_ptr<World>* w : {&g->anchorWorld_, &g->presentWorld_, &g->trailWorld_}) {
-    Diagnostics diag;
-    *w = World::create(world, profile, diag, worldOptions);
-    if (!*w) {
-      error = "the ghost's world: " + diag.format();
+  std::unique_ptr<Ghost> g(new Ghost(world, profile, options));
+  const RobotModel& robot = world.robots[0].model;
+  for (const std::string& name : splitNames(params.ghostHold)) {
+    const std::vector<int> subtree = subtreeJoints(robot, name);
+    if (subtree.empty()) {
+      error = "ghost.hold: the robot has no joint '" + name + "'";
       return nullptr;
     }
+    g->held_.insert(g->held_.end(), subtree.begin(), subtree.end());
   }
+  // The worlds are built on the first telemetry (the pose to weld at);
+  // what could fail is checked now, in the robot's initial pose.
+  const std::shared_ptr<const Twin> twin = g->makeTwin(std::vector<double>(robot.joints.size(), 0.0), error);
+  if (!twin) return nullptr;
+  if (!g->buildWorld(*twin, &error)) return nullptr;
   g->anchorThread_ = std::thread([raw = g.get()] { raw->anchorLoop(); });
   g->presentThread_ = std::thread([raw = g.get()] { raw->presentLoop(); });
   g->trailThread_ = std::thread([raw = g.get()] { raw->trailLoop(); });
@@ -90,6 +96,39 @@ Ghost::~Ghost() {
   trailWake_.notify_all();
   for (std::thread* t : {&anchorThread_, &presentThread_, &trailThread_})
     if (t->joinable()) t->join();
+}
+
+std::shared_ptr<const Ghost::Twin> Ghost::makeTwin(const std::vector<double>& positions, std::string& error) const {
+  auto twin = std::make_shared<Twin>();
+  twin->world = model_;
+  if (!held_.empty()) {
+    twin->rigid = holdRigid(model_.robots[0].model, positions, held_, error);
+    if (!twin->rigid) {
+      error = "ghost.hold: " + error;
+      return nullptr;
+    }
+    twin->world.robots[0].model = twin->rigid->model;
+    twin->held = held_;
+  }
+  return twin;
+}
+
+std::unique_ptr<World> Ghost::buildWorld(const Twin& twin, std::string* error) const {
+  WorldOptions options;
+  options.sensors = false;  // the ghost draws the robot; the laser is the robot's
+  Diagnostics diag;
+  std::unique_ptr<World> world = World::create(twin.world, params_, diag, options);
+  if (!world && error) *error = "the ghost's world: " + diag.format();
+  return world;
+}
+
+std::vector<double> Ghost::fullPositions(const Twin& twin, const std::vector<double>& joints,
+                                         const std::vector<double>* reported) const {
+  if (!twin.rigid) return joints;
+  std::vector<double> full = fullJoints(*twin.rigid, joints);
+  if (reported && reported->size() == full.size())
+    for (int j : twin.held) full[static_cast<size_t>(j)] = (*reported)[static_cast<size_t>(j)];
+  return full;
 }
 
 double Ghost::ghostTimeLocked(double wall) const {
@@ -222,9 +261,9 @@ bool Ghost::advance(World& world, double& t, double target, const std::vector<Se
 }
 
 void Ghost::anchorLoop() {
-  World& w = *anchorWorld_;
-  const Snapshot initial = w.snapshot();
-  Snapshot anchored = initial;  // the last anchored state, commands in effect included
+  std::shared_ptr<const Twin> twin;
+  std::unique_ptr<World> world;
+  Snapshot anchored;  // the last anchored state, commands in effect included
   uint64_t seen = 0, applied = 0, epoch = 0;
   double lastStart = -1e9;
   for (;;) {
@@ -241,16 +280,26 @@ void Ghost::anchorLoop() {
       if (stop_) return;
       seen = frameVersion_;
       frame = *frame_;
-      if (epoch != epoch_) {
+      if (epoch != epoch_) {  // the robot restarted: weld and build anew
         epoch = epoch_;
-        w.restore(initial);
-        anchored = initial;
+        world.reset();
         applied = nextSeq_;
       }
       for (SentCommand& c : commandsFrom(applied)) (c.time <= frame.time ? effective : pending).push_back(std::move(c));
       target = options_.runAhead ? ghostTimeLocked(now()) : frame.time;
     }
     lastStart = now();
+    if (!world) {
+      std::string error;
+      twin = makeTwin(frame.jointPositions, error);
+      world = twin ? buildWorld(*twin, &error) : nullptr;
+      if (!world) {
+        setProblem(error);
+        continue;
+      }
+      anchored = world->snapshot();
+    }
+    World& w = *world;
     const bool latched = frame.estop || frame.failsafe;
     if (!effective.empty()) applied = effective.back().seq + 1;
     if (latched) {
@@ -268,11 +317,12 @@ void Ghost::anchorLoop() {
     }
     std::vector<std::pair<std::string, Pose>> objects;
     for (const ObjectReadout& o : frame.objects) objects.emplace_back(o.name, o.pose);
-    const RobotModel& robot = w.robotModel(0);
+    const std::vector<double> positions = twin->rigid ? rigidJoints(*twin->rigid, frame.jointPositions) : frame.jointPositions;
+    const std::vector<double> rates = twin->rigid ? rigidJoints(*twin->rigid, frame.jointRates) : frame.jointRates;
     const std::string error = w.setRobotMotion(
         0,
-        linkMotions(robot, frame.base, frame.hasBaseVelocity ? frame.baseLinearVelocity : Vec3{},
-                    frame.hasBaseVelocity ? frame.baseAngularVelocity : Vec3{}, frame.jointPositions, frame.jointRates),
+        linkMotions(w.robotModel(0), frame.base, frame.hasBaseVelocity ? frame.baseLinearVelocity : Vec3{},
+                    frame.hasBaseVelocity ? frame.baseAngularVelocity : Vec3{}, positions, rates),
         objects);
     if (!error.empty()) {
       w.restore(anchored);
@@ -284,6 +334,7 @@ void Ghost::anchorLoop() {
     size_t next = 0;
     const bool ok = advance(w, t, target, pending, next);
     auto base = std::make_shared<Base>();
+    base->twin = twin;
     base->time = t;
     base->nextSeq = next < pending.size() ? pending[next].seq : (pending.empty() ? applied : pending.back().seq + 1);
     base->made = frame.time;
@@ -309,7 +360,8 @@ void Ghost::anchorLoop() {
 }
 
 void Ghost::presentLoop() {
-  World& w = *presentWorld_;
+  std::shared_ptr<const Twin> twin;
+  std::unique_ptr<World> world;
   std::shared_ptr<const Base> base;
   uint64_t seenBase = 0, seenCommands = 0, next = 0;
   double t = 0, lastTrail = -1e9;
@@ -335,10 +387,16 @@ void Ghost::presentLoop() {
       if (!base->latched && options_.inFlight) commands = commandsFrom(next);
       target = options_.runAhead ? ghostTimeLocked(now()) : newestTime_;
     }
+    if (newBase && base->twin != twin) {
+      twin = base->twin;
+      world = buildWorld(*twin);  // the anchor thread built one from it: it builds
+    }
+    if (!world) continue;
     if (newBase) {
-      w.restore(base->snapshot);
+      world->restore(base->snapshot);
       t = base->time;
     }
+    World& w = *world;
     size_t applied = 0;
     if (!advance(w, t, target, commands, applied)) {
       const std::string health = w.health().message();
@@ -353,7 +411,7 @@ void Ghost::presentLoop() {
     const double wall = now();
     std::shared_ptr<TrailRequest> trail;
     if (newCommands || wall - lastTrail >= kTrailPeriod) {
-      trail = std::make_shared<TrailRequest>(TrailRequest{w.snapshot(), t, next, base->latched, newCommands});
+      trail = std::make_shared<TrailRequest>(TrailRequest{twin, w.snapshot(), t, next, base->latched, newCommands});
       lastTrail = wall;
     }
     {
@@ -363,7 +421,7 @@ void Ghost::presentLoop() {
       v.time = t;
       v.span = t - newestTime_;
       v.base = r.base;
-      v.jointPositions = r.jointPositions;
+      v.jointPositions = fullPositions(*twin, r.jointPositions, frame_ ? &frame_->jointPositions : nullptr);
       v.objects = r.objects;
       v.problem.clear();
       v.commands = next;
@@ -381,7 +439,8 @@ void Ghost::presentLoop() {
 }
 
 void Ghost::trailLoop() {
-  World& w = *trailWorld_;
+  std::shared_ptr<const Twin> twin;
+  std::unique_ptr<World> world;
   uint64_t seen = 0;
   for (;;) {
     std::shared_ptr<const TrailRequest> request;
@@ -395,6 +454,12 @@ void Ghost::trailLoop() {
       if (!request->latched && options_.inFlight) commands = commandsFrom(request->nextSeq);
     }
     const double start = now();
+    if (request->twin != twin) {
+      twin = request->twin;
+      world = buildWorld(*twin);
+    }
+    if (!world) continue;
+    World& w = *world;
     w.restore(request->snapshot);
     double t = request->time;
     size_t next = 0;

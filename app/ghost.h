@@ -14,7 +14,10 @@
 // run at real time.
 //
 // Three threads, each owning one World built from the same model with the
-// ghost's profile (ghost.step, ghost.iterations; sensors off):
+// ghost's profile (ghost.step, ghost.iterations; sensors off) and the
+// ghost.hold joints (the upper body) welded at the pose of the first
+// telemetry (sim/rigid.h; their links are drawn as telemetry reports them,
+// and commands to them do not move the ghost):
 //   anchor   on the newest telemetry (at most ghost.anchor_rate per second):
 //            the commands in effect by then, the frame's state through
 //            linkMotions + World::setRobotMotion, then run to ghost(now)
@@ -57,6 +60,7 @@
 #include "app/robot_frame.h"
 #include "sim/command.h"
 #include "sim/params.h"
+#include "sim/rigid.h"
 #include "sim/robot_model.h"
 #include "sim/world.h"
 
@@ -144,8 +148,25 @@ class Ghost {
   };
   struct Base;  // a published anchored state
   struct TrailRequest;
+  /// What the ghost's worlds are built from: the world with its robot's
+  /// ghost.hold joints welded at the pose of the first telemetry (or the
+  /// full robot without any).
+  struct Twin {
+    WorldModel world;
+    std::optional<RigidRobot> rigid;
+    std::vector<int> held;  ///< the full robot's joints welded
+  };
 
-  Ghost(const SimParams& params, const Options& options) : params_(params), options_(options) {}
+  Ghost(const WorldModel& world, const SimParams& params, const Options& options)
+      : model_(world), params_(params), options_(options) {}
+  /// The twin welded at `positions` (the full robot's joints). Null and `error`
+  /// when the hold cannot be made.
+  std::shared_ptr<const Twin> makeTwin(const std::vector<double>& positions, std::string& error) const;
+  std::unique_ptr<World> buildWorld(const Twin& twin, std::string* error = nullptr) const;
+  /// A state of `twin`'s robot as the full robot's joint positions: held
+  /// ones as `reported` has them (the newest telemetry), when it has them.
+  std::vector<double> fullPositions(const Twin& twin, const std::vector<double>& joints,
+                                    const std::vector<double>* reported) const;
   void anchorLoop();
   void presentLoop();
   void trailLoop();
@@ -158,9 +179,10 @@ class Ghost {
   double ghostTimeLocked(double wall) const;
   void setProblem(const std::string& problem);
 
+  WorldModel model_;  // the full world
   SimParams params_;  // the ghost profile
   Options options_;
-  std::unique_ptr<World> anchorWorld_, presentWorld_, trailWorld_;
+  std::vector<int> held_;  // joints the ghost holds rigid (ghost.hold's subtrees)
 
   mutable std::mutex mutex_;  // guards everything below
   std::condition_variable anchorWake_, presentWake_, trailWake_;

@@ -2,6 +2,8 @@
 
 #include "sim/file_set.h"
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <functional>
@@ -137,6 +139,21 @@ Accessors realTimeFactor() {
           [](const SimParams& p) { return p.realTimeFactor > 0 ? shortestText(p.realTimeFactor) : "max"; }};
 }
 
+// Comma-separated joint names, or `none`.
+Accessors jointNames(std::string SimParams::*field) {
+  return {[field](SimParams& p, std::string_view text) -> std::string {
+            if (text != "none")
+              for (const std::string& name : splitNames(text))
+                if (name.empty() || !std::all_of(name.begin(), name.end(), [](char c) {
+                      return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+                    }))
+                  return "expected joint names separated by commas, or 'none', got '" + std::string(text) + "'";
+            p.*field = std::string(text);
+            return {};
+          },
+          [field](const SimParams& p) { return p.*field; }};
+}
+
 Entry entry(const char* key, const char* description, Accessors a) {
   return {key, description, std::move(a.set), std::move(a.get)};
 }
@@ -193,6 +210,8 @@ const std::vector<Entry>& table() {
             real(&SimParams::ghostHorizon, closed(0, 60))),
       entry("ghost.anchor_rate", "ghost: re-anchorings on telemetry per second at most [Hz], [1, 1000]",
             real(&SimParams::ghostAnchorRate, closed(1, 1000))),
+      entry("ghost.hold", "ghost: joints whose subtrees it holds rigid, comma-separated, or none",
+            jointNames(&SimParams::ghostHold)),
       entry("gait.caterpillar.hip_swing", "caterpillar: hip swing about the stance pose [deg], (0, 45]",
             real(&SimParams::caterpillarHipSwing, openClosed(0, 45))),
       entry("gait.caterpillar.phase_time", "caterpillar: duration of each half cycle [s], (0, 60]",
@@ -228,6 +247,18 @@ const Entry* findEntry(std::string_view key) {
 constexpr const char* kCommandLine = "<command line>";
 
 }  // namespace
+
+std::vector<std::string> splitNames(std::string_view text) {
+  std::vector<std::string> out;
+  if (text == "none") return out;
+  size_t start = 0;
+  for (;;) {
+    const size_t comma = text.find(',', start);
+    out.emplace_back(text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    if (comma == std::string_view::npos) return out;
+    start = comma + 1;
+  }
+}
 
 bool setParam(SimParams& params, std::string_view key, std::string_view value, std::string_view where,
               int line, Diagnostics& diag) {

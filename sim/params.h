@@ -46,6 +46,9 @@ struct SimParams {
   int ghostIterations = 20;       ///< ghost: quick solver iterations
   double ghostHorizon = 5;        ///< [s] ghost: how far the trail looks ahead of the ghost
   double ghostAnchorRate = 15;    ///< [Hz] ghost: re-anchorings per second at most
+  /// Ghost: joints whose subtrees it holds rigid (comma-separated names, or
+  /// "none"): fewer bodies, faster predictions (sim/rigid.h).
+  std::string ghostHold = "waist_yaw";
   // Gaits (sim/gait.h); swings in degrees about the stance pose
   double caterpillarHipSwing = 12;   ///< [deg]
   double caterpillarPhaseTime = 1.0; ///< [s] per half cycle
@@ -89,5 +92,7 @@ std::vector<ParamInfo> paramTable();
 
 /// The value of `key` in `params` as text (for logs and `--help`).
 std::string paramValue(const SimParams& params, std::string_view key);
+/// A comma-separated list's items (ghost.hold); none for "none".
+std::vector<std::string> splitNames(std::string_view text);
 
 }  // namespace sp

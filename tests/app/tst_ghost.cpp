@@ -24,6 +24,8 @@
 #include "app/console_session.h"
 #include "app/session_log.h"
 #include "net/robot_client.h"
+#include "sim/model_loader.h"
+#include "sim/readout.h"
 #include "tests/app/shared_state.h"
 
 using namespace sp;
@@ -186,6 +188,70 @@ class TestGhost : public QObject {
     QCOMPARE(r.trail, size_t{51});
     // Re-anchoring kept going (a stall would show as a handful).
     QVERIFY2(rate > 5, qPrintable(QString::number(rate)));
+  }
+
+  // The ghost holds the upper body rigid (ghost.hold) but draws it as the
+  // newest telemetry reports it: an arm bent on the robot is bent on the
+  // ghost, every joint of the full robot is in the view.
+  void heldLinksDrawnAsReported() {
+    Diagnostics diag;
+    const auto world = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
+    QVERIFY2(world, diag.format().c_str());
+    auto robot = World::create(*world, SimParams{}, diag);
+    QVERIFY(robot);
+    const auto frameOf = [](const World& w) {
+      const RobotReadout r = readRobot(w);
+      RobotFrame f;
+      f.time = r.time;
+      f.base = r.base;
+      f.hasBaseVelocity = true;
+      f.baseLinearVelocity = r.baseLinearVelocity;
+      f.baseAngularVelocity = r.baseAngularVelocity;
+      f.jointPositions = r.jointPositions;
+      f.jointRates = r.jointRates;
+      return f;
+    };
+    std::string error;
+    auto ghost = Ghost::create(*world, SimParams{}, error);
+    QVERIFY2(ghost, error.c_str());
+    // Welded at the first frame's pose: the arm straight.
+    QVERIFY(!ghost->anchor(frameOf(*robot), 0.1));  // nothing shown yet to compare with
+    QTRY_VERIFY_WITH_TIMEOUT(ghost->viewVersion() > 0, 5000);
+    const size_t elbow = static_cast<size_t>(world->robots[0].model.findJoint("elbow_l"));
+    QCOMPARE(ghost->view().jointPositions[elbow], 0.0);
+    // The robot bends its elbow; the ghost's drawn elbow follows telemetry.
+    QCOMPARE(robot->submit(JointTargetCmd{"elbow_l", degToRad(40)}), std::string());
+    for (int i = 0; i < 2000; ++i) QVERIFY(robot->step());
+    const RobotFrame bent = frameOf(*robot);
+    QVERIFY(std::abs(bent.jointPositions[elbow]) > degToRad(5));
+    ghost->anchor(bent, 0.1);
+    QTRY_VERIFY_WITH_TIMEOUT(ghost->view().time > bent.time, 5000);
+    const GhostView v = ghost->view();
+    QCOMPARE(v.problem, std::string());
+    QCOMPARE(v.jointPositions.size(), bent.jointPositions.size());
+    QCOMPARE(v.jointPositions[elbow], bent.jointPositions[elbow]);
+  }
+
+  void badHoldRefused_data() {
+    QTest::addColumn<QString>("hold");
+    QTest::addColumn<QString>("error");
+    QTest::newRow("unknown joint") << "waist_yaw,nope" << "ghost.hold: the robot has no joint 'nope'";
+    QTest::newRow("a wheel") << "knee_fl" << "ghost.hold: joint 'wheel_fl' drives the robot and cannot be held";
+  }
+
+  void badHoldRefused() {
+    QFETCH(QString, hold);
+    QFETCH(QString, error);
+    Diagnostics diag;
+    const auto world = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
+    QVERIFY2(world, diag.format().c_str());
+    SimParams params;
+    params.ghostHold = hold.toStdString();
+    std::string why;
+    QVERIFY(!Ghost::create(*world, params, why));
+    QCOMPARE(QString::fromStdString(why), error);
+    params.ghostHold = "none";
+    QVERIFY(Ghost::create(*world, params, why));
   }
 
   // The predictions go into the session's log, as the session saw them.
