@@ -1,5 +1,10 @@
 #include "app/ghost.h"
 
+#include <pthread.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -39,6 +44,13 @@ constexpr double kTrailPeriod = 0.25; // [s] between trails while nothing change
 std::chrono::steady_clock::duration steady(double seconds) {
   return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
 }
+
+// The calling thread yields to the rest of the process: re-anchoring and
+// the trail are best effort, and must not take the cores the robot's twin
+// and the window's frames need (Linux: a thread's nice value is its own).
+void yieldToOthers() { setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10); }
+// Names the calling thread (top -H, gdb): at most 15 characters.
+void nameThread(const char* name) { pthread_setname_np(pthread_self(), name); }
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -261,6 +273,8 @@ bool Ghost::advance(World& world, double& t, double target, const std::vector<Se
 }
 
 void Ghost::anchorLoop() {
+  nameThread("ghost-anchor");
+  yieldToOthers();
   std::shared_ptr<const Twin> twin;
   std::unique_ptr<World> world;
   Snapshot anchored;  // the last anchored state, commands in effect included
@@ -360,6 +374,7 @@ void Ghost::anchorLoop() {
 }
 
 void Ghost::presentLoop() {
+  nameThread("ghost-present");
   std::shared_ptr<const Twin> twin;
   std::unique_ptr<World> world;
   std::shared_ptr<const Base> base;
@@ -439,6 +454,8 @@ void Ghost::presentLoop() {
 }
 
 void Ghost::trailLoop() {
+  nameThread("ghost-trail");
+  yieldToOthers();
   std::shared_ptr<const Twin> twin;
   std::unique_ptr<World> world;
   uint64_t seen = 0;

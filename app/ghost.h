@@ -33,7 +33,8 @@
 //            state when the last is done, at most 4 times a second).
 // A keypress thus reaches the view within a frame however long the round
 // trip, while re-anchoring (which re-runs the whole round trip) goes on
-// beside it.
+// beside it. The anchor and trail threads run at nice 10: best effort,
+// never at the expense of the robot's twin or the window's frames.
 //
 // Error. Each telemetry frame is compared with what the present thread
 // showed for that frame's robot time: horizontal distance and yaw

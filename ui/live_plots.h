@@ -274,6 +274,7 @@ class PredictionErrorPlot : public LivePlot {
 
  public:
   static constexpr double kWindow = 30;  ///< [s] of robot time shown
+  static constexpr double kBin = 0.1;    ///< [s] one point per bin: the bin's largest errors
 
   explicit PredictionErrorPlot(QWidget* parent = nullptr);
   /// One comparison: robot time [s], position error [m], heading error
@@ -283,7 +284,8 @@ class PredictionErrorPlot : public LivePlot {
   void clear();
   /// Samples received (kept or not).
   int64_t samplesReceived() const { return received_; }
-  /// The samples shown after the last replot (position series).
+  /// The points shown after the last replot (position series): one per
+  /// 0.1 s of robot time that had samples.
   int shownPoints() const;
 
  protected:

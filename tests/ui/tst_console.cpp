@@ -426,7 +426,7 @@ class TestConsole : public QObject {
     // Once the robot drives, telemetry meets the ghost's predictions.
     QTRY_VERIFY_WITH_TIMEOUT(apart(scene->drawnBasePose(), robot0) > 0.3, 5000);
     PredictionErrorPlot* plot = w.predictionErrorPlot();
-    QTRY_VERIFY_WITH_TIMEOUT(plot->samplesReceived() > 20, 5000);
+    QTRY_VERIFY_WITH_TIMEOUT(plot->samplesReceived() > 150, 8000);  // 3 s: 30 points of 0.1 s
     plot->replotNow();
     QVERIFY(plot->shownPoints() > 20);
     QTRY_VERIFY_WITH_TIMEOUT(w.ghostStatus().contains(QLatin1String(" cm")), 2000);

@@ -18,6 +18,7 @@
 #include <QSignalSpy>
 #include <QtCharts/QChart>
 #include <QtCharts/QChartView>
+#include <QtCharts/QLineSeries>
 
 #include <array>
 #include <cmath>
@@ -166,6 +167,24 @@ class TestLivePlots : public QObject {
 
   // addSample only stores: nothing is drawn until the timer fires, then the
   // series show every sample of a 5 s run in the default 10 s window.
+  // The ghost's error plot keeps one point per 0.1 s, the bin's worst: 2 s
+  // at 50 Hz is 20 points, and a one-frame spike still shows.
+  void predictionErrorsBinned() {
+    sp::PredictionErrorPlot plot;
+    for (int i = 0; i < 100; ++i) plot.addSample(0.02 * i + 0.001, i == 37 ? 0.25 : 0.01, 0.001);
+    plot.replotNow();
+    QCOMPARE(plot.samplesReceived(), int64_t{100});
+    QCOMPARE(plot.shownPoints(), 20);
+    const auto* series = qobject_cast<QLineSeries*>(plot.chart()->series().at(0));
+    QVERIFY(series);
+    double top = 0;
+    for (const QPointF& p : series->points()) top = std::max(top, p.y());
+    QCOMPARE(top, 25.0);  // [cm]
+    plot.addSample(0.5, 0.01, 0.001);  // the robot restarted: the plot starts over
+    plot.replotNow();
+    QCOMPARE(plot.shownPoints(), 1);
+  }
+
   void addSampleDefersDrawing() {
     auto plot = shownWheelPlot();
     QCOMPARE(plot->replots(), 0);
