@@ -15,6 +15,7 @@
 #include "app/headless_runner.h"
 #include "app/log_export.h"
 #include "app/plot_svg.h"
+#include "app/rehearsal.h"
 #include "app/resimulation.h"
 #include "app/validation.h"
 #include "sim/command_file.h"
@@ -53,6 +54,14 @@ constexpr const char* kUsage = R"(usage:
       latest snapshot at or before S sim seconds (default 0), applies the
       logged commands and compares every logged state hash. Exits 0 when all
       match, 5 at the first divergence (printed), 1 if the log is unusable.
+  simpartner-sim rehearse --world FILE --commands SEQ [options]
+      Rehearses a command sequence on the twin from the world's start, as
+      fast as it goes, checking the flight rules after every step, and prints
+      each rule's verdict (first violation, or closest approach).
+      --rules FILE      flight rules (default: built-in, see config/flight.rules)
+      --params FILE, --set KEY=VALUE   as for run
+      --robust N        also N perturbed rehearsals (ranges robust.* of the rules)
+      Exits 0 when the sequence passed, 6 when a rule failed, 1 on bad input.
   simpartner-sim export LOG --csv DIR
       Writes one CSV per stream of a session log into DIR (samples.csv,
       laser.csv, commands.csv, events.csv), headers naming columns and units.
@@ -229,6 +238,78 @@ int run(const std::vector<std::string>& args) {
   return report->health.healthy() ? 0 : 3;
 }
 
+int rehearseCommand(const std::vector<std::string>& args) {
+  std::string worldFile, commandsFile, rulesFile, paramsFile;
+  std::vector<std::string> overrides;
+  int robust = 0;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a != "--world" && a != "--commands" && a != "--rules" && a != "--params" && a != "--set" && a != "--robust") {
+      std::cerr << "<command line>: error: unknown option '" << a << "'\n" << kUsage;
+      return 2;
+    }
+    if (i + 1 >= args.size()) {
+      std::cerr << "<command line>: error: " << a << " needs a value\n";
+      return 2;
+    }
+    const std::string& v = args[++i];
+    if (a == "--world") worldFile = v;
+    else if (a == "--commands") commandsFile = v;
+    else if (a == "--rules") rulesFile = v;
+    else if (a == "--params") paramsFile = v;
+    else if (a == "--set") overrides.push_back(v);
+    else {
+      char* end = nullptr;
+      const long n = std::strtol(v.c_str(), &end, 10);
+      if (end == v.c_str() || *end != '\0' || n < 1 || n > 100000) {
+        std::cerr << "<command line>: error: --robust: expected a count 1..100000, got '" << v << "'\n";
+        return 2;
+      }
+      robust = static_cast<int>(n);
+    }
+  }
+  if (worldFile.empty() || commandsFile.empty()) {
+    std::cerr << "<command line>: error: rehearse needs --world FILE and --commands FILE\n";
+    return 2;
+  }
+  sp::Diagnostics diag;
+  std::optional<sp::WorldModel> world = sp::loadWorld(worldFile, diag);
+  sp::SimParams params;
+  if (world && world->robots.empty()) diag.error(worldFile, 0, "the world has no robot to rehearse");
+  if (!paramsFile.empty()) sp::loadParams(paramsFile, params, diag);
+  for (const std::string& o : overrides) sp::applyOverride(params, o, diag);
+  sp::FlightRules rules;
+  if (!rulesFile.empty()) sp::loadFlightRules(rulesFile, rules, diag);
+  std::optional<std::vector<sp::TimedCommand>> commands;
+  if (world && !world->robots.empty()) {
+    commands = sp::loadCommandSequence(commandsFile, diag, &world->robots[0].model);
+    if (commands) sp::checkCommands(*commands, world->robots[0].model, commandsFile, diag);
+  }
+  if (diag.hasErrors() || !commands) {
+    std::cerr << diag.format();
+    return 1;
+  }
+  if (robust > 0) rules.robustSamples = robust;
+  const sp::RehearsalPlan plan{*world, params, rules, *commands, std::nullopt};
+  const sp::RehearsalResult r = sp::rehearse(plan);
+  if (!r.error.empty()) {
+    std::cerr << "error: " << r.error << "\n";
+    return 1;
+  }
+  std::cout << "rehearsal of " << commandsFile << " (hash " << sp::sequenceHash(sp::sequenceText(*commands, &world->robots[0].model))
+            << ") on " << worldFile << ": " << r.duration << " s simulated in " << r.wallSeconds << " s\n";
+  for (const sp::RuleVerdict& v : r.verdicts) std::cout << "  " << (v.passed ? "pass  " : "FAIL  ") << v.message() << "\n";
+  std::cout << (r.passed ? "passed" : "failed: " + r.summary()) << "\n";
+  if (robust > 0) {
+    const sp::RobustnessResult rob = sp::robustness(plan, 1, 2);
+    std::cout << "robustness: " << rob.passed << " of " << rob.samples << " passed (" << 100 * rob.probability()
+              << " %), end positions within " << rob.spread << " m of their mean, " << rob.wallSeconds << " s\n";
+    for (int i = 0; i < rob.samples; ++i)
+      if (!rob.samplePassed[i]) std::cout << "  sample " << i << ": " << rob.failures[i] << "\n";
+  }
+  return r.passed ? 0 : 6;
+}
+
 int resim(const std::vector<std::string>& args) {
   std::string log;
   sp::ResimOptions options;
@@ -314,6 +395,7 @@ int main(int argc, char** argv) {
   if (cmd == "params") return printParams();
   if (cmd == "validate") return validate(args, argv[0]);
   if (cmd == "resim") return resim(args);
+  if (cmd == "rehearse") return rehearseCommand(args);
   if (cmd == "export") return exportLog(args);
   std::cerr << "<command line>: error: unknown command '" << cmd << "'\n" << kUsage;
   return 2;

@@ -1,6 +1,7 @@
 #include "sim/params.h"
 
 #include "sim/file_set.h"
+#include "sim/properties.h"
 
 #include <algorithm>
 #include <cctype>
@@ -8,7 +9,6 @@
 #include <cmath>
 #include <functional>
 #include <limits>
-#include <map>
 #include <optional>
 #include <system_error>
 
@@ -287,34 +287,11 @@ bool loadParams(const std::string& path, SimParams& params, Diagnostics& diag) {
 bool parseParams(std::string_view contents, std::string_view path, SimParams& params, Diagnostics& diag) {
   // Applied to a copy, committed only if the whole file is valid.
   SimParams staged = params;
-  std::map<std::string, int, std::less<>> firstLine;
-  bool ok = true;
-  int line = 0;
-  for (size_t pos = 0; pos < contents.size();) {
-    size_t end = contents.find('\n', pos);
-    if (end == std::string_view::npos) end = contents.size();
-    std::string_view text = contents.substr(pos, end - pos);
-    pos = end + 1;
-    ++line;
-    text = trim(text.substr(0, text.find('#')));
-    if (text.empty()) continue;
-    const size_t eq = text.find('=');
-    const std::string_view key = eq == std::string_view::npos ? std::string_view() : trim(text.substr(0, eq));
-    const std::string_view value = eq == std::string_view::npos ? std::string_view() : trim(text.substr(eq + 1));
-    if (key.empty() || value.empty()) {
-      diag.error(path, line, "expected 'key = value'");
-      ok = false;
-      continue;
-    }
-    if (const auto it = firstLine.find(key); it != firstLine.end()) {
-      diag.error(path, line, "duplicate key '" + std::string(key) + "' (first set on line " +
-                                 std::to_string(it->second) + ")");
-      ok = false;
-      continue;
-    }
-    if (findEntry(key)) firstLine.emplace(std::string(key), line);
-    if (!setParam(staged, key, value, path, line, diag)) ok = false;
-  }
+  const bool ok = readProperties(
+      contents, path, diag, [](std::string_view key) { return findEntry(key) != nullptr; },
+      [&](std::string_view key, std::string_view value, int line) {
+        return setParam(staged, key, value, path, line, diag);
+      });
   if (ok) params = staged;
   return ok;
 }

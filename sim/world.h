@@ -102,6 +102,16 @@ struct WorldOptions {
   bool controllers = true;  ///< run actuators, drive kinematics and damping
 };
 
+/// One contact point of the last step that involves a robot's link.
+struct LinkContact {
+  int robot = -1, link = -1;            ///< the robot link touching
+  int otherRobot = -1, otherLink = -1;  ///< when it touches a robot link (its own robot's too)
+  int object = -1;                      ///< when it touches a world object
+  bool terrain = false;                 ///< when it touches the ground
+  Vec3 position;                        ///< [m] world frame
+  double depth = 0;                     ///< [m] penetration
+};
+
 /// The articulated-steering geometry of a robot with a <drive>, measured
 /// from its current pose (legs move, so it changes).
 struct DriveGeometry {
@@ -204,6 +214,9 @@ class World {
   /// Steering geometry now; nullopt if the robot has no <drive>.
   std::optional<DriveGeometry> driveGeometry(int robot) const;
   Pose objectPose(int object) const;
+  /// The contact points of the last step that involve a robot link, in
+  /// the canonical contact order. Built on each call (flight rules read it).
+  std::vector<LinkContact> linkContacts() const;
   /// Number of contact points in the last step.
   int contactCount() const { return lastContactCount_; }
 

@@ -71,4 +71,29 @@ void World::collide() {
   lastContactCount_ = static_cast<int>(m.candidates.size());
 }
 
+std::vector<LinkContact> World::linkContacts() const {
+  std::vector<LinkContact> out;
+  for (const Impl::Candidate& c : impl_->candidates) {
+    const auto* a = static_cast<const GeomInfo*>(dGeomGetData(c.g1));
+    const auto* b = static_cast<const GeomInfo*>(dGeomGetData(c.g2));
+    if (a->robot < 0) std::swap(a, b);  // the robot link first
+    if (a->robot < 0 || a->link < 0) continue;
+    LinkContact k;
+    k.robot = a->robot;
+    k.link = a->link;
+    if (b->robot >= 0) {
+      k.otherRobot = b->robot;
+      k.otherLink = b->link;
+    } else if (b->object >= 0) {
+      k.object = b->object;
+    } else {
+      k.terrain = true;
+    }
+    k.position = {c.geom.pos[0], c.geom.pos[1], c.geom.pos[2]};
+    k.depth = c.geom.depth;
+    out.push_back(k);
+  }
+  return out;
+}
+
 }  // namespace sp

@@ -1,0 +1,139 @@
+// Rehearsal of command sequences on the twin with the flight rules
+// (app/rehearsal.h, sim/flight_rules.h): a typo is caught with its line, a
+// sequence that tips the robot over the test track's bumps fails the
+// stability rule after its cause and before the fall, the same drive without
+// the cause passes, and the rules file reports its errors by line.
+
+#include <QTemporaryDir>
+#include <QtTest>
+
+#include <cmath>
+
+#include "app/rehearsal.h"
+#include "sim/command_file.h"
+#include "sim/model_loader.h"
+#include "tests/test_files.h"
+
+using namespace sp;
+
+namespace {
+
+WorldModel loadOrFail(const char* file) {
+  Diagnostics diag;
+  std::optional<WorldModel> w = loadWorld(file, diag);
+  if (!w) qFatal("%s", diag.format().c_str());
+  return *w;
+}
+
+std::vector<TimedCommand> parseOrFail(const char* text, const RobotModel& robot) {
+  Diagnostics diag;
+  auto c = parseCommandSequence(text, "test.seq", diag, &robot);
+  if (!c) qFatal("%s", diag.format().c_str());
+  return *c;
+}
+
+const RuleVerdict& verdict(const RehearsalResult& r, Rule rule) { return r.verdicts[static_cast<int>(rule)]; }
+
+// Driving over the test track's bumps, then folding the two left legs up
+// to their limits at t = 3 s: the left side loses its wheels.
+constexpr const char* kTip =
+    "0.5 drive 0.4 0\n"
+    "3.0 target knee_fl 80\n"
+    "3.0 target hip_fl 45\n"
+    "3.0 target knee_rl -80\n"
+    "3.0 target hip_rl -45\n";
+constexpr const char* kDrive = "0.5 drive 0.4 0\n";
+
+}  // namespace
+
+class TestRehearsal : public QObject {
+  Q_OBJECT
+
+ private slots:
+  void typoCaughtWithItsLine() {
+    const WorldModel world = loadOrFail("terrains/test_track.world.xml");
+    Diagnostics diag;
+    const auto c = parseCommandSequence("0.5 drive 0.4 0\n1.0 drvie 0.4 0\n2.0 drive 0.4 oops\n", "typo.seq", diag,
+                                        &world.robots[0].model);
+    QVERIFY(!c);
+    QCOMPARE(diag.errorCount(), 2);
+    QVERIFY2(diag.items()[0].line == 2 && diag.items()[0].message.find("drvie") != std::string::npos,
+             diag.format().c_str());
+    QCOMPARE(diag.items()[1].line, 3);
+  }
+
+  // Criterion, stated before the run: the stability rule fails after the
+  // legs start folding (t > 3 s) and before the robot has fallen (its roll
+  // first exceeds 30 deg, read from the same rehearsal's path); the same
+  // drive without the folding (the control) passes every rule.
+  void tippingFailsStabilityBeforeTheFall() {
+    RehearsalPlan plan{loadOrFail("terrains/test_track.world.xml"), {}, {}, {}, {}};
+    plan.commands = parseOrFail(kTip, plan.world.robots[0].model);
+    plan.rules.settle = 5;
+    const RehearsalResult tip = rehearse(plan);
+    QVERIFY2(tip.error.empty(), tip.error.c_str());
+    QVERIFY(!tip.passed);
+    double fell = -1;
+    for (const RehearsalSample& s : tip.path)
+      if (std::abs(s.roll) > degToRad(30)) {
+        fell = s.time;
+        break;
+      }
+    const RuleVerdict& stability = verdict(tip, Rule::Stability);
+    qInfo("tipping: %s; roll beyond 30 deg at %.2f s", stability.message().c_str(), fell);
+    QVERIFY2(fell > 3, "the control of the criterion: the robot must fall");
+    QVERIFY2(!stability.passed, stability.message().c_str());
+    QVERIFY(stability.time > 3.0);
+    QVERIFY(stability.time < fell);
+
+    plan.commands = parseOrFail(kDrive, plan.world.robots[0].model);
+    const RehearsalResult drive = rehearse(plan);
+    for (const RuleVerdict& v : drive.verdicts) qInfo("drive: %s", v.message().c_str());
+    QVERIFY2(drive.passed, drive.summary().c_str());
+    QVERIFY(verdict(drive, Rule::Stability).worst > plan.rules.minStabilityMargin);
+  }
+
+  void rulesFileErrorsNameTheirLines() {
+    FlightRules rules;
+    Diagnostics diag;
+    QVERIFY(!parseFlightRules("# rules\nattitude.max_roll = 20\nattitude.max_rol = 3\nspeed.max = fast\n"
+                              "attitude.max_roll = 21\ncollision.allowed = a b\n",
+                              "my.rules", rules, diag));
+    QCOMPARE(diag.errorCount(), 4);
+    QCOMPARE(diag.items()[0].format(), std::string("my.rules:3: error: unknown key 'attitude.max_rol'"));
+    QCOMPARE(diag.items()[1].line, 4);
+    QVERIFY(diag.items()[2].message.find("duplicate") != std::string::npos);
+    QCOMPARE(diag.items()[3].line, 6);
+    QCOMPARE(rules.maxRoll, FlightRules{}.maxRoll);  // nothing applied
+
+    // The shipped file is the defaults, key for key.
+    FlightRules shipped;
+    shipped.maxRoll = -1;
+    Diagnostics d2;
+    QVERIFY2(loadFlightRules("config/flight.rules", shipped, d2), d2.format().c_str());
+    QCOMPARE(flightRulesText(shipped), flightRulesText(FlightRules{}));
+  }
+
+  void supportMarginIsGeometry() {
+    const std::vector<Vec3> square = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}};
+    QCOMPARE(supportMargin({1, 1, 5}, square), 1.0);
+    QCOMPARE(supportMargin({1, 0.25, 0}, square), 0.25);
+    QCOMPARE(supportMargin({3, 1, 0}, square), -1.0);
+    QCOMPARE(supportMargin({1, 1, 0}, {{0, 0, 0}, {2, 2, 0}}), -0.0);  // on a diagonal pair's line
+    QCOMPARE(supportMargin({1, 0, 0}, {{0, 0, 0}, {2, 2, 0}}), -std::sqrt(0.5));
+  }
+
+  void sequenceHashNamesTheText() {
+    const WorldModel world = loadOrFail("terrains/flat.world.xml");
+    const RobotModel& robot = world.robots[0].model;
+    const auto a = parseOrFail("1 drive 0.5 10\n2.5 stop\n", robot);
+    const auto b = parseOrFail("1.0   drive 0.50 10.0   # same\n2.5 stop\n", robot);
+    const auto c = parseOrFail("1 drive 0.5 11\n2.5 stop\n", robot);
+    QCOMPARE(sequenceText(a, &robot), std::string("1 drive 0.5 10\n2.5 stop\n"));
+    QCOMPARE(sequenceHash(sequenceText(a, &robot)), sequenceHash(sequenceText(b, &robot)));
+    QVERIFY(sequenceHash(sequenceText(a, &robot)) != sequenceHash(sequenceText(c, &robot)));
+  }
+};
+
+QTEST_GUILESS_MAIN(TestRehearsal)
+#include "tst_rehearsal.moc"
