@@ -285,6 +285,11 @@ void ConsoleSession::note(const std::string& text) {
   if (recorder_) recorder_->event("note", text);
 }
 
+void ConsoleSession::logEvent(const std::string& kind, const std::string& text) {
+  if (standIn_) standIn_->logEvent(kind, text);
+  if (recorder_) recorder_->event(kind, text);
+}
+
 void ConsoleSession::event(const std::string& kind, const std::string& text) {
   if (recorder_) recorder_->event(kind, text);
 }

@@ -142,6 +142,9 @@ class ConsoleSession {
   void commandSent(const Command& command);
   /// An operator note into the session log.
   void note(const std::string& text);
+  /// Something the console did or decided (kind "rehearsal", "relay",
+  /// "guard"), into the session log whichever robot it is.
+  void logEvent(const std::string& kind, const std::string& text);
   /// A link event the console saw ("link", "estop", ...): logged when remote
   /// (the stand-in logs its own link events).
   void event(const std::string& kind, const std::string& text);

@@ -151,6 +151,7 @@ std::string StandInRobot::logError() const { return host_->log() ? host_->log()-
 int64_t StandInRobot::logDropped() const { return host_->log() ? host_->log()->dropped() : 0; }
 
 void StandInRobot::addNote(std::string text) { host_->logEvent("note", std::move(text)); }
+void StandInRobot::logEvent(std::string kind, std::string text) { host_->logEvent(std::move(kind), std::move(text)); }
 
 void StandInRobot::logPrediction(const LogPrediction& prediction) { host_->logPrediction(prediction); }
 

@@ -119,6 +119,8 @@ class StandInRobot {
   /// Writes an operator note (event kind "note") into the log at the twin's
   /// current step; dropped without a log. Never blocks on the disk.
   void addNote(std::string text);
+  /// Writes an event of `kind` (rehearsal, sequence, guard, ...) the same way.
+  void logEvent(std::string kind, std::string text);
   /// Logs a prediction of the console's ghost; dropped without a log.
   void logPrediction(const LogPrediction& prediction);
 

@@ -74,7 +74,92 @@ void TwinHost::apply(const std::vector<Command>& commands) {
 
 net::RobotState TwinHost::state() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return state_;
+  net::RobotState s = state_;
+  s.sequence = sequence_;
+  return s;
+}
+
+std::string TwinHost::startSequence(const net::SequenceRun& run) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  char buf[200];
+  if (acceptedRun_ || sequence_.state == net::SequenceStateKind::Running)
+    return "sequence " + sequence_.hash + " is running: abort it first";
+  const double speed = std::hypot(state_.baseLinearVelocity.x, state_.baseLinearVelocity.y);
+  if (speed > kStillSpeed) {
+    std::snprintf(buf, sizeof buf, "the robot is moving (%.2f m/s): stop it before a sequence", speed);
+    return buf;
+  }
+  const double off = std::hypot(state_.pose.p.x - run.start.p.x, state_.pose.p.y - run.start.p.y);
+  const double turn = std::abs(std::remainder(heading(state_.pose.q) - heading(run.start.q), 2 * kPi));
+  if (off > run.startPosition) {
+    std::snprintf(buf, sizeof buf, "stale rehearsal: the robot is %.3f m from its start (tolerance %.3f m)", off,
+                  run.startPosition);
+    return buf;
+  }
+  if (turn > run.startHeading) {
+    std::snprintf(buf, sizeof buf, "stale rehearsal: the robot's heading is %.1f deg from its start (tolerance %.1f deg)",
+                  radToDeg(turn), radToDeg(run.startHeading));
+    return buf;
+  }
+  acceptedRun_ = run;
+  sequence_ = {run.hash, net::SequenceStateKind::Accepted, 0, run.commands.size(), 0, ""};
+  return {};
+}
+
+void TwinHost::abortSequence(const std::string& reason) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  aborts_.push_back(reason);
+}
+
+void TwinHost::logSequenceEvent(const std::string& text) {
+  if (log_) log_->writer().logEvent(world_->stepCount(), world_->time(), "sequence", text);
+}
+
+void TwinHost::takeSequence() {
+  std::optional<net::SequenceRun> run;
+  std::vector<std::string> aborts;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    run.swap(acceptedRun_);
+    aborts.swap(aborts_);
+  }
+  const double now = world_->time();
+  if (run) {
+    // t = 0 is this boundary: the robot's own clock from here on.
+    for (const TimedCommand& c : run->commands) runner_->schedule(ScheduledCommand{c.command, now + c.time, -1, 0, c.line});
+    sequenceActive_ = true;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      sequence_.state = net::SequenceStateKind::Running;
+      sequence_.startTime = now;
+    }
+    logSequenceEvent("started " + run->hash + " (" + std::to_string(run->commands.size()) + " commands)");
+  }
+  if (!aborts.empty() && sequenceActive_) abortRunning(aborts.front());
+}
+
+void TwinHost::abortRunning(const std::string& reason) {
+  runner_->dropPending();
+  sequenceActive_ = false;
+  std::string hash;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    sequence_.state = net::SequenceStateKind::Aborted;
+    sequence_.reason = reason;
+    hash = sequence_.hash;
+  }
+  logSequenceEvent("aborted " + hash + ": " + reason);
+}
+
+void TwinHost::sequenceCommand(const ScheduledCommand& command, const std::string& refusal) {
+  World& w = *world_;
+  if (refusal.empty() && log_) log_->writer().logCommand(w.stepCount(), w.time(), "sequence", command.command, &model_);
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++sequence_.index;
+  if (sequence_.index < sequence_.count) return;
+  sequence_.state = net::SequenceStateKind::Done;
+  sequenceActive_ = false;
+  if (log_) log_->writer().logEvent(w.stepCount(), w.time(), "sequence", "done " + sequence_.hash);
 }
 
 std::optional<net::LaserScanState> TwinHost::laserAfter(uint64_t afterCount) const {
@@ -133,6 +218,11 @@ void TwinHost::takeCommands() {
     commands.swap(pending_);
   }
   World& w = *world_;
+  if (!commands.empty() && sequenceActive_) {
+    // The operator took over: the rest of the sequence must not follow.
+    // (An ABORT or a stop of the link's came through takeSequence() first.)
+    abortRunning("an operator command took over");
+  }
   for (const Command& c : commands) {
     // Checked by the server already; a command the World still refuses was
     // not applied, so it is not logged either.
@@ -145,8 +235,11 @@ void TwinHost::run() {
   pacer.start(monotonic());
   const int64_t publishEvery = std::max<int64_t>(1, std::llround(0.01 / world_->params().step));  // 100 Hz
   if (log_) log_->start(*world_);
-  // Commands reach the World from takeCommands(), not from a schedule.
+  // Operator commands reach the World from takeCommands(); only a sequence's
+  // are scheduled, at their times on the twin's clock.
   Runner runner(*world_);
+  runner_ = &runner;
+  runner.setSubmitHook([this](const ScheduledCommand& c, const std::string& why) { sequenceCommand(c, why); });
   runner.setMonitor([&](const World& w) {
     if (log_) log_->stepped(w);
     if (w.stepCount() % publishEvery == 0) publish();
@@ -156,7 +249,10 @@ void TwinHost::run() {
     const int64_t due = pacer.stepsDue(monotonic());
     // Commands only when a step follows: none is left pending in the last
     // snapshot when the loop stops.
-    if (due > 0) takeCommands();
+    if (due > 0) {
+      takeSequence();
+      takeCommands();
+    }
     runner.advanceBy(due);  // a diverged twin stops there and says so in state().health
     logHealth();
     pacer.stepped(due);
@@ -179,6 +275,7 @@ void TwinHost::run() {
     queued = !pending_.empty();
   }
   if (queued) {
+    takeSequence();
     takeCommands();
     runner.advanceBy(1);
     logHealth();

@@ -13,12 +13,14 @@
 #include <atomic>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "app/session_recorder.h"
 #include "net/robot_server.h"
+#include "sim/runner.h"
 #include "sim/world.h"
 
 namespace sp {
@@ -63,6 +65,14 @@ class TwinHost : public net::RobotPort {
   void apply(const std::vector<Command>& commands) override;
   net::RobotState state() const override;
   std::optional<net::LaserScanState> laserAfter(uint64_t afterCount) const override;
+  /// Runs a sequence on board against the twin's clock: refused while one
+  /// runs, while the robot moves (> kStillSpeed) or when its base is beyond
+  /// the run's tolerances from the rehearsal's start (a stale rehearsal).
+  /// Its commands are logged with source "sequence"; an operator's command
+  /// arriving while it runs aborts it (the operator took over).
+  std::string startSequence(const net::SequenceRun& run) override;
+  void abortSequence(const std::string& reason) override;
+  static constexpr double kStillSpeed = 0.05;  ///< [m/s] base speed a sequence may start at
 
  private:
   struct PendingEvent {
@@ -78,6 +88,14 @@ class TwinHost : public net::RobotPort {
   void takeCommands();
   // The "health" event, once, when the World has diverged. Physics thread.
   void logHealth();
+  // Starts an accepted sequence, then aborts it for the queued reasons.
+  // Physics thread, before takeCommands().
+  void takeSequence();
+  // Drops the running sequence's remaining commands. Physics thread.
+  void abortRunning(const std::string& reason);
+  // A scheduled sequence command went to the World. Physics thread.
+  void sequenceCommand(const ScheduledCommand& command, const std::string& refusal);
+  void logSequenceEvent(const std::string& text);
 
   std::unique_ptr<World> world_;
   const RobotModel model_;  // a copy: read by the server thread
@@ -88,11 +106,16 @@ class TwinHost : public net::RobotPort {
   bool started_ = false;
   std::thread thread_;
   std::atomic<bool> stop_{false};
-  mutable std::mutex mutex_;  // guards the four below
+  bool sequenceActive_ = false;  // physics thread: its commands are in the runner's schedule
+  Runner* runner_ = nullptr;     // physics thread: run()'s step loop
+  mutable std::mutex mutex_;  // guards the seven below
   std::vector<Command> pending_;
   std::vector<PendingEvent> events_;
   net::RobotState state_;
   net::LaserScanState laser_;
+  std::optional<net::SequenceRun> acceptedRun_;  // to start at the next pass
+  std::vector<std::string> aborts_;
+  net::SequenceStatus sequence_;
 };
 
 }  // namespace sp

@@ -1,6 +1,7 @@
 #include "net/message.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 
 #include "sim/command_check.h"
 #include "sim/command_file.h"
+#include "sim/hash.h"
 #include "sim/robot_model.h"
 
 namespace sp::net {
@@ -26,11 +28,12 @@ constexpr const char* kTypeNames[] = {
     "HELLO",     "WELCOME", "LEASE_ACQUIRE", "LEASE_KEEPALIVE", "LEASE_RELEASE",
     "LEASE_STATE", "COMMAND", "REPLY",       "TELEMETRY",       "LASER",
     "HEARTBEAT", "ESTOP",   "REARM",         "EVENT",           "ERROR",
-    "CHALLENGE", "LIMITS"};
+    "CHALLENGE", "LIMITS",  "SEQUENCE",      "SEQUENCE_STATE",  "ABORT"};
 constexpr const char* kRoleNames[] = {"control", "monitor"};
 constexpr const char* kStatusNames[] = {"ok",   "invalid", "out_of_limits", "not_owner",
                                         "busy", "failed",  "expired",       "duplicate"};
 constexpr const char* kEventNames[] = {"failsafe", "divergence", "estop", "rearmed", "link"};
+constexpr const char* kSequenceStateNames[] = {"accepted", "refused", "running", "done", "aborted"};
 static_assert(std::size(kTypeNames) == kLastMessageType);
 
 template <class E, size_t N>
@@ -227,6 +230,22 @@ void forEachField(M& m, F& f) {
     f("drive_speed", m.driveSpeed, Need::Optional);
     f("wheel_speed", m.wheelSpeed, Need::Optional);
     f("articulation", m.articulation, Need::Optional);
+  } else if constexpr (std::is_same_v<T, SequenceMsg>) {
+    f("hash", m.hash, R);
+    f("commands", m.commands, R);
+    f("start", m.start, R);
+    f("start_position", m.startPosition, R);
+    f("start_heading", m.startHeading, R);
+  } else if constexpr (std::is_same_v<T, SequenceStateMsg>) {
+    f("hash", m.hash, R);
+    f("state", m.state, R);
+    f("index", m.index, Need::Optional);
+    f("count", m.count, Need::Optional);
+    f("start_time", m.startTime, Need::Optional);
+    f("reason", m.reason, Need::Optional);
+  } else if constexpr (std::is_same_v<T, AbortMsg>) {
+    f("hash", m.hash, R);
+    f("reason", m.reason, Need::Optional);
   } else {
     // LEASE_ACQUIRE, LEASE_KEEPALIVE, LEASE_RELEASE, REARM: no keys.
     static_assert(std::is_empty_v<T>);
@@ -310,6 +329,20 @@ struct Validator {
     }
     return {};
   }
+  std::string operator()(const SequenceMsg& m) const {
+    if (std::string e = sequenceHashRule(m.hash); !e.empty()) return e;
+    if (m.commands.empty()) return "key 'commands': must not be empty";
+    if (!(std::isfinite(m.startPosition) && m.startPosition > 0)) return "key 'start_position': must be finite and > 0";
+    if (!(std::isfinite(m.startHeading) && m.startHeading > 0)) return "key 'start_heading': must be finite and > 0";
+    return {};
+  }
+  std::string operator()(const SequenceStateMsg& m) const { return m.hash.empty() ? "key 'hash': must not be empty" : ""; }
+  std::string operator()(const AbortMsg& m) const { return sequenceHashRule(m.hash); }
+  static std::string sequenceHashRule(const std::string& hash) {
+    if (std::string e = hexDigits("hash", hash, 16, "16 hex digits"); !e.empty()) return e;
+    if (hash.size() != 16) return "key 'hash': expected 16 hex digits, got " + std::to_string(hash.size());
+    return {};
+  }
   std::string operator()(const LaserMsg& m) const {
     if (!std::isfinite(m.angleMin)) return "key 'angle_min': must be finite";
     if (!std::isfinite(m.angleStep)) return "key 'angle_step': must be finite";
@@ -364,6 +397,9 @@ struct Encoder {
   }
   void operator()(const char* key, EventKind v, Need) {
     line(key, [&] { name(key, static_cast<size_t>(v), kEventNames); });
+  }
+  void operator()(const char* key, SequenceStateKind v, Need) {
+    line(key, [&] { name(key, static_cast<size_t>(v), kSequenceStateNames); });
   }
   void operator()(const char* key, const Pose& v, Need) {
     const double xs[7] = {v.p.x, v.p.y, v.p.z, v.q.w, v.q.x, v.q.y, v.q.z};
@@ -467,6 +503,7 @@ struct Decoder {
   static std::string parse(std::string_view s, Role& v) { return parseName(s, v, kRoleNames); }
   static std::string parse(std::string_view s, ReplyStatus& v) { return parseName(s, v, kStatusNames); }
   static std::string parse(std::string_view s, EventKind& v) { return parseName(s, v, kEventNames); }
+  static std::string parse(std::string_view s, SequenceStateKind& v) { return parseName(s, v, kSequenceStateNames); }
 
   static std::string parse(std::string_view s, std::vector<double>& v) {
     const std::vector<std::string_view> items = splitSpaces(s);
@@ -567,6 +604,7 @@ const char* messageTypeName(uint8_t type) {
 const char* toString(Role role) { return enumName(role, kRoleNames); }
 const char* toString(ReplyStatus status) { return enumName(status, kStatusNames); }
 const char* toString(EventKind kind) { return enumName(kind, kEventNames); }
+const char* toString(SequenceStateKind state) { return enumName(state, kSequenceStateNames); }
 
 MessageType typeOf(const Message& message) {
   return static_cast<MessageType>(message.index() + kFirstMessageType);
@@ -715,6 +753,35 @@ LimitsMsg limitsOf(const RobotModel& robot) {
 
 CommandMsg makeCommandMsg(uint64_t seq, uint64_t expiresMs, const Command& command, const RobotModel* robot) {
   return CommandMsg{seq, expiresMs, toText(command, robot)};
+}
+
+std::optional<std::vector<TimedCommand>> parseSequenceMsg(const SequenceMsg& message, const RobotModel* robot,
+                                                          std::string& error) {
+  std::string text;
+  for (size_t start = 0; start <= message.commands.size();) {
+    const size_t end = std::min(message.commands.find(';', start), message.commands.size());
+    text.append(message.commands, start, end - start);
+    text += '\n';
+    start = end + 1;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(fnv1a64(text)));
+  std::string lower = message.hash;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](char c) { return static_cast<char>(std::tolower(c)); });
+  if (lower != hex) {
+    error = "SEQUENCE: key 'hash': " + quote(message.hash) + " is not the hash of the commands (" + hex + ")";
+    return std::nullopt;
+  }
+  Diagnostics diag;
+  std::optional<std::vector<TimedCommand>> commands = parseCommandSequence(text, "SEQUENCE", diag, robot);
+  if (!commands) {
+    const Diagnostic& d = diag.items().front();
+    error = "SEQUENCE: key 'commands': command " + std::to_string(d.line) + ": " + d.message;
+  } else if (commands->empty()) {
+    error = "SEQUENCE: key 'commands': no command";
+    commands.reset();
+  }
+  return commands;
 }
 
 std::optional<Command> parseCommandMsg(const CommandMsg& message, const RobotModel* robot, std::string& error) {

@@ -54,9 +54,12 @@ enum class MessageType : uint8_t {
   Error = 15,          ///< C and R: a message was refused
   Challenge = 16,      ///< R: first message on a connection: the nonce HELLO's proof covers
   Limits = 17,         ///< R: after WELCOME: the robot's joint and drive limits
+  Sequence = 18,       ///< C: a rehearsed command sequence for the robot to run on board
+  SequenceState = 19,  ///< R: a sequence accepted, refused, running (progress), done or aborted
+  Abort = 20,          ///< C: stop the running sequence; the robot stops
 };
 inline constexpr uint8_t kFirstMessageType = 1;
-inline constexpr uint8_t kLastMessageType = 17;
+inline constexpr uint8_t kLastMessageType = 20;
 
 /// "HELLO", "LEASE_ACQUIRE", ... as in docs/protocol.md.
 const char* toString(MessageType type);
@@ -69,7 +72,10 @@ enum class Role { Control, Monitor };
 enum class ReplyStatus { Ok, Invalid, OutOfLimits, NotOwner, Busy, Failed, Expired, Duplicate };
 /// EVENT kind.
 enum class EventKind { Failsafe, Divergence, Estop, Rearmed, Link };
+/// SEQUENCE_STATE state.
+enum class SequenceStateKind { Accepted, Refused, Running, Done, Aborted };
 const char* toString(Role role);                  ///< "control", "monitor"
+const char* toString(SequenceStateKind state);    ///< "accepted", "refused", ...
 const char* toString(ReplyStatus status);         ///< "ok", "out_of_limits", ...
 const char* toString(EventKind kind);             ///< "failsafe", ...
 
@@ -225,11 +231,45 @@ struct LimitsMsg {
   friend bool operator==(const LimitsMsg&, const LimitsMsg&) = default;
 };
 
+/// SEQUENCE: keys `hash`, `commands`, `start`, `start_position`, `start_heading`.
+/// A sequence that passed its rehearsal, sent whole. The robot checks the
+/// hash against the commands, every command against its limits, and its own
+/// state against the rehearsal's start; then runs the commands against its
+/// own clock (t = 0 at its next step) and reports SEQUENCE_STATE.
+struct SequenceMsg {
+  std::string hash;      ///< FNV-1a 64 of the canonical text (commands joined by line feeds, each line ended by one), 16 hex digits
+  /// The canonical lines `TIME COMMAND` (sequence-file syntax, times from
+  /// the start [s]), joined by `;` (a command never holds one).
+  std::string commands;
+  Pose start;                ///< the base pose the rehearsal started from
+  double startPosition = 0;  ///< [m] how far the robot's base may be from `start`, > 0
+  double startHeading = 0;   ///< [rad] how far its heading may be, > 0
+  friend bool operator==(const SequenceMsg&, const SequenceMsg&) = default;
+};
+/// SEQUENCE_STATE: keys `hash`, `state`, `index` (optional), `count`
+/// (optional), `start_time` (optional), `reason` (optional).
+struct SequenceStateMsg {
+  std::string hash;  ///< the SEQUENCE's (as received, when it is refused for a bad one)
+  SequenceStateKind state = SequenceStateKind::Accepted;
+  uint64_t index = 0;     ///< commands applied so far
+  uint64_t count = 0;     ///< commands in the sequence
+  double startTime = 0;   ///< [s] robot time of the sequence's t = 0 (running, done, aborted)
+  std::string reason;     ///< refused, aborted: why
+  friend bool operator==(const SequenceStateMsg&, const SequenceStateMsg&) = default;
+};
+/// ABORT: keys `hash`, `reason` (optional). From any controlling client.
+struct AbortMsg {
+  std::string hash;  ///< the sequence to abort
+  std::string reason;
+  friend bool operator==(const AbortMsg&, const AbortMsg&) = default;
+};
+
 /// Any message. The alternatives are in type-code order: index() + 1 is the
 /// MessageType.
 using Message = std::variant<HelloMsg, WelcomeMsg, LeaseAcquireMsg, LeaseKeepaliveMsg, LeaseReleaseMsg,
                              LeaseStateMsg, CommandMsg, ReplyMsg, TelemetryMsg, LaserMsg, HeartbeatMsg,
-                             EstopMsg, RearmMsg, EventMsg, ErrorMsg, ChallengeMsg, LimitsMsg>;
+                             EstopMsg, RearmMsg, EventMsg, ErrorMsg, ChallengeMsg, LimitsMsg, SequenceMsg,
+                             SequenceStateMsg, AbortMsg>;
 
 MessageType typeOf(const Message& message);
 
@@ -279,6 +319,13 @@ class LaserFanOut {
 /// `unknown message type 200`. Values are quoted at most 40 bytes long with
 /// control characters escaped; a bad token is never echoed.
 std::optional<Message> decodeMessage(const Frame& frame, std::string& error);
+
+/// The commands of a SEQUENCE, parsed against `robot` (may be null) and
+/// with their times; nullopt and `error` naming the command (`SEQUENCE: key
+/// 'commands': command 3: ...`) when one does not parse, the times are
+/// unsorted, or the hash does not match the text.
+std::optional<std::vector<TimedCommand>> parseSequenceMsg(const SequenceMsg& message, const RobotModel* robot,
+                                                          std::string& error);
 
 /// The limits `robot` enforces on commands (sp::checkCommand), for LIMITS.
 LimitsMsg limitsOf(const RobotModel& robot);

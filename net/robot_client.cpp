@@ -137,6 +137,11 @@ class RobotClient::Impl {
     notice("client: ESTOP not sent yet: not connected; it goes out when the robot welcomes the next connection");
   }
 
+  void doSend(const Message& message, const char* what) {
+    if (ready_) send(message);
+    else notice(std::string("client: ") + what + " not sent: not connected");
+  }
+
   void doRearm() {
     if (ready_) send(RearmMsg{});
     else notice("client: REARM not sent: not connected");
@@ -441,6 +446,10 @@ class RobotClient::Impl {
     send(HelloMsg{config_.name, {}, config_.role, helloProof(config_.token, m.nonce, config_.name, config_.role)});
   }
 
+  void handle(const SequenceStateMsg& m) {
+    if (cb_.sequence) cb_.sequence(m);
+  }
+
   void handle(const LimitsMsg& m) {
     {
       std::lock_guard lock(statsMutex_);
@@ -654,6 +663,12 @@ uint64_t RobotClient::sendCommandText(std::string text, uint64_t expiresMs) {
 
 void RobotClient::estop(std::string reason) {
   impl_->post([impl = impl_.get(), r = std::move(reason)] { impl->doEstop(r); });
+}
+void RobotClient::sendSequence(SequenceMsg sequence) {
+  impl_->post([impl = impl_.get(), m = std::move(sequence)] { impl->doSend(m, "SEQUENCE"); });
+}
+void RobotClient::abortSequence(std::string hash, std::string reason) {
+  impl_->post([impl = impl_.get(), m = AbortMsg{std::move(hash), std::move(reason)}] { impl->doSend(m, "ABORT"); });
 }
 void RobotClient::rearm() {
   impl_->post([impl = impl_.get()] { impl->doRearm(); });

@@ -132,6 +132,9 @@ struct RobotClientCallbacks {
   /// ERRORs from the robot (a message of ours it refused), and local notices
   /// prefixed `client: ` (an ESTOP or REARM that could not be sent).
   std::function<void(const ErrorMsg&)> error;
+  /// Every SEQUENCE_STATE: a sequence accepted, refused, running (each
+  /// command applied), done or aborted.
+  std::function<void(const SequenceStateMsg&)> sequence;
   /// The robot's LIMITS (after WELCOME on each connection).
   std::function<void(const LimitsMsg&)> limits;
   /// Each heartbeat round trip [ms], as measured (for plots and benchmarks).
@@ -192,6 +195,13 @@ class RobotClient {
   /// ESTOP with an optional reason. If not Ready, it is sent as soon as the
   /// next connection is welcomed (and `error` reports the delay).
   void estop(std::string reason = {});
+  /// SEQUENCE: a rehearsed sequence to run on board (only the lease holder's
+  /// is taken); the answer comes as SEQUENCE_STATE. If not Ready it is not
+  /// sent; `error` says so.
+  void sendSequence(SequenceMsg sequence);
+  /// ABORT of the running sequence `hash`: the robot stops. If not Ready
+  /// it is not sent; `error` says so (an e-stop is the way then).
+  void abortSequence(std::string hash, std::string reason = {});
   /// REARM: clears a latched failsafe or e-stop (the robot accepts it from
   /// the lease holder, or from a controlling client when nobody holds the
   /// lease). If not Ready it is not sent; `error` says so.

@@ -77,8 +77,29 @@ void RobotLink::refuse(ClientId client, uint64_t seq, ReplyStatus status, std::s
   send(client, ReplyMsg{seq, status, std::move(reason)});
 }
 
-void RobotLink::stopEverything(EventKind why, const std::string& text, double now) {
+void RobotLink::stopRobot(const std::string& why) {
   commands_.emplace_back(std::in_place_type<StopCmd>);
+  aborts_.push_back(why);
+}
+
+void RobotLink::refuseSequence(ClientId client, const std::string& hash, const std::string& reason) {
+  notice("link", who(client) + ": sequence " + hash.substr(0, 16) + " refused: " + reason);
+  SequenceStateMsg m{hash, SequenceStateKind::Refused, 0, 0, 0, reason};
+  if (m.hash.empty()) m.hash = "-";
+  send(client, m);
+}
+
+void RobotLink::sequenceState(const SequenceStateMsg& state) {
+  std::string text = "sequence " + state.hash + " " + toString(state.state);
+  if (state.state == SequenceStateKind::Running)
+    text += ": " + std::to_string(state.index) + " of " + std::to_string(state.count) + " commands applied";
+  if (!state.reason.empty()) text += ": " + state.reason;
+  notice("sequence", text);
+  broadcast(state);
+}
+
+void RobotLink::stopEverything(EventKind why, const std::string& text, double now) {
+  stopRobot(text);
   if (why == EventKind::Failsafe) {
     failsafe_ = true;
     lastFailsafe_ = now;
@@ -177,7 +198,7 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
             holder_ = 0;
             deadmanArmed_ = false;
             awaitingHolder_ = false;
-            commands_.emplace_back(std::in_place_type<StopCmd>);
+            stopRobot("the lease was released");
             notice("link", "lease released by " + who(client) + " (the robot stops)");
             broadcastLease();
           }
@@ -221,6 +242,30 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
           commands_.push_back(*command);
           ++accepted_;
           send(client, ReplyMsg{m.seq, ReplyStatus::Ok, ""});
+        } else if constexpr (std::is_same_v<T, SequenceMsg>) {
+          if (client != holder_)
+            return refuseSequence(client, m.hash, holder_ ? "'" + clients_[holder_].name + "' holds the lease"
+                                                         : "nobody holds the lease");
+          heardFromHolder(now);
+          if (failsafe_ || estop_)
+            return refuseSequence(client, m.hash, std::string(estop_ ? "e-stop" : "failsafe") + " latched: re-arm first");
+          std::string error;
+          std::optional<std::vector<TimedCommand>> commands = parseSequenceMsg(m, robot_, error);
+          if (!commands) return refuseSequence(client, m.hash, error);
+          for (size_t i = 0; i < commands->size(); ++i)
+            if (CommandCheck verdict = check_ ? check_((*commands)[i].command) : CommandCheck{}; !verdict.ok())
+              return refuseSequence(client, m.hash, "command " + std::to_string(i + 1) + ": " + verdict.message);
+          notice("link", who(client) + " sent sequence " + m.hash + " (" + std::to_string(commands->size()) +
+                             " commands)");
+          sequences_.push_back({client, m, std::move(*commands)});
+        } else if constexpr (std::is_same_v<T, AbortMsg>) {
+          if (c.role != Role::Control) {
+            notice("link", who(client) + ": abort refused: a monitor does not control the robot");
+            return send(client, ErrorMsg{"a monitor cannot abort"});
+          }
+          const std::string why = "ABORT from '" + c.name + "'" + (m.reason.empty() ? "" : ": " + m.reason);
+          notice("link", why + " (sequence " + m.hash + "; the robot stops)");
+          stopRobot(why);
         } else if constexpr (std::is_same_v<T, HeartbeatMsg>) {
           // An echo of one of ours measures the round trip; the client's
           // own heartbeats are echoed back for it to do the same.
@@ -264,7 +309,7 @@ void RobotLink::tick(double now) {
     notice("link", "lease taken back from " + who(holder_) + ": no keep-alive within " +
                        std::to_string(static_cast<int>(config_.leaseConfirm * 1000)) + " ms of the grant");
     holder_ = 0;
-    commands_.emplace_back(std::in_place_type<StopCmd>);
+    stopRobot("the lease was taken back");
     broadcastLease();
   }
   // The deadman watches the holder, and keeps watching after a holder is
@@ -290,6 +335,8 @@ void RobotLink::sendHeartbeats(double now) {
 
 std::vector<RobotLink::Outgoing> RobotLink::takeOutgoing() { return std::exchange(outgoing_, {}); }
 std::vector<Command> RobotLink::takeCommands() { return std::exchange(commands_, {}); }
+std::vector<RobotLink::SequenceRequest> RobotLink::takeSequences() { return std::exchange(sequences_, {}); }
+std::vector<std::string> RobotLink::takeAborts() { return std::exchange(aborts_, {}); }
 std::vector<ClientId> RobotLink::takeClosing() { return std::exchange(closing_, {}); }
 std::vector<RobotLink::Notice> RobotLink::takeNotices() { return std::exchange(notices_, {}); }
 

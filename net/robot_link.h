@@ -86,6 +86,19 @@ class RobotLink {
   std::vector<Outgoing> takeOutgoing();
   /// Twin commands to apply since the last call, in order (checked).
   std::vector<Command> takeCommands();
+  /// A SEQUENCE from the lease holder that parsed, matched its hash and
+  /// passed every command's check: for the robot to start (or refuse).
+  struct SequenceRequest {
+    ClientId client;
+    SequenceMsg message;
+    std::vector<TimedCommand> commands;
+  };
+  std::vector<SequenceRequest> takeSequences();
+  /// Why running sequences must stop, in order: an ABORT, an e-stop, the
+  /// failsafe, the lease given up or taken back (each also queued a stop).
+  std::vector<std::string> takeAborts();
+  /// Tells every client where a sequence stands (SEQUENCE_STATE), and notes it.
+  void sequenceState(const SequenceStateMsg& state);
   /// Clients whose connection must be closed (after their last messages).
   std::vector<ClientId> takeClosing();
 
@@ -142,6 +155,9 @@ class RobotLink {
   void broadcastLease();
   void refuse(ClientId client, uint64_t seq, ReplyStatus status, std::string reason);
   void stopEverything(EventKind why, const std::string& text, double now);
+  /// Queues a stop and aborts any running sequence, for `why`.
+  void stopRobot(const std::string& why);
+  void refuseSequence(ClientId client, const std::string& hash, const std::string& reason);
   /// A keep-alive or command from the holder arrived: the deadman counts from now.
   void heardFromHolder(double now);
   void close(ClientId client, const std::string& reason);
@@ -168,6 +184,8 @@ class RobotLink {
   uint64_t accepted_ = 0, refused_ = 0;
   std::vector<Outgoing> outgoing_;
   std::vector<Command> commands_;
+  std::vector<SequenceRequest> sequences_;
+  std::vector<std::string> aborts_;
   std::vector<ClientId> closing_;
   std::vector<Notice> notices_;
 };

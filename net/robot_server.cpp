@@ -246,6 +246,18 @@ void RobotServer::flush() {
   // later than the stop it caused.
   for (RobotLink::Notice& n : link_.takeNotices())
     if (config_.events) config_.events(n.kind, n.text);
+  // A new sequence, then what stops sequences, then commands (a stop among
+  // them): the robot sees them in the order that keeps it safe.
+  for (RobotLink::SequenceRequest& r : link_.takeSequences()) {
+    const SequenceMsg& m = r.message;
+    const std::string why = robot_.startSequence(
+        {m.hash, std::move(r.commands), m.start, m.startPosition, m.startHeading});
+    SequenceStateMsg state{m.hash, why.empty() ? SequenceStateKind::Accepted : SequenceStateKind::Refused, 0, 0, 0, why};
+    link_.sequenceState(state);
+  }
+  for (const std::string& why : link_.takeAborts()) robot_.abortSequence(why);
+  for (RobotLink::Notice& n : link_.takeNotices())
+    if (config_.events) config_.events(n.kind, n.text);
   const std::vector<Command> commands = link_.takeCommands();
   if (!commands.empty()) robot_.apply(commands);
   for (const RobotLink::Outgoing& o : link_.takeOutgoing()) {
@@ -356,6 +368,11 @@ void RobotServer::onTimer() {
     if (st.health != lastHealth_) {
       lastHealth_ = st.health;
       if (!st.health.empty()) link_.announce(EventKind::Divergence, st.health);
+    }
+    if (st.sequence != lastSequence_ && !st.sequence.hash.empty()) {
+      lastSequence_ = st.sequence;
+      const SequenceStatus& q = st.sequence;
+      link_.sequenceState({q.hash, q.state, q.index, q.count, q.startTime, q.reason});
     }
     TelemetryMsg m;
     m.time = st.time;

@@ -27,6 +27,26 @@
 
 namespace sp::net {
 
+/// A sequence the link accepted (SEQUENCE), for the robot to run on board.
+struct SequenceRun {
+  std::string hash;
+  std::vector<TimedCommand> commands;  ///< times from the sequence's start [s]
+  Pose start;                          ///< the rehearsal's start pose
+  double startPosition = 0;            ///< [m] tolerance of the base's position
+  double startHeading = 0;             ///< [rad] tolerance of its heading
+};
+
+/// Where the robot's latest sequence stands; the server sends
+/// SEQUENCE_STATE to every client when it changes.
+struct SequenceStatus {
+  std::string hash;  ///< "" = no sequence yet
+  SequenceStateKind state = SequenceStateKind::Accepted;
+  uint64_t index = 0, count = 0;  ///< commands applied, in the sequence
+  double startTime = 0;           ///< [s] robot time of its t = 0
+  std::string reason;             ///< aborted: why
+  friend bool operator==(const SequenceStatus&, const SequenceStatus&) = default;
+};
+
 /// The robot's state for one TELEMETRY frame (the server adds the per-client
 /// sequence number, round trip, losses and latches).
 struct RobotState {
@@ -41,6 +61,7 @@ struct RobotState {
   /// Poses of the world's dynamic objects the robot knows of (names without
   /// spaces); empty when there are none.
   std::vector<ObjectPose> objects;
+  SequenceStatus sequence;
 };
 
 struct LaserScanState {
@@ -62,6 +83,14 @@ class RobotPort {
   virtual RobotState state() const = 0;
   /// The latest laser scan, if one newer than `afterCount` exists.
   virtual std::optional<LaserScanState> laserAfter(uint64_t afterCount) const = 0;
+  /// Starts a checked sequence at the next step boundary: "" when it
+  /// starts, else why the robot refuses (its state departed from the
+  /// rehearsal's start, another sequence runs). A robot that cannot run
+  /// sequences refuses them all.
+  virtual std::string startSequence(const SequenceRun&) { return "this robot does not run sequences"; }
+  /// Stops the running sequence (its remaining commands are dropped; the
+  /// link queues the stop itself). Nothing when none runs.
+  virtual void abortSequence(const std::string& /*reason*/) {}
 };
 
 struct RobotServerConfig {
@@ -145,6 +174,7 @@ class RobotServer {
   double nextTelemetry_ = 0, nextHeartbeat_ = 0;
   uint64_t lastLaser_ = 0;
   std::string lastHealth_;  // announced divergence, so it is announced once
+  SequenceStatus lastSequence_;  // announced sequence state
   RobotServerStats stats_;
   bool stopped_ = false;
 };

@@ -34,6 +34,13 @@ void Runner::skipBefore(int64_t step) {
     ++next_;
 }
 
+size_t Runner::dropPending() {
+  const size_t n = queue_.size() - next_;
+  queue_.clear();
+  next_ = 0;
+  return n;
+}
+
 void Runner::submitDue() {
   while (next_ < queue_.size() && due(queue_[next_])) {
     const ScheduledCommand& c = queue_[next_++];

@@ -69,6 +69,9 @@ class Runner {
   /// Drops, unsubmitted, the scheduled commands due before step `step` (a
   /// run restored from a snapshot at `step`: they are in its state).
   void skipBefore(int64_t step);
+  /// Drops every scheduled command not yet submitted (an aborted
+  /// sequence); returns how many.
+  size_t dropPending();
   /// Submits the scheduled commands due at the current boundary (a step
   /// does this itself; call it only to submit before checking the state).
   void submitDue();

@@ -145,6 +145,12 @@ void TestMessage::roundTrip_data() {
   limits.lower[0] = -std::numeric_limits<double>::infinity();
   limits.upper[0] = std::numeric_limits<double>::infinity();
   QTest::newRow("LIMITS unlimited joint") << Message(limits);
+  QTest::newRow("SEQUENCE") << Message(SequenceMsg{"0123456789abcdef", "0 drive 0.5 10;2.5 stop",
+                                                   Pose{{1, 2, 0.8}, {1, 0, 0, 0}}, 0.1, 0.0873});
+  QTest::newRow("SEQUENCE_STATE") << Message(SequenceStateMsg{"0123456789abcdef", SequenceStateKind::Running, 1, 2, 12.5, ""});
+  QTest::newRow("SEQUENCE_STATE refused")
+      << Message(SequenceStateMsg{"0123456789abcdef", SequenceStateKind::Refused, 0, 0, 0, "stale rehearsal"});
+  QTest::newRow("ABORT") << Message(AbortMsg{"0123456789abcdef", "guard: position 0.31 m"});
   QTest::newRow("LIMITS without drive") << Message(LimitsMsg{{"arm"}, {0}, {1}, {2}, {3}, 0, 0, ""});
   QTest::newRow("WELCOME") << Message(WelcomeMsg{"workpartner", 18446744073709551615u, 50, 0, "", ""});
   QTest::newRow("WELCOME with files") << Message(WelcomeMsg{"workpartner", 3, 50, 0.5, "0123456789abcdef", "fedcba9876543210"});
@@ -195,13 +201,14 @@ void TestMessage::typeNames() {
   const char* names[] = {"HELLO",     "WELCOME", "LEASE_ACQUIRE", "LEASE_KEEPALIVE", "LEASE_RELEASE",
                          "LEASE_STATE", "COMMAND", "REPLY",        "TELEMETRY",       "LASER",
                          "HEARTBEAT", "ESTOP",   "REARM",         "EVENT",           "ERROR",
-                         "CHALLENGE", "LIMITS"};
-  for (int code = 1; code <= 17; ++code) {
+                         "CHALLENGE", "LIMITS",  "SEQUENCE",      "SEQUENCE_STATE",  "ABORT"};
+  for (int code = 1; code <= 20; ++code) {
     QCOMPARE(messageTypeName(static_cast<uint8_t>(code)), names[code - 1]);
     QCOMPARE(toString(static_cast<MessageType>(code)), names[code - 1]);
   }
   QCOMPARE(messageTypeName(0), "unknown");
-  QCOMPARE(messageTypeName(18), "unknown");
+  QCOMPARE(messageTypeName(21), "unknown");
+  QCOMPARE(toString(SequenceStateKind::Aborted), "aborted");
   QCOMPARE(toString(ReplyStatus::NotOwner), "not_owner");
   QCOMPARE(toString(EventKind::Rearmed), "rearmed");
   QCOMPARE(toString(Role::Monitor), "monitor");
