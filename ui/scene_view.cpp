@@ -337,17 +337,23 @@ struct SceneView::Impl {
   osg::ref_ptr<osg::Group> worldNode;  // terrain, grid, axes, objects
   osg::ref_ptr<osg::Group> robotNode;
   std::vector<osg::ref_ptr<osg::MatrixTransform>> links;
-  // A second robot, translucent (the predictive ghost): the same link
-  // geometry, shared, under transforms of its own.
-  osg::ref_ptr<osg::Group> ghostNode;
-  std::vector<osg::ref_ptr<osg::MatrixTransform>> ghostLinks;
+  // Translucent robots (the predictive ghost, the rehearsal): the same link
+  // geometry, shared, under transforms of their own, each with its path.
+  struct Phantom {
+    osg::ref_ptr<osg::Group> node;
+    std::vector<osg::ref_ptr<osg::MatrixTransform>> links;
+    osg::ref_ptr<osg::Geode> pathNode;
+    osg::ref_ptr<osg::Geometry> path;
+    std::vector<Vec3> pathPoints;
+    bool pathDirty = false;
+    Pose base;
+    std::vector<double> joints;
+    bool dirty = false;
+    bool visible = false;
+  };
+  Phantom ghost, rehearsal;
   osg::ref_ptr<osg::Geode> laserNode;
   osg::ref_ptr<osg::Geometry> beams, hits;
-  // The ghost's predicted path: a line strip of base positions.
-  osg::ref_ptr<osg::Geode> trailNode;
-  osg::ref_ptr<osg::Geometry> trail;
-  std::vector<Vec3> trailPoints;
-  bool trailDirty = false;
   osg::ref_ptr<osg::Fog> fog;
 
   // The robot as last set, and whether the graph still shows an older state.
@@ -357,10 +363,6 @@ struct SceneView::Impl {
   std::vector<double> joints;
   std::vector<Pose> linkWorld;
   bool robotDirty = false;
-  Pose ghostBase;
-  std::vector<double> ghostJoints;
-  bool ghostDirty = false;
-  bool ghostVisible = false;
 
   // Dynamic objects by name: their transforms and poses as last set.
   struct DynamicObject {
@@ -398,6 +400,10 @@ struct SceneView::Impl {
   double fps = 0;
 
   Impl();
+  // Builds a phantom's node (tinted `body`, see-through) and its path (an
+  // opaque line in `line`) under root.
+  void buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line);
+  void syncPhantom(Phantom& p);
   void buildLaser();
   void updateLaser();
   void sync();
@@ -408,46 +414,15 @@ SceneView::Impl::Impl() {
   root = new osg::Group;
   worldNode = new osg::Group;
   robotNode = new osg::Group;
-  ghostNode = new osg::Group;
   root->addChild(worldNode);
   root->addChild(robotNode);
-  root->addChild(ghostNode);
-  {
-    // The ghost: one translucent tint over every link, drawn after the
-    // opaque scene (transparent bin) without writing depth, so the reported
-    // robot shows through it and it never hides itself.
-    osg::StateSet* g = ghostNode->getOrCreateStateSet();
-    auto* tint = new osg::Material;
-    tint->setColorMode(osg::Material::OFF);
-    tint->setDiffuse(osg::Material::FRONT_AND_BACK, {0.30f, 0.80f, 1.00f, 0.38f});
-    tint->setAmbient(osg::Material::FRONT_AND_BACK, {0.10f, 0.30f, 0.40f, 0.38f});
-    tint->setSpecular(osg::Material::FRONT_AND_BACK, {0, 0, 0, 0.38f});
-    g->setAttributeAndModes(tint, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
-    g->setAttributeAndModes(new osg::BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA), osg::StateAttribute::ON);
-    g->setAttributeAndModes(new osg::Depth(osg::Depth::LESS, 0.0, 1.0, false), osg::StateAttribute::ON);
-    g->setRenderingHint(osg::StateSet::TRANSPARENT_BIN);
-    ghostNode->setNodeMask(0);
-  }
+  // The ghost light blue; the rehearsal amber. The paths in the same hues,
+  // saturated and opaque: a thin line in a pale tint vanishes against the
+  // sky and light ground.
+  buildPhantom(ghost, {0.30f, 0.80f, 1.00f, 0.38f}, {0.05f, 0.45f, 1.00f, 1.0f});
+  buildPhantom(rehearsal, {1.00f, 0.70f, 0.15f, 0.38f}, {0.95f, 0.45f, 0.00f, 1.0f});
   buildLaser();
   root->addChild(laserNode);
-  trailNode = new osg::Geode;
-  trail = newGeometry();
-  trail->setVertexArray(new osg::Vec3Array);
-  auto* trailColor = new osg::Vec4Array;
-  // The ghost's hue, but saturated and opaque: a thin line in the ghost's
-  // pale tint vanishes against the sky and light ground.
-  trailColor->push_back({0.05f, 0.45f, 1.00f, 1.0f});
-  trail->setColorArray(trailColor, osg::Array::BIND_OVERALL);
-  trail->addPrimitiveSet(new osg::DrawArrays(GL_LINE_STRIP, 0, 0));
-  trail->setDataVariance(osg::Object::DYNAMIC);
-  trailNode->addDrawable(trail);
-  {
-    osg::StateSet* s = trailNode->getOrCreateStateSet();
-    s->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
-    s->setAttributeAndModes(new osg::LineWidth(4.0f));
-  }
-  trailNode->setNodeMask(0);
-  root->addChild(trailNode);
 
   osg::StateSet* s = root->getOrCreateStateSet();
   // Geometry colours drive ambient and diffuse; a little gloss on the shapes.
@@ -553,6 +528,60 @@ void SceneView::Impl::updateLaser() {
   hits->dirtyBound();
 }
 
+void SceneView::Impl::buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line) {
+  p.node = new osg::Group;
+  root->addChild(p.node);
+  // One translucent tint over every link, drawn after the opaque scene
+  // (transparent bin) without writing depth, so the reported robot shows
+  // through it and it never hides itself.
+  osg::StateSet* g = p.node->getOrCreateStateSet();
+  auto* tint = new osg::Material;
+  tint->setColorMode(osg::Material::OFF);
+  tint->setDiffuse(osg::Material::FRONT_AND_BACK, body);
+  tint->setAmbient(osg::Material::FRONT_AND_BACK, {body.r() / 3, body.g() / 3, body.b() / 3, body.a()});
+  tint->setSpecular(osg::Material::FRONT_AND_BACK, {0, 0, 0, body.a()});
+  g->setAttributeAndModes(tint, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+  g->setAttributeAndModes(new osg::BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA), osg::StateAttribute::ON);
+  g->setAttributeAndModes(new osg::Depth(osg::Depth::LESS, 0.0, 1.0, false), osg::StateAttribute::ON);
+  g->setRenderingHint(osg::StateSet::TRANSPARENT_BIN);
+  p.node->setNodeMask(0);
+  p.pathNode = new osg::Geode;
+  p.path = newGeometry();
+  p.path->setVertexArray(new osg::Vec3Array);
+  auto* color = new osg::Vec4Array;
+  color->push_back(line);
+  p.path->setColorArray(color, osg::Array::BIND_OVERALL);
+  p.path->addPrimitiveSet(new osg::DrawArrays(GL_LINE_STRIP, 0, 0));
+  p.path->setDataVariance(osg::Object::DYNAMIC);
+  p.pathNode->addDrawable(p.path);
+  osg::StateSet* s = p.pathNode->getOrCreateStateSet();
+  s->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
+  s->setAttributeAndModes(new osg::LineWidth(4.0f));
+  p.pathNode->setNodeMask(0);
+  root->addChild(p.pathNode);
+}
+
+void SceneView::Impl::syncPhantom(Phantom& p) {
+  if (p.dirty) {
+    const std::vector<Pose> poses = linkPoses(robot, p.base, p.joints);
+    for (size_t i = 0; i < p.links.size() && i < poses.size(); ++i) p.links[i]->setMatrix(toMatrix(poses[i]));
+    p.dirty = false;
+  }
+  p.node->setNodeMask(p.visible && hasRobot ? ~0u : 0u);
+  if (p.pathDirty) {
+    auto* v = static_cast<osg::Vec3Array*>(p.path->getVertexArray());
+    v->clear();
+    // A little above the given points (on the ground), so the ground does
+    // not hide the line.
+    for (const Vec3& q : p.pathPoints) v->push_back(toOsg(q) + osg::Vec3(0, 0, 0.05f));
+    v->dirty();
+    static_cast<osg::DrawArrays*>(p.path->getPrimitiveSet(0))->setCount(static_cast<GLsizei>(v->size()));
+    p.path->dirtyBound();
+    p.pathDirty = false;
+  }
+  p.pathNode->setNodeMask(p.visible && hasRobot && p.pathPoints.size() > 1 ? ~0u : 0u);
+}
+
 // Brings the scene graph and camera up to the stored state; called before
 // each frame, so setters never touch the graph.
 void SceneView::Impl::sync() {
@@ -562,24 +591,8 @@ void SceneView::Impl::sync() {
     robotDirty = false;
     laserDirty = true;  // the laser rides on the robot
   }
-  if (ghostDirty) {
-    const std::vector<Pose> poses = linkPoses(robot, ghostBase, ghostJoints);
-    for (size_t i = 0; i < ghostLinks.size() && i < poses.size(); ++i) ghostLinks[i]->setMatrix(toMatrix(poses[i]));
-    ghostDirty = false;
-  }
-  ghostNode->setNodeMask(ghostVisible && hasRobot ? ~0u : 0u);
-  if (trailDirty) {
-    auto* v = static_cast<osg::Vec3Array*>(trail->getVertexArray());
-    v->clear();
-    // A little above the given points (on the ground), so the ground does
-    // not hide the line.
-    for (const Vec3& p : trailPoints) v->push_back(toOsg(p) + osg::Vec3(0, 0, 0.05f));
-    v->dirty();
-    static_cast<osg::DrawArrays*>(trail->getPrimitiveSet(0))->setCount(static_cast<GLsizei>(v->size()));
-    trail->dirtyBound();
-    trailDirty = false;
-  }
-  trailNode->setNodeMask(ghostVisible && hasRobot && trailPoints.size() > 1 ? ~0u : 0u);
+  syncPhantom(ghost);
+  syncPhantom(rehearsal);
   if (stale != staleShown) {
     osg::StateSet* st = robotNode->getOrCreateStateSet();
     if (stale) {
@@ -656,9 +669,11 @@ void SceneView::setWorld(const WorldModel& world) {
   Impl& m = *m_;
   m.worldNode->removeChildren(0, m.worldNode->getNumChildren());
   m.robotNode->removeChildren(0, m.robotNode->getNumChildren());
-  m.ghostNode->removeChildren(0, m.ghostNode->getNumChildren());
+  for (Impl::Phantom* p : {&m.ghost, &m.rehearsal}) {
+    p->node->removeChildren(0, p->node->getNumChildren());
+    p->links.clear();
+  }
   m.links.clear();
-  m.ghostLinks.clear();
   m.objects.clear();
   m.objectsDirty = false;
 
@@ -701,21 +716,25 @@ void SceneView::setWorld(const WorldModel& world) {
     xf->addChild(shape);
     m.robotNode->addChild(xf);
     m.links.push_back(xf);
-    osg::ref_ptr<osg::MatrixTransform> ghost = new osg::MatrixTransform;
-    ghost->setDataVariance(osg::Object::DYNAMIC);
-    ghost->addChild(shape);
-    m.ghostNode->addChild(ghost);
-    m.ghostLinks.push_back(ghost);
+    for (Impl::Phantom* p : {&m.ghost, &m.rehearsal}) {
+      osg::ref_ptr<osg::MatrixTransform> phantom = new osg::MatrixTransform;
+      phantom->setDataVariance(osg::Object::DYNAMIC);
+      phantom->addChild(shape);
+      p->node->addChild(phantom);
+      p->links.push_back(phantom);
+    }
   }
   m.base = m.hasRobot ? world.robots[0].pose * m.robot.links[0].pose : Pose{};
   m.joints.assign(m.robot.joints.size(), 0.0);
   m.linkWorld.clear();
   m.robotDirty = true;
-  m.ghostBase = m.base;
-  m.ghostJoints = m.joints;
-  m.ghostDirty = true;
-  m.trailPoints.clear();
-  m.trailDirty = true;
+  for (Impl::Phantom* p : {&m.ghost, &m.rehearsal}) {
+    p->base = m.base;
+    p->joints = m.joints;
+    p->dirty = true;
+    p->pathPoints.clear();
+    p->pathDirty = true;
+  }
   m.laserRanges.clear();
   m.laserDirty = true;
   if (!m.hasRobot) m.centre = {};
@@ -728,29 +747,51 @@ void SceneView::setRobotState(const Pose& base, const std::vector<double>& joint
 }
 
 void SceneView::setGhostState(const Pose& base, const std::vector<double>& jointPositions) {
-  m_->ghostBase = base;
-  m_->ghostJoints = jointPositions;
-  m_->ghostDirty = true;
+  m_->ghost.base = base;
+  m_->ghost.joints = jointPositions;
+  m_->ghost.dirty = true;
 }
 
-void SceneView::setGhostVisible(bool visible) { m_->ghostVisible = visible; }
+void SceneView::setGhostVisible(bool visible) { m_->ghost.visible = visible; }
 
 void SceneView::setGhostTrail(const std::vector<Vec3>& points) {
-  m_->trailPoints = points;
-  m_->trailDirty = true;
+  m_->ghost.pathPoints = points;
+  m_->ghost.pathDirty = true;
 }
 
 size_t SceneView::drawnTrailPoints() const {
-  return m_->trailNode->getNodeMask() ? m_->trailPoints.size() : 0;
+  return m_->ghost.pathNode->getNodeMask() ? m_->ghost.pathPoints.size() : 0;
 }
-bool SceneView::ghostVisible() const { return m_->ghostVisible; }
+bool SceneView::ghostVisible() const { return m_->ghost.visible; }
 
-Pose SceneView::drawnGhostBasePose() const {
-  if (m_->ghostLinks.empty() || !m_->ghostVisible) return {};
-  const osg::Matrixd m = m_->ghostLinks[0]->getMatrix();
+namespace {
+Pose drawnPhantomBase(const std::vector<osg::ref_ptr<osg::MatrixTransform>>& links, bool visible) {
+  if (links.empty() || !visible) return {};
+  const osg::Matrixd m = links[0]->getMatrix();
   const osg::Vec3d t = m.getTrans();
   const osg::Quat q = m.getRotate();
   return Pose{{t.x(), t.y(), t.z()}, Quat{q.w(), q.x(), q.y(), q.z()}};
+}
+}  // namespace
+
+Pose SceneView::drawnGhostBasePose() const { return drawnPhantomBase(m_->ghost.links, m_->ghost.visible); }
+
+void SceneView::setRehearsalState(const Pose& base, const std::vector<double>& jointPositions) {
+  m_->rehearsal.base = base;
+  m_->rehearsal.joints = jointPositions;
+  m_->rehearsal.dirty = true;
+}
+void SceneView::setRehearsalPath(const std::vector<Vec3>& points) {
+  m_->rehearsal.pathPoints = points;
+  m_->rehearsal.pathDirty = true;
+}
+void SceneView::setRehearsalVisible(bool visible) { m_->rehearsal.visible = visible; }
+bool SceneView::rehearsalVisible() const { return m_->rehearsal.visible; }
+size_t SceneView::drawnRehearsalPathPoints() const {
+  return m_->rehearsal.pathNode->getNodeMask() ? m_->rehearsal.pathPoints.size() : 0;
+}
+Pose SceneView::drawnRehearsalBasePose() const {
+  return drawnPhantomBase(m_->rehearsal.links, m_->rehearsal.visible);
 }
 
 void SceneView::setObjectPoses(const std::vector<NamedPose>& objects) {

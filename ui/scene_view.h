@@ -75,6 +75,16 @@ class SceneView : public QOpenGLWidget {
   /// while it is hidden.
   Pose drawnGhostBasePose() const;
 
+  /// The rehearsal (ui/sequence_panel.h): a second translucent robot, amber,
+  /// at the rehearsal scrubber's time, and the rehearsed path on the ground;
+  /// hidden until setRehearsalVisible(true).
+  void setRehearsalState(const Pose& base, const std::vector<double>& jointPositions);
+  void setRehearsalPath(const std::vector<Vec3>& points);
+  void setRehearsalVisible(bool visible);
+  bool rehearsalVisible() const;
+  size_t drawnRehearsalPathPoints() const;
+  Pose drawnRehearsalBasePose() const;
+
   /// Places dynamic objects of the world by name (world frame). Names that
   /// are no dynamic object of the world are ignored; objects not named keep
   /// their last pose (the world file's until set). Cheap: the transforms are
