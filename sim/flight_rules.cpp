@@ -120,8 +120,10 @@ const char* unitOf(Rule rule) {
   return "";
 }
 
-// Convex hull of points in the xy plane, counter-clockwise (Andrew's monotone chain).
-std::vector<Vec3> hull(std::vector<Vec3> p) {
+}  // namespace
+
+// Andrew's monotone chain.
+std::vector<Vec3> convexHullXY(std::vector<Vec3> p) {
   std::sort(p.begin(), p.end(), [](Vec3 a, Vec3 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
   if (p.size() < 3) return p;
   auto turn = [](Vec3 o, Vec3 a, Vec3 b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); };
@@ -138,6 +140,8 @@ std::vector<Vec3> hull(std::vector<Vec3> p) {
   h.resize(k - 1);
   return h;
 }
+
+namespace {
 
 double segmentDistance(Vec3 p, Vec3 a, Vec3 b) {
   const double dx = b.x - a.x, dy = b.y - a.y;
@@ -214,7 +218,7 @@ std::string RuleVerdict::message() const {
 }
 
 double supportMargin(Vec3 point, const std::vector<Vec3>& support) {
-  const std::vector<Vec3> h = hull(support);
+  const std::vector<Vec3> h = convexHullXY(support);
   if (h.empty()) return -std::numeric_limits<double>::infinity();
   if (h.size() == 1) return -std::hypot(point.x - h[0].x, point.y - h[0].y);
   double edge = std::numeric_limits<double>::infinity();

@@ -93,6 +93,9 @@ struct RuleVerdict {
   std::string message() const;
 };
 
+/// The convex hull of `points` in the xy plane, counter-clockwise (z kept).
+std::vector<Vec3> convexHullXY(std::vector<Vec3> points);
+
 /// The support polygon's margin: the distance [m] from `point` (x, y) to
 /// the nearest edge of the convex hull of `support` (x, y), positive inside,
 /// negative outside; with fewer than three points the distance to the

@@ -87,8 +87,11 @@ int main(int argc, char** argv) {
   const QCommandLineOption quitAfter(QStringLiteral("quit-after"), QStringLiteral("Quit after S seconds, printing the frame rate (for measurements)."), QStringLiteral("S"));
   const QCommandLineOption delay(QStringLiteral("delay"), QStringLiteral("The stand-in's link delays every frame by S seconds each way (rehearse a slow link; the ghost spans it)."), QStringLiteral("S"));
   const QCommandLineOption noGhost(QStringLiteral("no-ghost"), QStringLiteral("Do not run the predictive ghost."));
+  const QCommandLineOption rules(QStringLiteral("rules"), QStringLiteral("Flight rules for rehearsals (default: built-in, see config/flight.rules)."), QStringLiteral("FILE"));
+  const QCommandLineOption sequenceFile(QStringLiteral("sequence"), QStringLiteral("Open this command sequence in the Sequence dock."), QStringLiteral("FILE"));
   const QCommandLineOption drive(QStringLiteral("drive"), QStringLiteral("Drive at SPEED m/s once in control (for demonstrations)."), QStringLiteral("SPEED"));
-  parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, delay, noGhost, monitor, screenshot, quitAfter, drive});
+  parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, delay, noGhost, monitor, screenshot, quitAfter, drive, rules,
+                     sequenceFile});
   if (!parser.parse(QCoreApplication::arguments())) {
     std::cerr << "<command line>: error: " << parser.errorText().toStdString() << "\n";
     return 2;
@@ -123,6 +126,8 @@ int main(int argc, char** argv) {
   options.logDir = parser.value(logDir);
   options.log = !parser.isSet(noLog);
   options.takeControl = !parser.isSet(monitor);
+  options.rules = parser.isSet(rules) ? findDataFile(parser.value(rules)) : QString();
+  options.sequence = parser.isSet(sequenceFile) ? findDataFile(parser.value(sequenceFile)) : QString();
   std::optional<double> driveSpeed, quitSeconds;
   if (parser.isSet(rtf)) {
     const std::optional<double> x = numberOption(parser, rtf, 0, 1000);

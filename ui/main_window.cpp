@@ -5,6 +5,7 @@
 #include <QDesktopServices>
 #include <QDir>
 #include <QDockWidget>
+#include <QFile>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QInputDialog>
@@ -36,6 +37,7 @@
 #include "ui/robot_connection.h"
 #include "ui/robot_feed.h"
 #include "ui/scene_view.h"
+#include "ui/sequence_panel.h"
 
 namespace sp {
 
@@ -209,11 +211,13 @@ double MainWindow::viewShare() const {
 void MainWindow::defaultLayout() {
   // Controls over the link on the right, full height; the plots under the
   // 3D view only. At 1280x800 the view gets over half the window.
-  for (QDockWidget* dock : {controlsDock_, linkDock_, plotsDock_}) {
+  for (QDockWidget* dock : {controlsDock_, sequenceDock_, linkDock_, plotsDock_}) {
     dock->setFloating(false);
     dock->show();
   }
   addDockWidget(Qt::RightDockWidgetArea, controlsDock_);
+  tabifyDockWidget(controlsDock_, sequenceDock_);
+  controlsDock_->raise();
   splitDockWidget(controlsDock_, linkDock_, Qt::Vertical);
   addDockWidget(Qt::BottomDockWidgetArea, plotsDock_);
   resizeDocks({controlsDock_}, {320}, Qt::Horizontal);
@@ -277,6 +281,43 @@ void MainWindow::buildDocks() {
   connect(link_, &LinkPanel::releaseControlRequested, connection_, &RobotConnection::releaseLease);
   connect(link_, &LinkPanel::estopRequested, this, &MainWindow::emergencyStop);
   connect(link_, &LinkPanel::rearmRequested, this, &MainWindow::rearm);
+
+  sequence_ = new SequencePanel;
+  sequenceDock_ = new QDockWidget(tr("Sequence"), this);
+  sequenceDock_->setObjectName(QStringLiteral("sequenceDock"));
+  sequenceDock_->setWidget(sequence_);
+  tabifyDockWidget(controlsDock_, sequenceDock_);
+  controlsDock_->raise();
+  sequence_->setStartProvider([this]() -> std::optional<RehearsalStart> {
+    const std::optional<net::TelemetryMsg>& t = lastTelemetry();
+    const RobotModel* robot = session_->robot();
+    if (!t || !robot) return std::nullopt;
+    std::string why;
+    std::optional<RehearsalStart> start = startFromTelemetry(*t, *robot, why);
+    if (!start) statusBar()->showMessage(tr("Rehearsing from the world's start: %1").arg(qs(why)), 6000);
+    return start;
+  });
+  connect(sequence_, &SequencePanel::sendRequested, connection_, &RobotConnection::sendSequence);
+  connect(sequence_, &SequencePanel::abortRequested, connection_, &RobotConnection::abortSequence);
+  connect(connection_, &RobotConnection::sequenceState, sequence_, &SequencePanel::onSequenceState);
+  connect(connection_, &RobotConnection::telemetry, sequence_, &SequencePanel::onTelemetry);
+  connect(sequence_, &SequencePanel::scrubbed, this, [this](const Pose& base, const std::vector<double>& joints) {
+    scene_->setRehearsalState(base, joints);
+    scene_->setRehearsalVisible(true);
+  });
+  connect(sequence_, &SequencePanel::pathChanged, this,
+          [this](const std::vector<Vec3>& path, const std::vector<Vec3>& envelope) {
+            scene_->setRehearsalPath(path);
+            scene_->setRehearsalEnvelope(envelope);
+            scene_->setRehearsalVisible(!path.empty());
+          });
+  connect(sequence_, &SequencePanel::logEvent, this,
+          [this](const QString& kind, const QString& text) { session_->logEvent(kind.toStdString(), text.toStdString()); });
+  connect(sequence_, &SequencePanel::alert, this, [this](const QString& text) {
+    link_->appendEvent(text);
+    statusBar()->showMessage(text, 10000);
+    sequenceDock_->raise();
+  });
 }
 
 void MainWindow::buildMenus() {
@@ -361,6 +402,18 @@ void MainWindow::buildMenus() {
 }
 
 QString MainWindow::start() {
+  if (!options_.rules.isEmpty()) {
+    FlightRules rules;
+    Diagnostics diag;
+    if (!loadFlightRules(options_.rules.toStdString(), rules, diag)) return qs(diag.format()).trimmed();
+    sequence_->setRules(rules);
+  }
+  if (!options_.sequence.isEmpty()) {
+    QFile f(options_.sequence);
+    if (!f.open(QIODevice::ReadOnly) || f.size() > 1 << 20)
+      return tr("%1: error: cannot read sequence file (or larger than 1 MiB)").arg(options_.sequence);
+    sequence_->setText(QString::fromUtf8(f.readAll()));
+  }
   if (const std::string error = session_->start(); !error.empty()) return qs(error);
   sessionChanged();
   return {};
@@ -403,6 +456,7 @@ void MainWindow::showWorld(const WorldModel& world) {
                                     : QString());
   }
   scene_->setWorld(world);
+  sequence_->setWorld(world, session_->params());
   if (!world.robots.empty()) {
     const RobotModel& robot = world.robots[0].model;
     controls_->setRobot(robot);
@@ -540,6 +594,7 @@ void MainWindow::updateControlsEnabled() {
   else if (!leaseHeld_) why = tr("Take control first (Robot ▸ Take control)");
   else if (estop_ || failsafe_) why = tr("The robot is stopped and latched: re-arm first");
   controls_->setControlsEnabled(why.isEmpty(), why);
+  sequence_->setLinkReady(why.isEmpty());
 }
 
 void MainWindow::updateStale() {

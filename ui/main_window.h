@@ -42,6 +42,7 @@ class LinkPanel;
 class PredictionErrorPlot;
 class RobotConnection;
 class SceneView;
+class SequencePanel;
 class WheelForcePlot;
 
 /// What the console starts with (the `simpartner` command line).
@@ -57,6 +58,8 @@ struct ConsoleOptions {
   double delay = 0;           ///< [s] one-way delay the stand-in's link emulates (each way)
   bool ghost = true;          ///< run and show the predictive ghost
   bool takeControl = true;    ///< ask for the lease as soon as connected
+  QString rules;              ///< flight rules file for rehearsals; "" = the built-in defaults
+  QString sequence;           ///< a sequence file to open in the Sequence dock
 };
 
 class MainWindow : public QMainWindow {
@@ -74,6 +77,7 @@ class MainWindow : public QMainWindow {
   SceneView* sceneView() const { return scene_; }
   ControlPanel* controlPanel() const { return controls_; }
   LinkPanel* linkPanel() const { return link_; }
+  SequencePanel* sequencePanel() const { return sequence_; }
   WheelForcePlot* wheelForcePlot() const { return wheelPlot_; }
   LaserPlot* laserPlot() const { return laserPlot_; }
   PredictionErrorPlot* predictionErrorPlot() const { return errorPlot_; }
@@ -158,6 +162,8 @@ class MainWindow : public QMainWindow {
   SceneView* scene_ = nullptr;
   ControlPanel* controls_ = nullptr;
   LinkPanel* link_ = nullptr;
+  SequencePanel* sequence_ = nullptr;
+  QDockWidget* sequenceDock_ = nullptr;
   WheelForcePlot* wheelPlot_ = nullptr;
   LaserPlot* laserPlot_ = nullptr;
   PredictionErrorPlot* errorPlot_ = nullptr;

@@ -30,6 +30,7 @@ void RobotConnection::open(const net::RobotClientConfig& config) {
   callbacks.reply = [this](const net::ReplyMsg& m) { post([this, m] { emit reply(m); }); };
   callbacks.event = [this](const net::EventMsg& m) { post([this, m] { emit event(m); }); };
   callbacks.lease = [this](const net::LeaseStateMsg& m) { post([this, m] { emit lease(m); }); };
+  callbacks.sequence = [this](const net::SequenceStateMsg& m) { post([this, m] { emit sequenceState(m); }); };
   callbacks.connection = [this](net::ConnectionState s, const std::string& detail) {
     post([this, s, d = QString::fromStdString(detail)] { emit connectionChanged(s, d); });
   };
@@ -61,6 +62,16 @@ uint64_t RobotConnection::send(const Command& command, const RobotModel* robot) 
   net::ReplyMsg local{0, net::ReplyStatus::Failed, "console: not connected, not sent"};
   post([this, local] { emit reply(local); });
   return 0;
+}
+
+void RobotConnection::sendSequence(const net::SequenceMsg& message) {
+  if (client_) client_->sendSequence(message);
+  else emit linkError(tr("SEQUENCE not sent: not connected"));
+}
+
+void RobotConnection::abortSequence(const QString& hash, const QString& reason) {
+  if (client_) client_->abortSequence(hash.toStdString(), reason.toStdString());
+  else emit linkError(tr("ABORT not sent: not connected"));
 }
 
 void RobotConnection::estop(const QString& reason) {

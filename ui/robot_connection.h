@@ -37,6 +37,9 @@ class RobotConnection : public QObject {
   /// when not open (then `reply` is emitted with status Failed at once).
   uint64_t send(const Command& command, const RobotModel* robot);
   void estop(const QString& reason);
+  /// SEQUENCE (the answer comes as sequenceState) and ABORT.
+  void sendSequence(const net::SequenceMsg& message);
+  void abortSequence(const QString& hash, const QString& reason);
   void rearm();
   /// Drops the connection as a lost link would (the client reconnects).
   void dropConnection();
@@ -48,6 +51,7 @@ class RobotConnection : public QObject {
   void reply(const sp::net::ReplyMsg& message);
   void event(const sp::net::EventMsg& message);
   void lease(const sp::net::LeaseStateMsg& message);
+  void sequenceState(const sp::net::SequenceStateMsg& message);
   void connectionChanged(sp::net::ConnectionState state, const QString& detail);
   void linkError(const QString& reason);
 

@@ -345,6 +345,8 @@ struct SceneView::Impl {
     osg::ref_ptr<osg::Geode> pathNode;
     osg::ref_ptr<osg::Geometry> path;
     std::vector<Vec3> pathPoints;
+    osg::ref_ptr<osg::Geometry> envelope;  // a closed line (the robustness runs' end positions)
+    std::vector<Vec3> envelopePoints;
     bool pathDirty = false;
     Pose base;
     std::vector<double> joints;
@@ -554,6 +556,12 @@ void SceneView::Impl::buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line) {
   p.path->addPrimitiveSet(new osg::DrawArrays(GL_LINE_STRIP, 0, 0));
   p.path->setDataVariance(osg::Object::DYNAMIC);
   p.pathNode->addDrawable(p.path);
+  p.envelope = newGeometry();
+  p.envelope->setVertexArray(new osg::Vec3Array);
+  p.envelope->setColorArray(color, osg::Array::BIND_OVERALL);
+  p.envelope->addPrimitiveSet(new osg::DrawArrays(GL_LINE_STRIP, 0, 0));
+  p.envelope->setDataVariance(osg::Object::DYNAMIC);
+  p.pathNode->addDrawable(p.envelope);
   osg::StateSet* s = p.pathNode->getOrCreateStateSet();
   s->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
   s->setAttributeAndModes(new osg::LineWidth(4.0f));
@@ -569,14 +577,16 @@ void SceneView::Impl::syncPhantom(Phantom& p) {
   }
   p.node->setNodeMask(p.visible && hasRobot ? ~0u : 0u);
   if (p.pathDirty) {
-    auto* v = static_cast<osg::Vec3Array*>(p.path->getVertexArray());
-    v->clear();
-    // A little above the given points (on the ground), so the ground does
-    // not hide the line.
-    for (const Vec3& q : p.pathPoints) v->push_back(toOsg(q) + osg::Vec3(0, 0, 0.05f));
-    v->dirty();
-    static_cast<osg::DrawArrays*>(p.path->getPrimitiveSet(0))->setCount(static_cast<GLsizei>(v->size()));
-    p.path->dirtyBound();
+    for (auto [geometry, points] : {std::pair{p.path.get(), &p.pathPoints}, std::pair{p.envelope.get(), &p.envelopePoints}}) {
+      auto* v = static_cast<osg::Vec3Array*>(geometry->getVertexArray());
+      v->clear();
+      // A little above the given points (on the ground), so the ground does
+      // not hide the line.
+      for (const Vec3& q : *points) v->push_back(toOsg(q) + osg::Vec3(0, 0, 0.05f));
+      v->dirty();
+      static_cast<osg::DrawArrays*>(geometry->getPrimitiveSet(0))->setCount(static_cast<GLsizei>(v->size()));
+      geometry->dirtyBound();
+    }
     p.pathDirty = false;
   }
   p.pathNode->setNodeMask(p.visible && hasRobot && p.pathPoints.size() > 1 ? ~0u : 0u);
@@ -733,6 +743,7 @@ void SceneView::setWorld(const WorldModel& world) {
     p->joints = m.joints;
     p->dirty = true;
     p->pathPoints.clear();
+    p->envelopePoints.clear();
     p->pathDirty = true;
   }
   m.laserRanges.clear();
@@ -783,6 +794,10 @@ void SceneView::setRehearsalState(const Pose& base, const std::vector<double>& j
 }
 void SceneView::setRehearsalPath(const std::vector<Vec3>& points) {
   m_->rehearsal.pathPoints = points;
+  m_->rehearsal.pathDirty = true;
+}
+void SceneView::setRehearsalEnvelope(const std::vector<Vec3>& points) {
+  m_->rehearsal.envelopePoints = points;
   m_->rehearsal.pathDirty = true;
 }
 void SceneView::setRehearsalVisible(bool visible) { m_->rehearsal.visible = visible; }

@@ -80,6 +80,8 @@ class SceneView : public QOpenGLWidget {
   /// hidden until setRehearsalVisible(true).
   void setRehearsalState(const Pose& base, const std::vector<double>& jointPositions);
   void setRehearsalPath(const std::vector<Vec3>& points);
+  /// A closed line drawn with the path (the robustness runs' end positions).
+  void setRehearsalEnvelope(const std::vector<Vec3>& points);
   void setRehearsalVisible(bool visible);
   bool rehearsalVisible() const;
   size_t drawnRehearsalPathPoints() const;

@@ -1,0 +1,140 @@
+// The Sequence dock in the console under Xvfb, against its stand-in on
+// loopback: errors inline as you type, a rehearsal from the robot's state
+// with every rule's verdict, the path and the amber robot in the 3D view, the
+// scrubber, Send only for an unchanged passed sequence, and the robot
+// running it to the end under the guard.
+
+#include <QDockWidget>
+#include <QPushButton>
+#include <QRegularExpression>
+#include <QSettings>
+#include <QSignalSpy>
+#include <QSurfaceFormat>
+#include <QTemporaryDir>
+#include <QTreeWidget>
+#include <QtTest>
+
+#include <cmath>
+
+#include "app/console_session.h"
+#include "app/session_log.h"
+#include "ui/main_window.h"
+#include "ui/scene_view.h"
+#include "ui/sequence_panel.h"
+
+using namespace sp;
+
+class TestSequencePanel : public QObject {
+  Q_OBJECT
+
+ private slots:
+  void initTestCase() {
+    if (QGuiApplication::platformName() == QLatin1String("offscreen"))
+      QSKIP("the 3D view needs an X server: run under xvfb-run");
+    QVERIFY(dir_.isValid());
+    QSettings::setDefaultFormat(QSettings::IniFormat);
+    QSettings::setPath(QSettings::IniFormat, QSettings::UserScope, dir_.filePath(QStringLiteral("settings")));
+    QSettings().clear();
+    options_.world = QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml");
+    options_.logDir = dir_.filePath(QStringLiteral("sessions"));
+    window_ = std::make_unique<MainWindow>(options_);
+    const QString error = window_->start();
+    QVERIFY2(error.isEmpty(), qPrintable(error));
+    window_->resize(1280, 800);
+    window_->show();
+    QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
+    QTRY_VERIFY_WITH_TIMEOUT(window_->lastTelemetry().has_value(), 20000);
+    QTRY_VERIFY_WITH_TIMEOUT(window_->sequencePanel()->sendButton() != nullptr, 1000);
+  }
+  void cleanupTestCase() { window_.reset(); }
+
+  // A typing error is marked on its line as soon as the text is checked;
+  // Rehearse refuses it and says which line.
+  void typoMarkedInline() {
+    SequencePanel* p = window_->sequencePanel();
+    p->setText(QStringLiteral("1.0 drive 0.5 0\n2.0 drvie 0.5 0\n3.0 target knee_fl 120\n"));
+    QCOMPARE(p->markedLines(), (QList<int>{2}));
+    QVERIFY2(p->errors().size() == 1 && p->errors()[0].startsWith("line 2: unknown command 'drvie'"),
+             qPrintable(p->errors().join('\n')));
+    QVERIFY(!p->rehearse());
+    QVERIFY(p->status().contains("line 2"));
+    // Fixed, the limits are checked next: knee_fl's range is [-40, 80] deg.
+    p->setText(QStringLiteral("1.0 drive 0.5 0\n2.0 drive 0.5 0\n3.0 target knee_fl 120\n"));
+    QCOMPARE(p->markedLines(), (QList<int>{3}));
+    QVERIFY(p->errors()[0].contains("outside joint 'knee_fl' limits"));
+  }
+
+  // Criterion: the rehearsal passes with ten verdicts, all passed; the 3D
+  // view draws its path (> 10 points) and the amber robot where the
+  // scrubber is (within 1 mm of the rehearsed base there); an edit disables
+  // Send; sent unchanged, the robot runs it to done with the guard quiet,
+  // and the session log holds the rehearsal and the relay.
+  void rehearseScrubAndSend() {
+    SequencePanel* p = window_->sequencePanel();
+    p->setText(QStringLiteral("0.2 drive 0.5 10\n3.0 stop\n"));
+    QVERIFY(p->errors().isEmpty());
+    QSignalSpy rehearsed(p, &SequencePanel::rehearsed);
+    QTest::mouseClick(p->rehearseButton(), Qt::LeftButton);
+    QVERIFY(rehearsed.wait(30000));
+    QVERIFY2(rehearsed.at(0).at(0).toBool(), qPrintable(p->status()));
+    QCOMPARE(p->verdictList()->topLevelItemCount(), kRuleCount);
+    for (int i = 0; i < kRuleCount; ++i)
+      QVERIFY2(p->result()->verdicts[i].passed, p->result()->verdicts[i].message().c_str());
+    SceneView* scene = window_->sceneView();
+    QTRY_VERIFY(scene->drawnRehearsalPathPoints() > 10);
+    p->scrubTo(2.0);
+    QCOMPARE(p->scrubTime(), 2.0);
+    const std::optional<RehearsalSample> at = p->result()->at(2.0);
+    QVERIFY(at);
+    QTRY_VERIFY(std::hypot(scene->drawnRehearsalBasePose().p.x - at->base.p.x,
+                           scene->drawnRehearsalBasePose().p.y - at->base.p.y) < 1e-3);
+
+    QTRY_VERIFY(p->sendButton()->isEnabled());
+    p->setText(QStringLiteral("0.2 drive 0.5 11\n3.0 stop\n"));
+    QVERIFY(!p->sendButton()->isEnabled());
+    QVERIFY(!p->send());
+    QVERIFY(p->status().contains("changed since its rehearsal"));
+    // Back to the very text rehearsed: it may go (the robot refuses it if
+    // it has moved since, as a stale rehearsal).
+    p->setText(QStringLiteral("0.2 drive 0.5 10\n3.0 stop\n"));
+    QVERIFY(p->sendButton()->isEnabled());
+    QTest::mouseClick(p->sendButton(), Qt::LeftButton);
+    QTRY_COMPARE_WITH_TIMEOUT(p->relay().phase(), SequenceRelay::Phase::Done, 20000);
+    QTest::qWait(2500);  // the guard watches the settling time too
+    QVERIFY2(p->relay().compared() > 50, qPrintable(QString::number(p->relay().compared())));
+    QVERIFY(p->relay().worstPosition() < 0.05);
+    QVERIFY(p->status().contains("done on the robot"));
+
+    // The log: the rehearsals, the relay, the robot's run of it.
+    const QString log = window_->logPath();
+    window_.reset();  // the stand-in stops: its log is complete
+    std::string error;
+    auto reader = SessionLogReader::open(log.toStdString(), error);
+    QVERIFY2(reader, error.c_str());
+    QStringList kinds;
+    for (const LogEvent& e : reader->events()) kinds << QString::fromStdString(e.kind + ": " + e.text);
+    const QString all = kinds.join('\n');
+    QVERIFY2(all.contains(QRegularExpression("rehearsal: [0-9a-f]{16} passed")), qPrintable(all));
+    QVERIFY2(all.contains(QRegularExpression("relay: sent [0-9a-f]{16} \\(2 commands\\)")), qPrintable(all));
+    QVERIFY2(all.contains(QRegularExpression("sequence: done [0-9a-f]{16}")), qPrintable(all));
+  }
+
+ private:
+  QTemporaryDir dir_;
+  ConsoleOptions options_;
+  std::unique_ptr<MainWindow> window_;
+};
+
+int main(int argc, char** argv) {
+  // OpenSceneGraph needs a GL 2.1 compatibility context (see STACK.md).
+  QSurfaceFormat format;
+  format.setVersion(2, 1);
+  format.setProfile(QSurfaceFormat::CompatibilityProfile);
+  format.setDepthBufferSize(24);
+  QSurfaceFormat::setDefaultFormat(format);
+  QApplication app(argc, argv);
+  TestSequencePanel test;
+  return QTest::qExec(&test, argc, argv);
+}
+
+#include "tst_sequence_panel.moc"

@@ -1,0 +1,185 @@
+#pragma once
+// The console's first job: a command sequence is written here, rehearsed on
+// the console's own twin from the robot's current state, and only a sequence
+// that passed is sent to the robot, unchanged. While it runs on board, the
+// guard compares telemetry with the rehearsal and aborts it when the robot
+// departs.
+//
+//   editor      the `.seq` text; errors inline as you type (the line
+//               underlined, the message below), a template per command,
+//               open and save;
+//   rehearse    on a worker thread, with progress and cancel; the verdict of
+//               every flight rule (a failed one seeks the scrubber to its
+//               time); the rehearsed path and an amber robot in the 3D view;
+//               a scrubber over the rehearsal and a plot of its stability
+//               margin, roll and pitch with the scrubber's time marked;
+//   robustness  rules' robust.samples perturbed rehearsals on both cores:
+//               success probability and the spread of the end positions
+//               (their hull drawn with the path);
+//   relay       Send (only after a pass, with the text unchanged since),
+//               the robot's progress, Abort.
+//
+// The panel holds no link: it asks for the start state and sends through
+// the callbacks and signals MainWindow connects (app/sequence_relay.h does
+// the protocol's side).
+//
+// Thread: GUI thread. Rehearsals run on a std::thread of the panel's,
+// cancelled and joined by the destructor.
+
+#include <QString>
+#include <QStringList>
+#include <QWidget>
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <thread>
+
+#include "app/rehearsal.h"
+#include "app/sequence_relay.h"
+#include "net/message.h"
+
+class QLabel;
+class QListWidget;
+class QPlainTextEdit;
+class QProgressBar;
+class QPushButton;
+class QSlider;
+class QTimer;
+class QTreeWidget;
+class QToolButton;
+QT_FORWARD_DECLARE_CLASS(QChartView)
+QT_FORWARD_DECLARE_CLASS(QLineSeries)
+
+namespace sp {
+
+class SequencePanel : public QWidget {
+  Q_OBJECT
+
+ public:
+  explicit SequencePanel(QWidget* parent = nullptr);
+  /// Cancels and joins a rehearsal in progress.
+  ~SequencePanel() override;
+
+  /// The world and parameters rehearsals run on (robots[0] is the robot);
+  /// re-checks the text. Drops the last rehearsal.
+  void setWorld(const WorldModel& world, const SimParams& params);
+  void setRules(const FlightRules& rules);
+  const FlightRules& rules() const { return rules_; }
+  /// Where a rehearsal starts: the robot's state now (nullopt = not known:
+  /// then the world's own start). Called when Rehearse is pressed.
+  void setStartProvider(std::function<std::optional<RehearsalStart>()> provider);
+  /// Whether a sequence may go to the robot now (connected, holding the
+  /// lease, nothing latched).
+  void setLinkReady(bool ready);
+
+  void setText(const QString& text);
+  QString text() const;
+  /// The text's problems, "line N: message" each; empty when it parses and
+  /// passes the robot's limits. Up to date after checkNow().
+  QStringList errors() const { return errors_; }
+  /// Checks the text now (typing checks it 150 ms after the last key).
+  void checkNow();
+  /// The lines marked in the editor.
+  QList<int> markedLines() const;
+
+  /// Starts a rehearsal of the text (false, and the reason in status(), if
+  /// it has errors or one runs). `rehearsed` is emitted when it ends.
+  bool rehearse();
+  /// Starts the robustness rehearsals (needs a passed rehearsal).
+  bool checkRobustness();
+  bool busy() const { return busy_; }
+  /// The last rehearsal, if any (and whether the text is still what it rehearsed).
+  const std::optional<RehearsalResult>& result() const { return result_; }
+  const std::optional<RobustnessResult>& robustnessResult() const { return robust_; }
+  bool rehearsalCurrent() const;
+  /// Sends the rehearsed sequence (false and status() says why if it
+  /// cannot go: not passed, edited since, link not ready).
+  bool send();
+  /// Asks the robot to abort the running sequence.
+  void abort(const QString& reason);
+  const SequenceRelay& relay() const { return relay_; }
+  QString status() const;
+  /// Seeks the scrubber to `time` [s from the sequence's start].
+  void scrubTo(double time);
+  double scrubTime() const;
+
+  QPushButton* rehearseButton() const { return rehearseButton_; }
+  QPushButton* sendButton() const { return sendButton_; }
+  QPushButton* abortButton() const { return abortButton_; }
+  QTreeWidget* verdictList() const { return verdicts_; }
+
+ public slots:
+  /// The robot's SEQUENCE_STATE.
+  void onSequenceState(const sp::net::SequenceStateMsg& state);
+  /// Telemetry: the guard compares it while the sequence runs.
+  void onTelemetry(const sp::net::TelemetryMsg& telemetry);
+
+ signals:
+  void rehearsed(bool passed);
+  void robustnessDone();
+  /// Send this SEQUENCE to the robot.
+  void sendRequested(const sp::net::SequenceMsg& message);
+  /// Send ABORT for `hash`.
+  void abortRequested(const QString& hash, const QString& reason);
+  /// The scrubber moved: draw the rehearsed robot here.
+  void scrubbed(const sp::Pose& base, const std::vector<double>& jointPositions);
+  /// A new rehearsal path (base positions on the ground) and the robustness
+  /// envelope (hull of end positions; empty for none).
+  void pathChanged(const std::vector<sp::Vec3>& path, const std::vector<sp::Vec3>& envelope);
+  /// Something for the session log: kind "rehearsal", "relay" or "guard".
+  void logEvent(const QString& kind, const QString& text);
+  /// The operator must know now (the guard tripped, the robot refused).
+  void alert(const QString& text);
+
+ private:
+  void buildTemplateMenu(QToolButton* button);
+  void openFile();
+  void saveFile();
+  void startWorker(std::function<void()> work);
+  void rehearsalDone(RehearsalPlan plan, RehearsalResult result);
+  void robustnessFinished(RobustnessResult result);
+  void showVerdicts();
+  void showScrub(int index);
+  void updateButtons();
+  void setStatus(const QString& text);
+
+  std::optional<WorldModel> world_;
+  SimParams params_;
+  FlightRules rules_;
+  std::function<std::optional<RehearsalStart>()> startProvider_;
+  bool linkReady_ = false;
+
+  QPlainTextEdit* editor_ = nullptr;
+  QListWidget* errorList_ = nullptr;
+  QTimer* checkTimer_ = nullptr;
+  QStringList errors_;
+  QList<int> marked_;
+  QPushButton* rehearseButton_ = nullptr;
+  QPushButton* robustButton_ = nullptr;
+  QPushButton* cancelButton_ = nullptr;
+  QProgressBar* progress_ = nullptr;
+  QTreeWidget* verdicts_ = nullptr;
+  QSlider* scrubber_ = nullptr;
+  QLabel* scrubLabel_ = nullptr;
+  QChartView* chart_ = nullptr;
+  QLineSeries* marginSeries_ = nullptr;
+  QLineSeries* rollSeries_ = nullptr;
+  QLineSeries* pitchSeries_ = nullptr;
+  QLineSeries* cursor_ = nullptr;
+  QPushButton* sendButton_ = nullptr;
+  QPushButton* abortButton_ = nullptr;
+  QLabel* status_ = nullptr;
+
+  bool busy_ = false;
+  std::atomic<bool> cancel_{false};
+  std::thread worker_;
+  std::optional<RehearsalPlan> plan_;  // of result_
+  std::optional<RehearsalResult> result_;
+  QString rehearsedText_;              // the text result_ rehearsed
+  std::optional<RobustnessResult> robust_;
+  SequenceRelay relay_;
+};
+
+}  // namespace sp
