@@ -163,8 +163,26 @@ RehearsalPlan perturbed(const RehearsalPlan& plan, uint64_t seed) {
     link.mass *= f;
     for (GeomSpec& g : link.geoms) g.mass *= f;
   }
-  if (p.world.terrain.kind == TerrainSpec::Kind::Heightfield && r.robustTerrain > 0)
-    for (double& h : p.world.terrain.grid.heights) h += spread(r.robustTerrain);
+  if (p.world.terrain.kind == TerrainSpec::Kind::Heightfield && r.robustTerrain > 0) {
+    // A smooth random field: offsets drawn every kTerrainCell metres and
+    // interpolated between, so the ground is uncertain the way a survey is,
+    // not jagged (independent noise per 5 cm sample makes 40 % slopes).
+    constexpr double kTerrainCell = 1.0;
+    HeightGrid& g = p.world.terrain.grid;
+    const int nx = static_cast<int>(std::ceil(g.width / kTerrainCell)) + 1;
+    const int ny = static_cast<int>(std::ceil(g.depth / kTerrainCell)) + 1;
+    std::vector<double> coarse(static_cast<size_t>(nx) * ny);
+    for (double& c : coarse) c = spread(r.robustTerrain);
+    for (int j = 0; j < g.rows; ++j)
+      for (int i = 0; i < g.columns; ++i) {
+        const double x = i * g.spacingX() / kTerrainCell, y = j * g.spacingY() / kTerrainCell;
+        const int x0 = std::min(static_cast<int>(x), nx - 2), y0 = std::min(static_cast<int>(y), ny - 2);
+        const double fx = x - x0, fy = y - y0;
+        auto at = [&](int a, int b) { return coarse[static_cast<size_t>(b) * nx + a]; };
+        g.at(i, j) += (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) +
+                      fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1));
+      }
+  }
   const double dx = spread(r.robustStartPosition), dy = spread(r.robustStartPosition);
   const double dyaw = degToRad(spread(r.robustStartHeading));
   Pose& base = p.start ? p.start->base : p.world.robots[0].pose;

@@ -338,11 +338,17 @@ void RuleMonitor::check(const World& world) {
       w.offSince = -1;
     } else {
       const double ground = world.terrainHeight(p.p.x, p.p.y);
-      if (p.p.z - radius - ground < rules_.supportGap) support.push_back({p.p.x, p.p.y, ground});
-      if (w.offSince < 0) w.offSince = t;
-      if (t - w.offSince > longestOff) {
-        longestOff = t - w.offSince;
-        offWheel = w.name;
+      // Rocking on rough ground leaves a wheel a few millimetres up: it still
+      // supports the robot and has not lifted off.
+      if (p.p.z - radius - ground < rules_.supportGap) {
+        support.push_back({p.p.x, p.p.y, ground});
+        w.offSince = -1;
+      } else {
+        if (w.offSince < 0) w.offSince = t;
+        if (t - w.offSince > longestOff) {
+          longestOff = t - w.offSince;
+          offWheel = w.name;
+        }
       }
     }
     if (w.sensor >= 0) {

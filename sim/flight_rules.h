@@ -37,7 +37,7 @@ struct FlightRules {
   /// Joints that may run to their stops (grippers open and close on them);
   /// comma-separated names, or "none".
   std::string jointLimitExempt = "finger_l1,finger_l2,finger_r1,finger_r2";
-  double maxLiftoff = 1.5;           ///< [s] longest time a drive wheel may be off the ground
+  double maxLiftoff = 1.5;           ///< [s] longest time a drive wheel may be higher than supportGap
   double maxWheelForce = 4000;       ///< [N] normal force on one wheel
   /// Links that may touch objects (grippers picking up); comma-separated
   /// names, or "none". No link but the drive wheels may touch the ground.
@@ -56,7 +56,7 @@ struct FlightRules {
   int robustSamples = 16;
   double robustFriction = 0.3;       ///< relative +- on every contact's friction
   double robustMass = 0.1;           ///< relative +- on every link's mass
-  double robustTerrain = 0.01;       ///< [m] +- added to every heightfield sample
+  double robustTerrain = 0.01;       ///< [m] +- of a smooth random field (1 m cells) added to the heightfield
   double robustStartPosition = 0.05; ///< [m] +- on the start's x and y
   double robustStartHeading = 2;     ///< [deg] +- on the start's heading
 };

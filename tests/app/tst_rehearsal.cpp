@@ -93,6 +93,27 @@ class TestRehearsal : public QObject {
     QVERIFY(verdict(drive, Rule::Stability).worst > plan.rules.minStabilityMargin);
   }
 
+  // Criterion: with friction, masses, terrain and start perturbed within
+  // the default ranges, the test-track drive passes every sample and the
+  // tipping sequence (the control) none; the samples land the same on one
+  // thread and on two (each is seeded by its index).
+  void robustnessSeparatesSafeFromTipping() {
+    RehearsalPlan plan{loadOrFail("terrains/test_track.world.xml"), {}, {}, {}, {}};
+    plan.rules.settle = 5;
+    plan.rules.robustSamples = 4;
+    plan.commands = parseOrFail(kDrive, plan.world.robots[0].model);
+    const RobustnessResult safe = robustness(plan, 7, 2);
+    const RobustnessResult safeOne = robustness(plan, 7, 1);
+    qInfo("drive: %d of %d passed, end spread %.3f m", safe.passed, safe.samples, safe.spread);
+    QCOMPARE(safe.passed, 4);
+    QVERIFY(safe.spread > 0);  // the perturbations do move the robot
+    for (int i = 0; i < 4; ++i) QCOMPARE(safe.endPoses[i].p, safeOne.endPoses[i].p);
+    plan.commands = parseOrFail(kTip, plan.world.robots[0].model);
+    const RobustnessResult tip = robustness(plan, 7, 2);
+    qInfo("tipping: %d of %d passed; sample 0: %s", tip.passed, tip.samples, tip.failures[0].c_str());
+    QCOMPARE(tip.passed, 0);
+  }
+
   void rulesFileErrorsNameTheirLines() {
     FlightRules rules;
     Diagnostics diag;
