@@ -11,6 +11,7 @@
 #include "sim/hash.h"
 #include "sim/kinematics.h"
 #include "sim/random.h"
+#include "sim/rigid.h"
 #include "sim/runner.h"
 #include "sim/text.h"
 #include "sim/world.h"
@@ -36,13 +37,16 @@ void holdStartPose(World& world) {
   }
 }
 
-RehearsalSample sampleOf(const World& world, double margin) {
+// `rigid` (may be null): the held robot the world runs; joints are reported
+// as the full robot's.
+RehearsalSample sampleOf(const World& world, double margin, const RigidRobot* rigid) {
   RehearsalSample s;
   s.time = world.time();
   s.base = world.linkPose(0, 0);
   const RobotModel& robot = world.robotModel(0);
   s.jointPositions.resize(robot.joints.size());
   for (size_t j = 0; j < robot.joints.size(); ++j) s.jointPositions[j] = world.jointPosition(0, static_cast<int>(j));
+  if (rigid) s.jointPositions = fullJoints(*rigid, s.jointPositions);
   const Vec3 up = rotate(conjugate(s.base.q), {0, 0, 1});
   s.roll = std::atan2(up.y, up.z);
   s.pitch = std::atan2(-up.x, std::hypot(up.y, up.z));
@@ -83,6 +87,37 @@ std::optional<RehearsalSample> RehearsalResult::at(double time) const {
   return s;
 }
 
+std::vector<int> unmovedJoints(const RobotModel& robot, const std::vector<TimedCommand>& commands) {
+  std::vector<bool> moved(robot.joints.size(), false);
+  auto mark = [&](const std::string& name) {
+    if (const int j = robot.findJoint(name); j >= 0) moved[static_cast<size_t>(j)] = true;
+  };
+  for (const TimedCommand& c : commands)
+    std::visit(
+        [&](const auto& cmd) {
+          if constexpr (requires { cmd.joint; }) mark(cmd.joint);
+        },
+        c.command);
+  if (robot.drive) {
+    if (robot.drive->articulation >= 0) moved[static_cast<size_t>(robot.drive->articulation)] = true;
+    for (int w : robot.drive->wheels)
+      if (w >= 0) moved[static_cast<size_t>(w)] = true;
+  }
+  std::vector<int> held;
+  std::vector<bool> taken(robot.joints.size(), false);
+  for (size_t j = 0; j < robot.joints.size(); ++j) {
+    if (taken[j]) continue;
+    const std::vector<int> sub = subtreeJoints(robot, robot.joints[j].name);
+    if (std::any_of(sub.begin(), sub.end(), [&](int k) { return moved[static_cast<size_t>(k)]; })) continue;
+    for (int k : sub) {
+      taken[static_cast<size_t>(k)] = true;
+      held.push_back(k);
+    }
+  }
+  std::sort(held.begin(), held.end());
+  return held;
+}
+
 RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress) {
   const auto t0 = Clock::now();
   RehearsalResult result;
@@ -90,22 +125,39 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
     result.error = "the world has no robot";
     return result;
   }
+  const RobotModel& full = plan.world.robots[0].model;
+  if (plan.start && (plan.start->jointPositions.size() != full.joints.size() ||
+                     plan.start->jointRates.size() != full.joints.size())) {
+    result.error = "the start state has " + std::to_string(plan.start->jointPositions.size()) +
+                   " joints, the robot " + std::to_string(full.joints.size());
+    return result;
+  }
+  // The joints the sequence leaves alone, welded where the start has them.
+  std::optional<RigidRobot> rigid;
+  WorldModel model = plan.world;
+  if (plan.holdUnmoved) {
+    const std::vector<int> held = unmovedJoints(full, plan.commands);
+    std::string why;
+    const std::vector<double> at = plan.start ? plan.start->jointPositions : std::vector<double>(full.joints.size(), 0.0);
+    if (!held.empty() && (rigid = holdRigid(full, at, held, why))) {
+      model.robots[0].model = rigid->model;
+      result.heldJoints = static_cast<int>(held.size());
+    }
+  }
   Diagnostics diag;
-  std::unique_ptr<World> world = World::create(plan.world, plan.params, diag);
+  std::unique_ptr<World> world = World::create(model, plan.params, diag);
   if (!world) {
     result.error = "cannot build the twin: " + diag.format();
     return result;
   }
   const RobotModel& robot = world->robotModel(0);
+  const RigidRobot* held = rigid ? &*rigid : nullptr;
   if (plan.start) {
     const RehearsalStart& s = *plan.start;
-    if (s.jointPositions.size() != robot.joints.size() || s.jointRates.size() != robot.joints.size()) {
-      result.error = "the start state has " + std::to_string(s.jointPositions.size()) + " joints, the robot " +
-                     std::to_string(robot.joints.size());
-      return result;
-    }
-    const std::string why = world->setRobotMotion(
-        0, linkMotions(robot, s.base, s.baseLinear, s.baseAngular, s.jointPositions, s.jointRates), s.objects);
+    const std::vector<double> q = held ? rigidJoints(*held, s.jointPositions) : s.jointPositions;
+    const std::vector<double> dq = held ? rigidJoints(*held, s.jointRates) : s.jointRates;
+    const std::string why =
+        world->setRobotMotion(0, linkMotions(robot, s.base, s.baseLinear, s.baseAngular, q, dq), s.objects);
     if (!why.empty()) {
       result.error = "the start state does not fit: " + why;
       return result;
@@ -119,11 +171,11 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   const int64_t total = std::max<int64_t>(1, std::llround(result.duration / plan.params.step));
   const int64_t sampleEvery = std::max<int64_t>(1, std::llround(RehearsalResult::kSampleInterval / plan.params.step));
   const int64_t progressEvery = std::max<int64_t>(1, total / 100);
-  result.path.push_back(sampleOf(*world, 0));
+  result.path.push_back(sampleOf(*world, 0, held));
   runner.setMonitor([&](const World& w) {
     monitor.check(w);
     const int64_t n = w.stepCount();
-    if (n % sampleEvery == 0) result.path.push_back(sampleOf(w, monitor.margin()));
+    if (n % sampleEvery == 0) result.path.push_back(sampleOf(w, monitor.margin(), held));
     if (progress && n % progressEvery == 0 && !progress(static_cast<double>(n) / static_cast<double>(total))) {
       result.cancelled = true;
       return false;

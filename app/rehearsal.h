@@ -49,7 +49,15 @@ struct RehearsalPlan {
   std::vector<TimedCommand> commands;  ///< times from the start, non-decreasing
   /// nullopt = the world's own initial state (the stand-in at rest).
   std::optional<RehearsalStart> start;
+  /// Hold rigid the joints no command of the sequence moves (whole
+  /// subtrees without drive joints: an arm, the head; sim/rigid.h), for
+  /// speed: fewer bodies, the same mass and centre of mass.
+  bool holdUnmoved = true;
 };
+
+/// The joints `commands` leave alone, as held subtrees: every joint whose
+/// subtree holds no commanded joint and no drive joint, outermost first.
+std::vector<int> unmovedJoints(const RobotModel& robot, const std::vector<TimedCommand>& commands);
 
 /// The robot's state every RehearsalResult::kSampleInterval.
 struct RehearsalSample {
@@ -71,6 +79,7 @@ struct RehearsalResult {
   double duration = 0;     ///< [s] simulated: last command's time + rules.settle
   double wallSeconds = 0;  ///< what it took
   uint64_t endHash = 0;    ///< World::stateHash() at the end
+  int heldJoints = 0;      ///< joints held rigid (plan.holdUnmoved)
   /// The first failed rule's one-line message, or "passed".
   std::string summary() const;
   /// The rehearsed state at `time` [s from the start], interpolated

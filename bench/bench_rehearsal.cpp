@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <thread>
@@ -63,8 +64,8 @@ int main(int argc, char** argv) {
   const std::string root = SP_SOURCE_DIR;
   std::printf("SimPartner rehearsal benchmark: median of %d, the machine's %u hardware threads\n", rounds,
               std::thread::hardware_concurrency());
-  std::printf("%-11s %10s %12s %12s %10s %8s\n", "world", "simulated", "rehearse [s]", "bare run [s]", "rules cost",
-              "verdict");
+  std::printf("%-11s %10s %12s %12s %10s %14s %8s %22s\n", "world", "simulated", "rehearse [s]", "bare run [s]",
+              "rules cost", "held rigid [s]", "speed-up", "held vs full at the end");
   for (const auto& [name, file, text] :
        {std::tuple{"flat", root + "/terrains/flat.world.xml", kFlat},
         std::tuple{"test track", root + "/terrains/test_track.world.xml", kTrack}}) {
@@ -76,11 +77,15 @@ int main(int argc, char** argv) {
       return 1;
     }
     RehearsalPlan plan{*world, {}, {}, *commands, std::nullopt};
-    std::vector<double> rehearsal, bare;
-    RehearsalResult last;
+    RehearsalPlan heldPlan = plan;
+    plan.holdUnmoved = false;
+    std::vector<double> rehearsal, bare, heldTimes;
+    RehearsalResult last, held;
     for (int r = 0; r < rounds; ++r) {
       last = rehearse(plan);
       rehearsal.push_back(last.wallSeconds);
+      held = rehearse(heldPlan);
+      heldTimes.push_back(held.wallSeconds);
       // The same steps without rules or samples: World and Runner alone.
       const auto t0 = Clock::now();
       auto w = World::create(plan.world, plan.params, diag);
@@ -89,9 +94,14 @@ int main(int argc, char** argv) {
       runner.advanceToTime(last.duration);
       bare.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
     }
-    const double a = median(rehearsal), b = median(bare);
-    std::printf("%-11s %8.0f s %12.2f %12.2f %9.2fx %8s\n", name, last.duration, a, b, a / b,
-                last.passed ? "passed" : "failed");
+    const double a = median(rehearsal), b = median(bare), h = median(heldTimes);
+    const Pose& pa = last.path.back().base;
+    const Pose& ph = held.path.back().base;
+    const double dyaw = radToDeg(std::abs(std::remainder(heading(pa.q) - heading(ph.q), 2 * kPi)));
+    std::printf("%-11s %8.0f s %12.2f %12.2f %9.2fx %14.2f %7.2fx %8.1f mm, %5.2f deg  %s (%d held)\n", name, last.duration,
+                a, b, a / b, h, a / h, 1000 * std::hypot(pa.p.x - ph.p.x, pa.p.y - ph.p.y), dyaw,
+                last.passed == held.passed ? (last.passed ? "both passed" : "both failed") : "VERDICTS DIFFER",
+                held.heldJoints);
     if (!last.passed) std::printf("            %s\n", last.summary().c_str());
   }
 

@@ -7,11 +7,13 @@
 #include <QTemporaryDir>
 #include <QtTest>
 
+#include <algorithm>
 #include <cmath>
 
 #include "app/rehearsal.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
+#include "sim/rigid.h"
 #include "tests/test_files.h"
 
 using namespace sp;
@@ -112,6 +114,37 @@ class TestRehearsal : public QObject {
     const RobustnessResult tip = robustness(plan, 7, 2);
     qInfo("tipping: %d of %d passed; sample 0: %s", tip.passed, tip.samples, tip.failures[0].c_str());
     QCOMPARE(tip.passed, 0);
+  }
+
+  // Holding the joints no command moves is a speed lever, not another
+  // physics: criterion, the held rehearsal of the test-track drive ends
+  // within 1 cm and 0.1 deg of the full one with the same verdicts, having
+  // held the upper body (a drive commands no arm joint); a sequence that
+  // moves an arm keeps that arm's joints.
+  void heldRehearsalMatchesTheFullOne() {
+    RehearsalPlan plan{loadOrFail("terrains/test_track.world.xml"), {}, {}, {}, {}};
+    const RobotModel& robot = plan.world.robots[0].model;
+    plan.commands = parseOrFail("0.5 drive 0.4 0\n4 drive 0.4 8\n", robot);
+    plan.rules.settle = 4;
+    const RehearsalResult held = rehearse(plan);
+    plan.holdUnmoved = false;
+    const RehearsalResult full = rehearse(plan);
+    QCOMPARE(held.heldJoints, static_cast<int>(subtreeJoints(robot, "waist_yaw").size()));
+    QCOMPARE(full.heldJoints, 0);
+    const Pose a = held.path.back().base, b = full.path.back().base;
+    qInfo("held %d joints: %.2f s vs %.2f s; ends %.2f mm, %.4f deg apart", held.heldJoints, held.wallSeconds,
+          full.wallSeconds, 1000 * std::hypot(a.p.x - b.p.x, a.p.y - b.p.y),
+          radToDeg(std::abs(std::remainder(heading(a.q) - heading(b.q), 2 * kPi))));
+    QVERIFY(std::hypot(a.p.x - b.p.x, a.p.y - b.p.y) < 0.01);
+    QVERIFY(std::abs(std::remainder(heading(a.q) - heading(b.q), 2 * kPi)) < degToRad(0.1));
+    for (int i = 0; i < kRuleCount; ++i) QCOMPARE(held.verdicts[i].passed, full.verdicts[i].passed);
+    QCOMPARE(held.path.back().jointPositions.size(), robot.joints.size());  // reported as the full robot's
+
+    const std::vector<int> moved = unmovedJoints(robot, parseOrFail("1 target elbow_l 30\n", robot));
+    QVERIFY(std::find(moved.begin(), moved.end(), robot.findJoint("elbow_l")) == moved.end());
+    QVERIFY(std::find(moved.begin(), moved.end(), robot.findJoint("waist_yaw")) == moved.end());  // above the elbow
+    QVERIFY(std::find(moved.begin(), moved.end(), robot.findJoint("head_pan")) != moved.end());
+    QVERIFY(std::find(moved.begin(), moved.end(), robot.findJoint("elbow_r")) != moved.end());
   }
 
   void rulesFileErrorsNameTheirLines() {
