@@ -300,7 +300,8 @@ void MainWindow::buildDocks() {
   connect(sequence_, &SequencePanel::sendRequested, connection_, &RobotConnection::sendSequence);
   connect(sequence_, &SequencePanel::abortRequested, connection_, &RobotConnection::abortSequence);
   connect(connection_, &RobotConnection::sequenceState, sequence_, &SequencePanel::onSequenceState);
-  connect(connection_, &RobotConnection::telemetry, sequence_, &SequencePanel::onTelemetry);
+  sequence_->setGuard(connection_->guard());
+  connect(connection_, &RobotConnection::guardTripped, sequence_, &SequencePanel::onGuardTripped);
   connect(sequence_, &SequencePanel::scrubbed, this, [this](const Pose& base, const std::vector<double>& joints) {
     scene_->setRehearsalState(base, joints);
     scene_->setRehearsalVisible(true);

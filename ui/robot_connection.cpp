@@ -25,12 +25,23 @@ void RobotConnection::open(const net::RobotClientConfig& config) {
   net::RobotClientCallbacks callbacks;
   // Each callback copies its message into a queued call: the worker thread
   // never waits on the GUI thread.
-  callbacks.telemetry = [this](const net::TelemetryMsg& m) { post([this, m] { emit telemetry(m); }); };
+  callbacks.telemetry = [this](const net::TelemetryMsg& m) {
+    // The guard first, here on the worker: its ABORT must not wait for the window.
+    if (std::optional<GuardDeparture> d = guard_->telemetry(m)) {
+      const std::string hash = guard_->snapshot().hash();
+      client_->abortSequence(hash, "guard: " + d->message());
+      post([this, h = QString::fromStdString(hash), d = *d] { emit guardTripped(h, d); });
+    }
+    post([this, m] { emit telemetry(m); });
+  };
   callbacks.laser = [this](const net::LaserMsg& m) { post([this, m] { emit laser(m); }); };
   callbacks.reply = [this](const net::ReplyMsg& m) { post([this, m] { emit reply(m); }); };
   callbacks.event = [this](const net::EventMsg& m) { post([this, m] { emit event(m); }); };
   callbacks.lease = [this](const net::LeaseStateMsg& m) { post([this, m] { emit lease(m); }); };
-  callbacks.sequence = [this](const net::SequenceStateMsg& m) { post([this, m] { emit sequenceState(m); }); };
+  callbacks.sequence = [this](const net::SequenceStateMsg& m) {
+    guard_->state(m);
+    post([this, m] { emit sequenceState(m); });
+  };
   callbacks.connection = [this](net::ConnectionState s, const std::string& detail) {
     post([this, s, d = QString::fromStdString(detail)] { emit connectionChanged(s, d); });
   };

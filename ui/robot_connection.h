@@ -11,6 +11,7 @@
 
 #include <memory>
 
+#include "app/sequence_guard.h"
 #include "net/robot_client.h"
 
 namespace sp {
@@ -37,6 +38,9 @@ class RobotConnection : public QObject {
   /// when not open (then `reply` is emitted with status Failed at once).
   uint64_t send(const Command& command, const RobotModel* robot);
   void estop(const QString& reason);
+  /// The guard of relayed sequences: fed on the client's worker thread,
+  /// which sends ABORT itself when it trips (then guardTripped follows).
+  const std::shared_ptr<SequenceGuard>& guard() const { return guard_; }
   /// SEQUENCE (the answer comes as sequenceState) and ABORT.
   void sendSequence(const net::SequenceMsg& message);
   void abortSequence(const QString& hash, const QString& reason);
@@ -52,6 +56,8 @@ class RobotConnection : public QObject {
   void event(const sp::net::EventMsg& message);
   void lease(const sp::net::LeaseStateMsg& message);
   void sequenceState(const sp::net::SequenceStateMsg& message);
+  /// The guard tripped and ABORT went out (from the worker thread, already).
+  void guardTripped(const QString& hash, const sp::GuardDeparture& departure);
   void connectionChanged(sp::net::ConnectionState state, const QString& detail);
   void linkError(const QString& reason);
 
@@ -62,6 +68,7 @@ class RobotConnection : public QObject {
 
   net::RobotClientConfig config_;
   std::unique_ptr<net::RobotClient> client_;
+  std::shared_ptr<SequenceGuard> guard_ = std::make_shared<SequenceGuard>();
 };
 
 }  // namespace sp

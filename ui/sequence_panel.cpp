@@ -468,56 +468,59 @@ bool SequencePanel::send() {
     setStatus(tr("Not sent: %1").arg(QString::fromStdString(why)));
     return false;
   }
-  relay_.relayed(*msg, *result_, plan_->rules, plan_->world.robots[0].model);
-  emit logEvent("relay", QStringLiteral("sent %1 (%2 commands)").arg(QString::fromStdString(msg->hash)).arg(relay_.count()));
+  guard_->relayed(*msg, *result_, plan_->rules, plan_->world.robots[0].model);
+  emit logEvent("relay", QStringLiteral("sent %1 (%2 commands)").arg(QString::fromStdString(msg->hash)).arg(relay().count()));
   emit sendRequested(*msg);
   setStatus(tr("Sent %1 to the robot; waiting for its answer…").arg(QString::fromStdString(msg->hash)));
   updateButtons();
   return true;
 }
 
+void SequencePanel::setGuard(std::shared_ptr<SequenceGuard> guard) {
+  guard_ = std::move(guard);
+  updateButtons();
+}
+
 void SequencePanel::abort(const QString& reason) {
-  if (relay_.phase() != SequenceRelay::Phase::Running && relay_.phase() != SequenceRelay::Phase::Sent) return;
-  emit abortRequested(QString::fromStdString(relay_.hash()), reason);
-  emit logEvent("relay", QStringLiteral("abort %1: %2").arg(QString::fromStdString(relay_.hash()), reason));
+  const SequenceRelay r = relay();
+  if (r.phase() != SequenceRelay::Phase::Running && r.phase() != SequenceRelay::Phase::Sent) return;
+  emit abortRequested(QString::fromStdString(r.hash()), reason);
+  emit logEvent("relay", QStringLiteral("abort %1: %2").arg(QString::fromStdString(r.hash()), reason));
   setStatus(tr("Abort sent: %1").arg(reason));
 }
 
 void SequencePanel::onSequenceState(const net::SequenceStateMsg& state) {
-  const SequenceRelay::Phase before = relay_.phase();
-  relay_.state(state);
-  if (state.hash != relay_.hash()) return;
-  const QString hash = QString::fromStdString(state.hash);
-  switch (relay_.phase()) {
+  const SequenceRelay r = relay();
+  if (state.hash != r.hash()) return;
+  const QString hash = QString::fromStdString(r.hash());
+  switch (r.phase()) {
     case SequenceRelay::Phase::Running:
-      setStatus(tr("Running %1 on the robot: %2 of %3 commands applied").arg(hash).arg(relay_.index()).arg(relay_.count()));
+      setStatus(tr("Running %1 on the robot: %2 of %3 commands applied").arg(hash).arg(r.index()).arg(r.count()));
       break;
     case SequenceRelay::Phase::Done: setStatus(tr("%1 done on the robot; the guard watches to the rehearsal's end").arg(hash)); break;
     case SequenceRelay::Phase::Refused:
     case SequenceRelay::Phase::Aborted: {
-      const QString what = relay_.phase() == SequenceRelay::Phase::Refused ? tr("refused") : tr("aborted");
-      const QString text = tr("The robot %1 %2: %3").arg(what, hash, QString::fromStdString(relay_.reason()));
+      const QString what = r.phase() == SequenceRelay::Phase::Refused ? tr("refused") : tr("aborted");
+      const QString text = tr("The robot %1 %2: %3").arg(what, hash, QString::fromStdString(r.reason()));
       setStatus(text);
-      if (before != relay_.phase()) emit alert(text);
+      if (shownPhase_ != r.phase()) emit alert(text);
       break;
     }
     default: break;
   }
+  shownPhase_ = r.phase();
   updateButtons();
 }
 
-void SequencePanel::onTelemetry(const net::TelemetryMsg& telemetry) {
-  const std::optional<GuardDeparture> d = relay_.guard(telemetry);
-  if (!d) return;
-  const QString why = QString::fromStdString("guard: " + d->message());
-  emit abortRequested(QString::fromStdString(relay_.hash()), why);
-  emit logEvent("guard", QStringLiteral("%1 at (%2, %3), rehearsed (%4, %5): ABORT sent")
-                             .arg(why)
-                             .arg(d->reported.p.x, 0, 'f', 2)
-                             .arg(d->reported.p.y, 0, 'f', 2)
-                             .arg(d->rehearsed.p.x, 0, 'f', 2)
-                             .arg(d->rehearsed.p.y, 0, 'f', 2));
-  scrubTo(d->time);
+void SequencePanel::onGuardTripped(const QString& hash, const GuardDeparture& d) {
+  const QString why = QString::fromStdString("guard: " + d.message());
+  emit logEvent("guard", QStringLiteral("%1 (sequence %2) at (%3, %4), rehearsed (%5, %6): ABORT sent")
+                             .arg(why, hash)
+                             .arg(d.reported.p.x, 0, 'f', 2)
+                             .arg(d.reported.p.y, 0, 'f', 2)
+                             .arg(d.rehearsed.p.x, 0, 'f', 2)
+                             .arg(d.rehearsed.p.y, 0, 'f', 2));
+  scrubTo(d.time);
   const QString text = tr("Aborted by the guard: %1. The amber robot shows where the rehearsal was.").arg(why);
   setStatus(text);
   emit alert(text);
@@ -528,7 +531,8 @@ QString SequencePanel::status() const { return status_->text(); }
 void SequencePanel::setStatus(const QString& text) { status_->setText(text); }
 
 void SequencePanel::updateButtons() {
-  const bool running = relay_.phase() == SequenceRelay::Phase::Running || relay_.phase() == SequenceRelay::Phase::Sent;
+  const SequenceRelay::Phase phase = relay().phase();
+  const bool running = phase == SequenceRelay::Phase::Running || phase == SequenceRelay::Phase::Sent;
   rehearseButton_->setEnabled(!busy_);
   robustButton_->setEnabled(!busy_ && rehearsalCurrent());
   cancelButton_->setEnabled(busy_);

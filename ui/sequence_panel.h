@@ -37,7 +37,7 @@
 #include <thread>
 
 #include "app/rehearsal.h"
-#include "app/sequence_relay.h"
+#include "app/sequence_guard.h"
 #include "net/message.h"
 
 class QLabel;
@@ -99,7 +99,11 @@ class SequencePanel : public QWidget {
   bool send();
   /// Asks the robot to abort the running sequence.
   void abort(const QString& reason);
-  const SequenceRelay& relay() const { return relay_; }
+  /// The guard the link's worker feeds (RobotConnection::guard()); the
+  /// panel arms it on Send and shows its state.
+  void setGuard(std::shared_ptr<SequenceGuard> guard);
+  /// Where the relayed sequence stands (a copy).
+  SequenceRelay relay() const { return guard_->snapshot(); }
   QString status() const;
   /// Seeks the scrubber to `time` [s from the sequence's start].
   void scrubTo(double time);
@@ -111,17 +115,17 @@ class SequencePanel : public QWidget {
   QTreeWidget* verdictList() const { return verdicts_; }
 
  public slots:
-  /// The robot's SEQUENCE_STATE.
+  /// The robot's SEQUENCE_STATE (after the guard has taken it).
   void onSequenceState(const sp::net::SequenceStateMsg& state);
-  /// Telemetry: the guard compares it while the sequence runs.
-  void onTelemetry(const sp::net::TelemetryMsg& telemetry);
+  /// The guard tripped; its ABORT has gone out already.
+  void onGuardTripped(const QString& hash, const sp::GuardDeparture& departure);
 
  signals:
   void rehearsed(bool passed);
   void robustnessDone();
   /// Send this SEQUENCE to the robot.
   void sendRequested(const sp::net::SequenceMsg& message);
-  /// Send ABORT for `hash`.
+  /// Send ABORT for `hash` (the operator's Abort).
   void abortRequested(const QString& hash, const QString& reason);
   /// The scrubber moved: draw the rehearsed robot here.
   void scrubbed(const sp::Pose& base, const std::vector<double>& jointPositions);
@@ -179,7 +183,8 @@ class SequencePanel : public QWidget {
   std::optional<RehearsalResult> result_;
   QString rehearsedText_;              // the text result_ rehearsed
   std::optional<RobustnessResult> robust_;
-  SequenceRelay relay_;
+  std::shared_ptr<SequenceGuard> guard_ = std::make_shared<SequenceGuard>();
+  SequenceRelay::Phase shownPhase_ = SequenceRelay::Phase::Idle;
 };
 
 }  // namespace sp

@@ -5,6 +5,7 @@
 // running it to the end under the guard.
 
 #include <QDockWidget>
+#include <QFile>
 #include <QPushButton>
 #include <QRegularExpression>
 #include <QSettings>
@@ -14,9 +15,18 @@
 #include <QTreeWidget>
 #include <QtTest>
 
+#include <chrono>
 #include <cmath>
+#include <mutex>
+#include <thread>
 
 #include "app/console_session.h"
+#include "app/sequence_relay.h"
+#include "app/stand_in.h"
+#include "net/robot_client.h"
+#include "sim/command_file.h"
+#include "sim/model_loader.h"
+#include "ui/robot_connection.h"
 #include "app/session_log.h"
 #include "ui/main_window.h"
 #include "ui/scene_view.h"
@@ -47,6 +57,112 @@ class TestSequencePanel : public QObject {
     QTRY_VERIFY_WITH_TIMEOUT(window_->sequencePanel()->sendButton() != nullptr, 1000);
   }
   void cleanupTestCase() { window_.reset(); }
+
+  // Safety path: the guard must not wait on the window. Criterion: with
+  // the GUI thread blocked (sleeping, no events) from the moment the
+  // sequence is sent, a stand-in whose friction was changed behind the
+  // console's back (0.02 instead of 1.0) still reports the sequence aborted
+  // by the guard's ABORT before the GUI thread wakes, 6 s later. A monitor
+  // client on its own thread watches.
+  void guardAbortsWithTheGuiBlocked() {
+    const QString flat = QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml");
+    QFile in(flat);
+    QVERIFY(in.open(QIODevice::ReadOnly));
+    QByteArray xml = in.readAll();
+    xml.replace("mu=\"1.0\"", "mu=\"0.02\"").replace("mu=\"0.8\"", "mu=\"0.02\"");
+    xml.replace("../robots/workpartner.xml", SP_SOURCE_DIR "/robots/workpartner.xml");
+    const QString slippery = dir_.filePath(QStringLiteral("slippery.world.xml"));
+    QFile out(slippery);
+    QVERIFY(out.open(QIODevice::WriteOnly) && out.write(xml) == xml.size());
+    out.close();
+    StandInOptions so;
+    so.worldFile = slippery.toStdString();
+    so.port = 0;
+    so.token = "00112233445566778899aabbccddeeff";
+    so.log = false;
+    Diagnostics diag;
+    auto robot = StandInRobot::create(so, diag);
+    QVERIFY2(robot, diag.format().c_str());
+    QVERIFY(robot->start().empty());
+
+    net::RobotClientConfig config;
+    config.port = robot->port();
+    config.token = so.token;
+    config.name = "guarded console";
+    RobotConnection connection;
+    std::optional<net::TelemetryMsg> last;
+    connect(&connection, &RobotConnection::telemetry, this, [&](const net::TelemetryMsg& t) { last = t; });
+    connection.open(config);
+    connection.acquireLease();
+    QTRY_VERIFY_WITH_TIMEOUT(connection.stats().leaseHeld && last.has_value(), 20000);
+
+    // A monitor on its own thread: when did the robot say "aborted"?
+    std::mutex mutex;
+    std::optional<std::chrono::steady_clock::time_point> abortedAt;
+    std::string reason;
+    std::optional<net::SequenceStateKind> lastState;
+    net::RobotClientConfig mc = config;
+    mc.name = "monitor";
+    mc.role = net::Role::Monitor;
+    net::RobotClientCallbacks cb;
+    cb.sequence = [&](const net::SequenceStateMsg& m) {
+      std::lock_guard lock(mutex);
+      lastState = m.state;
+      if (m.state == net::SequenceStateKind::Aborted && !abortedAt) {
+        abortedAt = std::chrono::steady_clock::now();
+        reason = m.reason;
+      }
+    };
+    net::RobotClient monitor(mc, cb);
+    monitor.start();
+    QTRY_VERIFY_WITH_TIMEOUT(monitor.stats().connected, 20000);
+
+    Diagnostics d2;
+    const WorldModel world = *loadWorld(flat.toStdString(), d2);  // what the console believes
+    RehearsalPlan plan{world, {}, {}, {}, {}};
+    plan.commands = *parseCommandSequence("0.2 drive 1.0 20\n8 stop\n", "s.seq", d2, &world.robots[0].model);
+    std::string why;
+    plan.start = startFromTelemetry(*last, world.robots[0].model, why);
+    const RehearsalResult result = rehearse(plan);
+    QVERIFY(result.passed);
+    const std::optional<net::SequenceMsg> msg = sequenceMessage(plan, result, why);
+    QVERIFY(msg);
+    connection.guard()->relayed(*msg, result, plan.rules, world.robots[0].model);
+    connection.sendSequence(*msg);
+    std::this_thread::sleep_for(std::chrono::seconds(6));  // the GUI thread blocked: no event is processed
+    const auto woke = std::chrono::steady_clock::now();
+    {
+      std::lock_guard lock(mutex);
+      QVERIFY2(abortedAt.has_value(), "the robot must have aborted while the GUI thread slept");
+      QVERIFY(*abortedAt < woke);
+      qInfo("aborted while the GUI slept: %s", reason.c_str());
+      QVERIFY(reason.find("ABORT from 'guarded console': guard: ") != std::string::npos);
+    }
+    QSignalSpy tripped(&connection, &RobotConnection::guardTripped);
+    QTRY_COMPARE(tripped.size(), 1);  // the window hears of it once it runs again
+
+    // The control: the same departure with the guard not armed for it goes
+    // on while the GUI sleeps (nothing else aborts it).
+    QTRY_VERIFY_WITH_TIMEOUT(std::hypot(last->baseVelocity[0], last->baseVelocity[1]) < 0.02, 20000);
+    plan.start = startFromTelemetry(*last, world.robots[0].model, why);
+    const RehearsalResult again = rehearse(plan);
+    const std::optional<net::SequenceMsg> second = sequenceMessage(plan, again, why);
+    QVERIFY(second && second->hash == msg->hash);  // the same text: the same hash
+    {
+      std::lock_guard lock(mutex);
+      abortedAt.reset();
+    }
+    connection.sendSequence(*second);
+    std::this_thread::sleep_for(std::chrono::seconds(6));
+    {
+      std::lock_guard lock(mutex);
+      QVERIFY2(!abortedAt.has_value(), reason.c_str());
+      QVERIFY(lastState == net::SequenceStateKind::Running);  // it runs, unguarded: the control is not vacuous
+    }
+    monitor.stop();
+    connection.close();
+    robot->stop();
+  }
 
   // A typing error is marked on its line as soon as the text is checked;
   // Rehearse refuses it and says which line.
