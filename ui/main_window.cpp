@@ -18,6 +18,7 @@
 #include <QLabel>
 #include <QMenuBar>
 #include <QMessageBox>
+#include <QScrollArea>
 #include <QSettings>
 #include <QSplitter>
 #include <QStandardPaths>
@@ -285,7 +286,12 @@ void MainWindow::buildDocks() {
   sequence_ = new SequencePanel;
   sequenceDock_ = new QDockWidget(tr("Sequence"), this);
   sequenceDock_->setObjectName(QStringLiteral("sequenceDock"));
-  sequenceDock_->setWidget(sequence_);
+  // Scrolled: its plot and lists must not make the window taller than the screen.
+  auto* scroll = new QScrollArea;
+  scroll->setWidgetResizable(true);
+  scroll->setFrameShape(QFrame::NoFrame);
+  scroll->setWidget(sequence_);
+  sequenceDock_->setWidget(scroll);
   tabifyDockWidget(controlsDock_, sequenceDock_);
   controlsDock_->raise();
   sequence_->setStartProvider([this]() -> std::optional<RehearsalStart> {
