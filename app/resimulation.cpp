@@ -30,10 +30,8 @@ std::string hashHex(uint64_t hash) {
   return text;
 }
 
-std::optional<ResimReport> resimulate(const std::string& path, const ResimOptions& options, std::string& error) {
-  std::unique_ptr<SessionLogReader> reader = SessionLogReader::open(path, error);
-  if (!reader) return std::nullopt;
-  const std::map<std::string, std::string> meta = reader->meta();
+std::optional<LoggedWorld> loggedWorld(const SessionLogReader& reader, const std::string& path, std::string& error) {
+  const std::map<std::string, std::string> meta = reader.meta();
   const std::string worldName = get(meta, "world_file");
   const std::string robotName = get(meta, "robot_file");
   if (worldName.empty() || !meta.count("world_contents") || robotName.empty() || !meta.count("robot_contents")) {
@@ -64,12 +62,22 @@ std::optional<ResimReport> resimulate(const std::string& path, const ResimOption
     error = path + ": cannot load the logged parameters:\n" + diag.format();
     return std::nullopt;
   }
-  for (const LogEvent& e : reader->events())
+  for (const LogEvent& e : reader.events())
     if (e.kind == "param_override" && !applyOverride(params, e.text, diag)) {
       error = path + ": cannot apply the logged override '" + e.text + "':\n" + diag.format();
       return std::nullopt;
     }
+  return LoggedWorld{std::move(*model), params};
+}
 
+std::optional<ResimReport> resimulate(const std::string& path, const ResimOptions& options, std::string& error) {
+  std::unique_ptr<SessionLogReader> reader = SessionLogReader::open(path, error);
+  if (!reader) return std::nullopt;
+  std::optional<LoggedWorld> logged = loggedWorld(*reader, path, error);
+  if (!logged) return std::nullopt;
+  std::optional<WorldModel> model = std::move(logged->world);
+  const SimParams params = logged->params;
+  Diagnostics diag;
   std::unique_ptr<World> world = World::create(*model, params, diag);
   if (!world) {
     error = path + ": cannot build the logged world:\n" + diag.format();

@@ -17,7 +17,22 @@
 #include <optional>
 #include <string>
 
+#include "sim/params.h"
+#include "sim/robot_model.h"
+
 namespace sp {
+
+class SessionLogReader;
+
+/// The world and parameters a log was recorded with, rebuilt from the files
+/// it stores (see above) and its parameter overrides.
+struct LoggedWorld {
+  WorldModel world;
+  SimParams params;
+};
+/// nullopt and `error` (naming `path`) when the log holds no files or they
+/// do not load.
+std::optional<LoggedWorld> loggedWorld(const SessionLogReader& reader, const std::string& path, std::string& error);
 
 struct ResimOptions {
   double from = 0;  ///< start at the latest snapshot at or before this sim time [s]

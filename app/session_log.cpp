@@ -421,28 +421,53 @@ std::vector<std::pair<std::string, int64_t>> SessionLogReader::streams() const {
   return out;
 }
 
+namespace {
+
+constexpr const char* kSampleColumns =
+    "SELECT step, time, base_x, base_y, base_z, qw, qx, qy, qz, joints, wheel_normal, roll, pitch FROM samples ";
+
+LogSample readSample(Stmt& q) {
+  LogSample s;
+  s.step = q.i64(0);
+  s.time = q.f64(1);
+  for (int i = 0; i < 3; ++i) s.base[static_cast<std::size_t>(i)] = q.f64(2 + i);
+  for (int i = 0; i < 4; ++i) s.quat[static_cast<std::size_t>(i)] = q.f64(5 + i);
+  s.joints = q.doubles(9);
+  std::vector<double> wheels = q.doubles(10);
+  for (std::size_t i = 0; i < 4 && i < wheels.size(); ++i) s.wheelNormal[i] = wheels[i];
+  s.roll = q.f64(11);
+  s.pitch = q.f64(12);
+  return s;
+}
+
+}  // namespace
+
 std::vector<LogSample> SessionLogReader::samplesBetween(double t0, double t1) const {
   std::vector<LogSample> out;
-  Stmt q(db_,
-         "SELECT step, time, base_x, base_y, base_z, qw, qx, qy, qz, joints, wheel_normal, roll, pitch "
-         "FROM samples INDEXED BY samples_time WHERE time >= ? AND time <= ? ORDER BY time, step");
+  Stmt q(db_, (std::string(kSampleColumns) + "INDEXED BY samples_time WHERE time >= ? AND time <= ? ORDER BY time, step")
+                  .c_str());
   if (!q) return out;
   q.bind(1, t0);
   q.bind(2, t1);
-  while (q.row()) {
-    LogSample s;
-    s.step = q.i64(0);
-    s.time = q.f64(1);
-    for (int i = 0; i < 3; ++i) s.base[static_cast<std::size_t>(i)] = q.f64(2 + i);
-    for (int i = 0; i < 4; ++i) s.quat[static_cast<std::size_t>(i)] = q.f64(5 + i);
-    s.joints = q.doubles(9);
-    std::vector<double> wheels = q.doubles(10);
-    for (std::size_t i = 0; i < 4 && i < wheels.size(); ++i) s.wheelNormal[i] = wheels[i];
-    s.roll = q.f64(11);
-    s.pitch = q.f64(12);
-    out.push_back(std::move(s));
-  }
+  while (q.row()) out.push_back(readSample(q));
   return out;
+}
+
+std::optional<LogSample> SessionLogReader::sampleAt(double time) const {
+  // One row from the time index, whatever the log's length.
+  Stmt q(db_,
+         (std::string(kSampleColumns) + "INDEXED BY samples_time WHERE time <= ? ORDER BY time DESC, step DESC LIMIT 1")
+             .c_str());
+  if (!q) return std::nullopt;
+  q.bind(1, time);
+  if (!q.row()) return std::nullopt;
+  return readSample(q);
+}
+
+std::optional<std::pair<double, double>> SessionLogReader::sampleTimeRange() const {
+  Stmt q(db_, "SELECT MIN(time), MAX(time), COUNT(*) > 0 FROM samples");
+  if (!q || !q.row() || q.i64(2) == 0) return std::nullopt;
+  return std::pair{q.f64(0), q.f64(1)};
 }
 
 std::vector<LogLaser> SessionLogReader::laserBetween(double t0, double t1) const {

@@ -217,6 +217,11 @@ class SessionLogReader {
   std::vector<std::pair<std::string, int64_t>> streams() const;
   /// Samples with t0 <= time <= t1 [s], in step order (uses the time index).
   std::vector<LogSample> samplesBetween(double t0, double t1) const;
+  /// The latest sample at or before `time` (one row from the time index);
+  /// nullopt before the first.
+  std::optional<LogSample> sampleAt(double time) const;
+  /// The first and last sample times; nullopt without samples.
+  std::optional<std::pair<double, double>> sampleTimeRange() const;
   /// Laser scans with t0 <= time <= t1 [s], in step order (uses the time
   /// index where the log has one: logs since laser_time was added).
   std::vector<LogLaser> laserBetween(double t0, double t1) const;

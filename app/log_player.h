@@ -1,0 +1,58 @@
+#pragma once
+// Replaying a session log (issue 15): the robot as the log says it was at
+// any time, for the console's replay feed and for tests. Opens the log,
+// rebuilds the logged world from the files the log stores (as re-simulation
+// does), and answers "the state at time t" with one row from the samples'
+// time index, so a seek costs the same in a one-hour log as in a short one.
+// Logs of remote robots (telemetry only) have samples too and replay the same.
+//
+//   std::string error;
+//   auto player = sp::LogPlayer::open(path, error);
+//   if (!player) show(error);
+//   for (const sp::LogEvent& e : player->events()) timeline.mark(e.time, e.kind);
+//   if (auto f = player->frameAt(t)) scene.setRobotState(f->base, f->jointPositions);
+//
+// Thread: one at a time (it owns a SessionLogReader).
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/resimulation.h"
+#include "app/robot_frame.h"
+#include "app/session_log.h"
+
+namespace sp {
+
+class LogPlayer {
+ public:
+  /// nullptr and `error` (naming the file) when it is not a log, holds no
+  /// samples, or its world cannot be rebuilt.
+  static std::unique_ptr<LogPlayer> open(const std::string& path, std::string& error);
+
+  const std::string& path() const { return path_; }
+  /// The logged world (robots[0] is the robot the samples describe).
+  const WorldModel& world() const { return logged_.world; }
+  /// First and last sample times [s].
+  double startTime() const { return start_; }
+  double endTime() const { return end_; }
+  /// Every logged event, in step order (links, notes, rehearsals, ...).
+  const std::vector<LogEvent>& events() const { return events_; }
+  /// The logged state at `time`: the latest sample at or before it (the
+  /// first one before the log's start); joints in the model's order.
+  std::optional<RobotFrame> frameAt(double time) const;
+  /// The latest laser scan at or before `time`, if one is within 1 s.
+  std::optional<LaserFrame> laserAt(double time) const;
+
+ private:
+  LogPlayer() = default;
+
+  std::string path_;
+  std::unique_ptr<SessionLogReader> reader_;
+  LoggedWorld logged_;
+  double start_ = 0, end_ = 0;
+  std::vector<LogEvent> events_;
+};
+
+}  // namespace sp
