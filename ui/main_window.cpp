@@ -37,6 +37,7 @@
 #include "ui/live_plots.h"
 #include "ui/robot_connection.h"
 #include "ui/robot_feed.h"
+#include "ui/replay_panel.h"
 #include "ui/scene_view.h"
 #include "ui/sequence_panel.h"
 
@@ -325,6 +326,48 @@ void MainWindow::buildDocks() {
     statusBar()->showMessage(text, 10000);
     sequenceDock_->raise();
   });
+
+  replay_ = new ReplayPanel;
+  replayDock_ = new QDockWidget(tr("Replay"), this);
+  replayDock_->setObjectName(QStringLiteral("replayDock"));
+  replayDock_->setWidget(replay_);
+  tabifyDockWidget(plotsDock_, replayDock_);
+  plotsDock_->raise();
+  connect(replay_, &ReplayPanel::opened, this, [this](const WorldModel& world) {
+    if (!replaying_) ghostShownBeforeReplay_ = scene_->ghostVisible();
+    replaying_ = true;
+    scene_->setWorld(world);
+    scene_->setGhostVisible(false);
+    wheelPlot_->clear();
+    statusBar()->showMessage(tr("Replaying %1: the live robot goes on unseen; close the replay to see it again")
+                                 .arg(QFileInfo(QString::fromStdString(replay_->player()->path())).fileName()));
+  });
+  connect(replay_, &ReplayPanel::frame, this, [this](const RobotFrame& f) {
+    scene_->setRobotState(f.base, f.jointPositions);
+    wheelPlot_->addSample(f.time, f.wheelNormal);
+    simTime_->setText(tr("replay t = %1 s").arg(formatFixed(f.time, 2)));
+  });
+  connect(replay_, &ReplayPanel::laser, this, [this](const LaserFrame& scan) {
+    scene_->setLaser(scan.angleMin, scan.angleStep, scan.ranges);
+    laserPlot_->setScan(scan.angleMin, scan.angleStep, scan.ranges);
+  });
+  connect(replay_, &ReplayPanel::closed, this, [this] {
+    replaying_ = false;
+    showWorld(*session_->world());
+    scene_->setGhostVisible(ghostShownBeforeReplay_);
+    statusBar()->clearMessage();
+  });
+}
+
+QString MainWindow::openLog(const QString& path, bool quiet) {
+  const QString error = replay_->open(path);
+  if (!error.isEmpty()) {
+    if (!quiet) showLoadErrors(tr("Open session log"), error);
+    return error;
+  }
+  replayDock_->show();
+  replayDock_->raise();
+  return {};
 }
 
 void MainWindow::buildMenus() {
@@ -335,6 +378,12 @@ void MainWindow::buildMenus() {
                                                       tr("World files (*.world.xml);;XML files (*.xml)"));
     if (!path.isEmpty()) openWorld(path);
   });
+  file->addAction(tr("Open session &log…"), QKeySequence(Qt::CTRL | Qt::Key_L), this, [this] {
+    const QString path = QFileDialog::getOpenFileName(this, tr("Open session log"), options_.logDir,
+                                                      tr("Session logs (*.splog);;All files (*)"));
+    if (!path.isEmpty()) openLog(path);
+  });
+  file->addAction(tr("Close replay"), this, [this] { replay_->close(); });
   file->addAction(tr("Open &robot…"), this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, tr("Open robot"), QStringLiteral("robots"),
                                                       tr("Robot files (*.xml)"));
@@ -661,7 +710,7 @@ void MainWindow::closeEvent(QCloseEvent* event) {
 }
 
 void MainWindow::onFrame(const RobotFrame& f) {
-  if (!session_->robot()) return;
+  if (!session_->robot() || replaying_) return;
   lastFrameClock_.restart();
   haveFrame_ = true;
   if (stale_) updateStale();
@@ -712,6 +761,7 @@ void MainWindow::pullGhost() {
 QString MainWindow::ghostStatus() const { return ghostLabel_->text(); }
 
 void MainWindow::onLaser(const LaserFrame& scan) {
+  if (replaying_) return;
   scene_->setLaser(scan.angleMin, scan.angleStep, scan.ranges);
   laserPlot_->setScan(scan.angleMin, scan.angleStep, scan.ranges);
 }
@@ -720,7 +770,9 @@ void MainWindow::refreshStatus() {
   const net::RobotClientStats stats = connection_->stats();
   link_->showStats(stats);
   const std::optional<net::TelemetryMsg>& last = feed_->lastTelemetry();
-  if (last) {
+  if (replaying_) {
+    // the replay's frames set the time shown
+  } else if (last) {
     simTime_->setText(tr("t = %1 s").arg(last->time, 0, 'f', 2));
     rtfLabel_->setText(tr("RTF %1").arg(session_->realTimeFactor(), 0, 'f', 2));
   } else {

@@ -41,6 +41,7 @@ class LaserPlot;
 class LinkPanel;
 class PredictionErrorPlot;
 class RobotConnection;
+class ReplayPanel;
 class SceneView;
 class SequencePanel;
 class WheelForcePlot;
@@ -78,6 +79,12 @@ class MainWindow : public QMainWindow {
   ControlPanel* controlPanel() const { return controls_; }
   LinkPanel* linkPanel() const { return link_; }
   SequencePanel* sequencePanel() const { return sequence_; }
+  ReplayPanel* replayPanel() const { return replay_; }
+  /// File ▸ Open session log: the views show the log at the replay cursor
+  /// (the live link goes on unseen) until the replay is closed. "" or why
+  /// not (shown in a dialog unless `quiet`).
+  QString openLog(const QString& path, bool quiet = false);
+  bool replaying() const { return replaying_; }
   WheelForcePlot* wheelForcePlot() const { return wheelPlot_; }
   LaserPlot* laserPlot() const { return laserPlot_; }
   PredictionErrorPlot* predictionErrorPlot() const { return errorPlot_; }
@@ -164,6 +171,10 @@ class MainWindow : public QMainWindow {
   LinkPanel* link_ = nullptr;
   SequencePanel* sequence_ = nullptr;
   QDockWidget* sequenceDock_ = nullptr;
+  ReplayPanel* replay_ = nullptr;
+  QDockWidget* replayDock_ = nullptr;
+  bool replaying_ = false;
+  bool ghostShownBeforeReplay_ = false;
   WheelForcePlot* wheelPlot_ = nullptr;
   LaserPlot* laserPlot_ = nullptr;
   PredictionErrorPlot* errorPlot_ = nullptr;

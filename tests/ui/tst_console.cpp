@@ -34,6 +34,7 @@
 #include "ui/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/live_plots.h"
+#include "tests/ui/console_fixture.h"
 #include "ui/main_window.h"
 #include "ui/robot_connection.h"
 #include "ui/scene_view.h"
@@ -116,17 +117,8 @@ class TestConsole : public QObject {
       QSKIP("the 3D view needs an X server: run under xvfb-run");
     QVERIFY(dir_.isValid());
     // Settings and logs go to a temporary folder, not the user's.
-    QSettings::setDefaultFormat(QSettings::IniFormat);
-    QSettings::setPath(QSettings::IniFormat, QSettings::UserScope, dir_.filePath(QStringLiteral("settings")));
-    QSettings().clear();
-    options_.world = QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml");
-    options_.logDir = dir_.filePath(QStringLiteral("sessions"));
-    window_ = std::make_unique<MainWindow>(options_);
-    const QString error = window_->start();
+    const QString error = test::startConsole(dir_, QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml"), options_, window_);
     QVERIFY2(error.isEmpty(), qPrintable(error));
-    window_->resize(1280, 800);
-    window_->show();
-    QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
   }
 
   void cleanupTestCase() { window_.reset(); }
@@ -670,16 +662,6 @@ class TestConsole : public QObject {
   std::unique_ptr<MainWindow> window_;
 };
 
-int main(int argc, char** argv) {
-  // OpenSceneGraph needs a GL 2.1 compatibility context (see STACK.md).
-  QSurfaceFormat format;
-  format.setVersion(2, 1);
-  format.setProfile(QSurfaceFormat::CompatibilityProfile);
-  format.setDepthBufferSize(24);
-  QSurfaceFormat::setDefaultFormat(format);
-  QApplication app(argc, argv);
-  TestConsole test;
-  return QTest::qExec(&test, argc, argv);
-}
+int main(int argc, char** argv) { return sp::test::glTestMain<TestConsole>(argc, argv); }
 
 #include "tst_console.moc"

@@ -28,6 +28,7 @@
 #include "sim/model_loader.h"
 #include "ui/robot_connection.h"
 #include "app/session_log.h"
+#include "tests/ui/console_fixture.h"
 #include "ui/main_window.h"
 #include "ui/scene_view.h"
 #include "ui/sequence_panel.h"
@@ -42,17 +43,8 @@ class TestSequencePanel : public QObject {
     if (QGuiApplication::platformName() == QLatin1String("offscreen"))
       QSKIP("the 3D view needs an X server: run under xvfb-run");
     QVERIFY(dir_.isValid());
-    QSettings::setDefaultFormat(QSettings::IniFormat);
-    QSettings::setPath(QSettings::IniFormat, QSettings::UserScope, dir_.filePath(QStringLiteral("settings")));
-    QSettings().clear();
-    options_.world = QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml");
-    options_.logDir = dir_.filePath(QStringLiteral("sessions"));
-    window_ = std::make_unique<MainWindow>(options_);
-    const QString error = window_->start();
+    const QString error = test::startConsole(dir_, QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml"), options_, window_);
     QVERIFY2(error.isEmpty(), qPrintable(error));
-    window_->resize(1280, 800);
-    window_->show();
-    QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
     QTRY_VERIFY_WITH_TIMEOUT(window_->lastTelemetry().has_value(), 20000);
     QTRY_VERIFY_WITH_TIMEOUT(window_->sequencePanel()->sendButton() != nullptr, 1000);
   }
@@ -241,16 +233,6 @@ class TestSequencePanel : public QObject {
   std::unique_ptr<MainWindow> window_;
 };
 
-int main(int argc, char** argv) {
-  // OpenSceneGraph needs a GL 2.1 compatibility context (see STACK.md).
-  QSurfaceFormat format;
-  format.setVersion(2, 1);
-  format.setProfile(QSurfaceFormat::CompatibilityProfile);
-  format.setDepthBufferSize(24);
-  QSurfaceFormat::setDefaultFormat(format);
-  QApplication app(argc, argv);
-  TestSequencePanel test;
-  return QTest::qExec(&test, argc, argv);
-}
+int main(int argc, char** argv) { return sp::test::glTestMain<TestSequencePanel>(argc, argv); }
 
 #include "tst_sequence_panel.moc"

@@ -1,0 +1,209 @@
+#include "ui/replay_panel.h"
+
+#include <QBoxLayout>
+#include <QComboBox>
+#include <QFileInfo>
+#include <QLabel>
+#include <QListWidget>
+#include <QMouseEvent>
+#include <QPainter>
+#include <QPushButton>
+#include <QSignalBlocker>
+#include <QSlider>
+#include <QTimer>
+
+#include <algorithm>
+#include <cmath>
+
+namespace sp {
+
+// Ticks at the events' times, aligned with the slider above; a click seeks
+// to the nearest event.
+class ReplayPanel::Marks : public QWidget {
+ public:
+  explicit Marks(ReplayPanel* panel) : QWidget(panel), panel_(panel) {
+    setFixedHeight(10);
+    setToolTip(tr("Events of the log; click one to go there"));
+  }
+
+ protected:
+  void paintEvent(QPaintEvent*) override {
+    const LogPlayer* p = panel_->player();
+    if (!p || p->endTime() <= p->startTime()) return;
+    QPainter painter(this);
+    for (const LogEvent& e : p->events()) {
+      const int x = xOf(e.time);
+      painter.setPen(e.kind == "note" ? QColor(0, 110, 200) : e.kind == "estop" || e.kind == "failsafe" || e.kind == "guard"
+                                                              ? QColor(200, 0, 0)
+                                                              : QColor(110, 110, 110));
+      painter.drawLine(x, 0, x, height());
+    }
+  }
+  void mousePressEvent(QMouseEvent* event) override {
+    const LogPlayer* p = panel_->player();
+    if (!p) return;
+    int best = -1, bestDistance = 8;  // pixels
+    for (int i = 0; i < static_cast<int>(p->events().size()); ++i) {
+      const int d = std::abs(xOf(p->events()[static_cast<size_t>(i)].time) - static_cast<int>(event->position().x()));
+      if (d < bestDistance) {
+        best = i;
+        bestDistance = d;
+      }
+    }
+    if (best >= 0) panel_->seekToEvent(best);
+  }
+
+ private:
+  int xOf(double t) const {
+    const LogPlayer* p = panel_->player();
+    const double f = (t - p->startTime()) / (p->endTime() - p->startTime());
+    return static_cast<int>(std::lround(std::clamp(f, 0.0, 1.0) * (width() - 1)));
+  }
+  ReplayPanel* panel_;
+};
+
+ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
+  auto* layout = new QVBoxLayout(this);
+  layout->setContentsMargins(4, 4, 4, 4);
+  title_ = new QLabel(tr("No log open: File ▸ Open session log…"), this);
+  layout->addWidget(title_);
+  auto* row = new QHBoxLayout;
+  auto* back = new QPushButton(QStringLiteral("◀"), this);
+  back->setToolTip(tr("Step back %1 s").arg(kStep));
+  playButton_ = new QPushButton(tr("Play"), this);
+  auto* forward = new QPushButton(QStringLiteral("▶|"), this);
+  forward->setToolTip(tr("Step forward %1 s").arg(kStep));
+  for (QPushButton* b : {back, playButton_, forward}) b->setFocusPolicy(Qt::NoFocus);
+  speedBox_ = new QComboBox(this);
+  for (double s : {0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0}) speedBox_->addItem(QStringLiteral("%1×").arg(s), s);
+  speedBox_->setCurrentIndex(3);
+  slider_ = new QSlider(Qt::Horizontal, this);
+  timeLabel_ = new QLabel(this);
+  timeLabel_->setMinimumWidth(130);
+  row->addWidget(back);
+  row->addWidget(playButton_);
+  row->addWidget(forward);
+  row->addWidget(speedBox_);
+  auto* track = new QVBoxLayout;
+  track->setSpacing(0);
+  track->addWidget(slider_);
+  marks_ = new Marks(this);
+  track->addWidget(marks_);
+  row->addLayout(track, 1);
+  row->addWidget(timeLabel_);
+  layout->addLayout(row);
+  events_ = new QListWidget(this);
+  layout->addWidget(events_, 1);
+
+  timer_ = new QTimer(this);
+  timer_->setInterval(16);
+  connect(timer_, &QTimer::timeout, this, &ReplayPanel::tick);
+  connect(playButton_, &QPushButton::clicked, this, [this] { playing_ ? pause() : play(); });
+  connect(back, &QPushButton::clicked, this, [this] { step(-1); });
+  connect(forward, &QPushButton::clicked, this, [this] { step(+1); });
+  connect(speedBox_, &QComboBox::currentIndexChanged, this, [this](int i) { setSpeed(speedBox_->itemData(i).toDouble()); });
+  connect(slider_, &QSlider::valueChanged, this, [this](int ms) { show(ms / 1000.0); });
+  connect(events_, &QListWidget::itemClicked, this, [this](QListWidgetItem* item) { seekToEvent(events_->row(item)); });
+  setEnabled(false);
+  title_->setEnabled(true);
+}
+
+ReplayPanel::~ReplayPanel() = default;
+
+QString ReplayPanel::open(const QString& path) {
+  std::string error;
+  std::unique_ptr<LogPlayer> player = LogPlayer::open(path.toStdString(), error);
+  if (!player) return QString::fromStdString(error);
+  pause();
+  player_ = std::move(player);
+  setEnabled(true);
+  title_->setText(tr("%1: %2 s, %3 events")
+                      .arg(QFileInfo(path).fileName())
+                      .arg(player_->endTime() - player_->startTime(), 0, 'f', 1)
+                      .arg(player_->events().size()));
+  events_->clear();
+  for (const LogEvent& e : player_->events())
+    events_->addItem(QStringLiteral("%1 s  %2: %3")
+                         .arg(e.time, 0, 'f', 2)
+                         .arg(QString::fromStdString(e.kind), QString::fromStdString(e.text)));
+  {
+    const QSignalBlocker block(slider_);
+    slider_->setRange(static_cast<int>(std::floor(player_->startTime() * 1000)),
+                      static_cast<int>(std::ceil(player_->endTime() * 1000)));
+  }
+  emit opened(player_->world());
+  cursor_ = player_->startTime();
+  show(cursor_);
+  marks_->update();
+  return {};
+}
+
+void ReplayPanel::close() {
+  pause();
+  player_.reset();
+  events_->clear();
+  title_->setText(tr("No log open: File ▸ Open session log…"));
+  setEnabled(false);
+  title_->setEnabled(true);
+  emit closed();
+}
+
+void ReplayPanel::seek(double time) { show(time); }
+
+void ReplayPanel::play() {
+  if (!player_) return;
+  if (cursor_ >= player_->endTime()) show(player_->startTime());  // from the start again
+  playing_ = true;
+  playButton_->setText(tr("Pause"));
+  wall_.start();
+  timer_->start();
+}
+
+void ReplayPanel::pause() {
+  playing_ = false;
+  timer_->stop();
+  playButton_->setText(tr("Play"));
+}
+
+void ReplayPanel::setSpeed(double factor) {
+  speed_ = std::clamp(factor, 0.1, 10.0);
+  const int i = speedBox_->findData(speed_);
+  if (i >= 0 && i != speedBox_->currentIndex()) {
+    const QSignalBlocker block(speedBox_);
+    speedBox_->setCurrentIndex(i);
+  }
+}
+
+void ReplayPanel::step(int direction) {
+  pause();
+  show(cursor_ + direction * kStep);
+}
+
+void ReplayPanel::seekToEvent(int index) {
+  if (!player_ || index < 0 || index >= static_cast<int>(player_->events().size())) return;
+  pause();
+  show(player_->events()[static_cast<size_t>(index)].time);
+}
+
+void ReplayPanel::tick() {
+  // Wall time since the last tick, not the timer's nominal period: the pace
+  // holds when ticks come late.
+  const double dt = static_cast<double>(wall_.nsecsElapsed()) * 1e-9;
+  wall_.start();
+  show(cursor_ + dt * speed_);
+  if (cursor_ >= player_->endTime()) pause();
+}
+
+void ReplayPanel::show(double time) {
+  if (!player_) return;
+  cursor_ = std::clamp(time, player_->startTime(), player_->endTime());
+  {
+    const QSignalBlocker block(slider_);
+    slider_->setValue(static_cast<int>(std::lround(cursor_ * 1000)));
+  }
+  timeLabel_->setText(tr("%1 / %2 s").arg(cursor_, 0, 'f', 2).arg(player_->endTime(), 0, 'f', 1));
+  if (std::optional<RobotFrame> f = player_->frameAt(cursor_)) emit frame(*f);
+  if (std::optional<LaserFrame> l = player_->laserAt(cursor_)) emit laser(*l);
+}
+
+}  // namespace sp
