@@ -1,13 +1,16 @@
 #include "app/console_session.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "app/headless_runner.h"  // loadRunParams
+#include "app/resimulation.h"
 #include "app/session_recorder.h"
 #include "app/stand_in.h"
 #include "app/telemetry_recorder.h"
 #include "sim/model_loader.h"
+#include "sim/text.h"
 
 namespace sp {
 namespace {
@@ -113,8 +116,11 @@ std::string ConsoleSession::useStandIn() {
   return {};
 }
 
-std::string ConsoleSession::startStandIn(const std::string& worldFile, const std::string& robotFile) {
+std::string ConsoleSession::startStandIn(const std::string& worldFile, const std::string& robotFile,
+                                         const Snapshot* startState, std::map<std::string, std::string> logMeta) {
   StandInOptions o;
+  if (startState) o.startState = *startState;
+  o.logMeta = std::move(logMeta);
   o.worldFile = worldFile;
   o.robotFile = robotFile;
   o.paramsFile = options_.params;
@@ -239,6 +245,35 @@ void ConsoleSession::logPrediction(const GhostError& e) {
   p.headingError = e.heading;
   if (recorder_) recorder_->prediction(p);
   else if (standIn_) standIn_->logPrediction(p);
+}
+
+std::string ConsoleSession::branchFrom(const std::string& logPath, double time) {
+  if (remote()) return "a branch runs on the stand-in: switch to it first (Robot > Use the stand-in)";
+  std::string error;
+  std::optional<BranchPoint> b = branchAt(logPath, time, error);
+  if (!b) return error;
+  const auto meta = [&](const char* key) {
+    const auto it = b->meta.find(key);
+    return it == b->meta.end() ? std::string() : it->second;
+  };
+  // The new session runs the files on disk: they must be the logged ones,
+  // or the state would be put into another robot or world.
+  const std::string worldFile = meta("world_file");
+  const std::string robotFile = meta("replaced_robot_file").empty() ? std::string() : meta("robot_file");
+  for (const auto& [file, contents] : {std::pair{worldFile, meta("world_contents")},
+                                       std::pair{meta("robot_file"), meta("robot_contents")},
+                                       std::pair{options_.params, meta("params_contents")}})
+    if (readWholeFile(file) != contents)
+      return (file.empty() ? std::string("the parameters") : file) +
+             ": differs from what the log was written with; a branch needs the logged files";
+  char hash[17];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(b->hash));
+  const std::string at = shortestText(static_cast<double>(b->step) * b->logged.params.step);
+  if (std::string e = startStandIn(worldFile, robotFile, &b->state, {{"parent_log", logPath}, {"parent_time", at}});
+      !e.empty())
+    return e;
+  standIn_->addNote("branch of " + logPath + " at t = " + at + " s (state hash " + hash + ")");
+  return {};
 }
 
 std::string ConsoleSession::resetRobot() {

@@ -15,6 +15,7 @@
 // on the disk.
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -90,6 +91,13 @@ class ConsoleSession {
   /// old log notes it and is complete; the new one names the old). For a
   /// robot elsewhere returns why not.
   std::string resetRobot();
+  /// Replay ▸ Simulate from here: a new stand-in starts from the state of
+  /// the log at `logPath` at `time` [s] (re-simulated from the snapshot
+  /// before it), logging into a new log that names its parent and time;
+  /// it replaces the running stand-in once it runs. Needs the log's world,
+  /// robot and parameters to be the files the console runs (else says
+  /// which differs); a robot elsewhere cannot be branched. "" or why not.
+  std::string branchFrom(const std::string& logPath, double time);
   /// The robot announced (WELCOME) the hashes of the files it runs ("" =
   /// not announced): "" when they match the files the console's twin and
   /// ghost are built from, else what differs, for the operator.
@@ -150,7 +158,8 @@ class ConsoleSession {
   void event(const std::string& kind, const std::string& text);
 
  private:
-  std::string startStandIn(const std::string& worldFile, const std::string& robotFile);
+  std::string startStandIn(const std::string& worldFile, const std::string& robotFile,
+                           const Snapshot* startState = nullptr, std::map<std::string, std::string> logMeta = {});
   void setWorld(WorldModel world);
   void openRemoteLog();
   void logPrediction(const GhostError& error);

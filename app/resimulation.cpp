@@ -1,6 +1,7 @@
 #include "app/resimulation.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -70,50 +71,101 @@ std::optional<LoggedWorld> loggedWorld(const SessionLogReader& reader, const std
   return LoggedWorld{std::move(*model), params};
 }
 
-std::optional<ResimReport> resimulate(const std::string& path, const ResimOptions& options, std::string& error) {
-  std::unique_ptr<SessionLogReader> reader = SessionLogReader::open(path, error);
-  if (!reader) return std::nullopt;
-  std::optional<LoggedWorld> logged = loggedWorld(*reader, path, error);
+namespace {
+
+// A log's world at its latest snapshot at or before `from`, with the logged
+// commands scheduled at their steps: what re-simulation and branching start from.
+struct Replay {
+  std::unique_ptr<SessionLogReader> reader;
+  LoggedWorld logged;
+  std::unique_ptr<World> world;
+  std::unique_ptr<Runner> runner;
+  int64_t start = 0;
+};
+
+std::optional<Replay> openReplay(const std::string& path, double from, std::string& error) {
+  Replay r;
+  r.reader = SessionLogReader::open(path, error);
+  if (!r.reader) return std::nullopt;
+  std::optional<LoggedWorld> logged = loggedWorld(*r.reader, path, error);
   if (!logged) return std::nullopt;
-  std::optional<WorldModel> model = std::move(logged->world);
-  const SimParams params = logged->params;
+  r.logged = std::move(*logged);
   Diagnostics diag;
-  std::unique_ptr<World> world = World::create(*model, params, diag);
-  if (!world) {
+  r.world = World::create(r.logged.world, r.logged.params, diag);
+  if (!r.world) {
     error = path + ": cannot build the logged world:\n" + diag.format();
     return std::nullopt;
   }
-  const RobotModel& robot = model->robots[0].model;
+  const RobotModel& robot = r.logged.world.robots[0].model;
 
   // The commands as applied, parsed back against the robot, each due at
   // the step it was logged at.
-  Runner runner(*world);
-  for (const LogCommand& c : reader->commands()) {
+  r.runner = std::make_unique<Runner>(*r.world);
+  for (const LogCommand& c : r.reader->commands()) {
     std::string why;
     std::optional<Command> command = parseCommand(c.text, why, &robot);
     if (!command) {
       error = path + ": logged command at step " + std::to_string(c.step) + " ('" + c.text + "'): " + why;
       return std::nullopt;
     }
-    if (c.step >= 0) runner.schedule(ScheduledCommand{std::move(*command), 0, c.step});
+    if (c.step >= 0) r.runner->schedule(ScheduledCommand{std::move(*command), 0, c.step});
   }
 
-  // The latest snapshot at or before the requested start.
-  const std::vector<int64_t> snapshotSteps = reader->snapshotSteps();
+  // The latest snapshot at or before `from`.
+  const std::vector<int64_t> snapshotSteps = r.reader->snapshotSteps();
   if (snapshotSteps.empty()) {
     error = path + ": the log holds no snapshot to start from";
     return std::nullopt;
   }
-  const double stepSize = params.step;
-  int64_t start = snapshotSteps.front();
+  r.start = snapshotSteps.front();
   for (int64_t s : snapshotSteps)
-    if (static_cast<double>(s) * stepSize <= options.from + 1e-9) start = s;
-  std::optional<std::pair<Snapshot, uint64_t>> snapshot = reader->snapshot(start, &error);
+    if (static_cast<double>(s) * r.logged.params.step <= from + 1e-9) r.start = s;
+  std::optional<std::pair<Snapshot, uint64_t>> snapshot = r.reader->snapshot(r.start, &error);
   if (!snapshot) return std::nullopt;
-  if (std::string why = world->restore(snapshot->first); !why.empty()) {
-    error = path + ": cannot restore the snapshot at step " + std::to_string(start) + ": " + why;
+  if (std::string why = r.world->restore(snapshot->first); !why.empty()) {
+    error = path + ": cannot restore the snapshot at step " + std::to_string(r.start) + ": " + why;
     return std::nullopt;
   }
+  // A command logged at step s was submitted before the step from s; those
+  // before the snapshot are in it (applied, or pending in its queue).
+  r.runner->skipBefore(r.start);
+  return r;
+}
+
+}  // namespace
+
+std::optional<BranchPoint> branchAt(const std::string& path, double time, std::string& error) {
+  std::optional<Replay> r = openReplay(path, time, error);
+  if (!r) return std::nullopt;
+  const int64_t step = std::llround(time / r->logged.params.step);
+  if (step < r->start) {
+    error = path + ": no snapshot at or before t = " + std::to_string(time) + " s";
+    return std::nullopt;
+  }
+  if (r->runner->advanceTo(step).stop == RunOutcome::Stop::Diverged) {
+    error = path + ": the twin diverged re-simulating to t = " + std::to_string(time) + " s: " +
+            r->world->health().message();
+    return std::nullopt;
+  }
+  BranchPoint b;
+  b.logged = std::move(r->logged);
+  b.state = r->world->snapshot();
+  b.hash = r->world->stateHash();
+  b.step = step;
+  b.fromSnapshot = r->start;
+  for (const auto& [s, h] : r->reader->hashes())
+    if (s == step) b.loggedHash = h;
+  b.meta = r->reader->meta();
+  return b;
+}
+
+std::optional<ResimReport> resimulate(const std::string& path, const ResimOptions& options, std::string& error) {
+  std::optional<Replay> replay = openReplay(path, options.from, error);
+  if (!replay) return std::nullopt;
+  SessionLogReader* reader = replay->reader.get();
+  World* world = replay->world.get();
+  Runner& runner = *replay->runner;
+  const int64_t start = replay->start;
 
   ResimReport report;
   report.startStep = start;
@@ -139,9 +191,6 @@ std::optional<ResimReport> resimulate(const std::string& path, const ResimOption
     return true;
   };
 
-  // A command logged at step s was submitted before the step from s; those
-  // before the snapshot are in it (applied, or pending in its queue).
-  runner.skipBefore(start);
   runner.setMonitor([&](const World&) { return compare(); });
   if (compare() && runner.advanceTo(end).stop == RunOutcome::Stop::Diverged)
     report.healthMessage = world->health().message();
@@ -149,7 +198,7 @@ std::optional<ResimReport> resimulate(const std::string& path, const ResimOption
   // A physical divergence before the end is a divergence from the log too.
   if (!report.divergence && !report.healthMessage.empty() && nextHash < hashes.size()) {
     const auto [step, expected] = hashes[nextHash];
-    report.divergence = ResimDivergence{step, static_cast<double>(step) * stepSize, expected, world->stateHash()};
+    report.divergence = ResimDivergence{step, static_cast<double>(step) * replay->logged.params.step, expected, world->stateHash()};
   }
   report.endStep = world->stepCount();
   return report;

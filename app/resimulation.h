@@ -17,8 +17,11 @@
 #include <optional>
 #include <string>
 
+#include <map>
+
 #include "sim/params.h"
 #include "sim/robot_model.h"
+#include "sim/world.h"
 
 namespace sp {
 
@@ -54,6 +57,21 @@ struct ResimReport {
   std::optional<ResimDivergence> divergence;  ///< nullopt: every hash matched
   std::string healthMessage;  ///< the twin diverged physically while re-simulating, else ""
 };
+
+/// A moment of a log to branch a new simulation from: the state there,
+/// re-simulated from the nearest snapshot before it.
+struct BranchPoint {
+  LoggedWorld logged;
+  Snapshot state;             ///< at `step`
+  uint64_t hash = 0;          ///< World::stateHash() of `state`
+  std::optional<uint64_t> loggedHash;  ///< the log's own hash at `step`, if it has one
+  int64_t step = 0;
+  int64_t fromSnapshot = 0;   ///< the snapshot's step it was re-simulated from
+  std::map<std::string, std::string> meta;  ///< the log's meta (its files)
+};
+/// The state at `time` [s] (the step nearest it) of the log at `path`;
+/// nullopt and `error` when the log cannot be re-simulated there. Thread: any.
+std::optional<BranchPoint> branchAt(const std::string& path, double time, std::string& error);
 
 /// Re-simulates the log at `path`. Returns nullopt and sets `error` when the
 /// log cannot be read or the world cannot be rebuilt. Thread: any; the

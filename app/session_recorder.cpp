@@ -36,6 +36,7 @@ std::unique_ptr<SessionLogWriter> openSessionLog(const std::string& path, const 
     info.files.push_back({"params", sources.paramsFile, readWholeFile(sources.paramsFile)});
   if (!sources.commandsFile.empty())
     info.files.push_back({"commands", sources.commandsFile, readWholeFile(sources.commandsFile)});
+  info.extraMeta = sources.extraMeta;
   if (!sources.replacedRobotFile.empty()) info.extraMeta["replaced_robot_file"] = sources.replacedRobotFile;
   std::unique_ptr<SessionLogWriter> writer = SessionLogWriter::open(path, info, error, options);
   if (writer)

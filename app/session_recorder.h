@@ -6,6 +6,7 @@
 // rate, laser scans, and a snapshot and state hash every sim second.
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,6 +27,8 @@ struct SessionSources {
   /// the file the world refers to ("" = none). Re-simulation lays the logged
   /// robot out under this name, so the logged world loads the robot used.
   std::string replacedRobotFile;
+  /// Further meta keys (a branched session's `parent_log`, `parent_time`).
+  std::map<std::string, std::string> extraMeta = {};
 };
 
 /// The bytes of the file at `path` ("" if it cannot be read), for the meta.

@@ -48,6 +48,12 @@ std::unique_ptr<StandInRobot> StandInRobot::create(const StandInOptions& options
   if (options.realTimeFactor) params->realTimeFactor = *options.realTimeFactor;
   std::unique_ptr<World> world = World::create(*model, *params, diag);
   if (!world) return nullptr;
+  if (options.startState) {
+    if (std::string why = world->restore(*options.startState); !why.empty()) {
+      diag.error(options.worldFile, 0, "cannot start from the given state: " + why);
+      return nullptr;
+    }
+  }
   auto host = std::make_unique<TwinHost>(std::move(world), params->realTimeFactor);
   return std::unique_ptr<StandInRobot>(new StandInRobot(options, std::move(*model), std::move(host), *params, std::move(replacedRobotFile)));
 }
@@ -111,7 +117,8 @@ std::string StandInRobot::start() {
                                .paramsFile = options_.paramsFile,
                                .commandsFile = {},
                                .overrides = options_.overrides,
-                               .replacedRobotFile = replacedRobotFile_},
+                               .replacedRobotFile = replacedRobotFile_,
+                               .extraMeta = options_.logMeta},
                               error);
     if (!writer) {
       server->server->stop();

@@ -23,6 +23,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -32,6 +33,7 @@
 #include "sim/diagnostics.h"
 #include "sim/params.h"
 #include "sim/robot_model.h"
+#include "sim/world.h"
 
 namespace sp {
 
@@ -59,6 +61,12 @@ struct StandInOptions {
   /// `-3`, ... appended if taken), created if missing. Relative to the
   /// current directory.
   std::string logDir = "sessions";
+  /// Start from this state instead of the world's initial one (a branch
+  /// of a logged session: app/resimulation.h branchAt); it must fit the
+  /// world (the same files).
+  std::optional<Snapshot> startState;
+  /// Further meta for the session log (`parent_log`, `parent_time`).
+  std::map<std::string, std::string> logMeta;
   /// Lines for the operator (no newline): connections, refusals, lease
   /// changes, e-stops. May be empty. Runs on the server's thread.
   std::function<void(const std::string&)> lineLog;

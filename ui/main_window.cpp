@@ -351,12 +351,30 @@ void MainWindow::buildDocks() {
     scene_->setLaser(scan.angleMin, scan.angleStep, scan.ranges);
     laserPlot_->setScan(scan.angleMin, scan.angleStep, scan.ranges);
   });
+  connect(replay_, &ReplayPanel::branchRequested, this, [this](double t) { branchFromReplay(t); });
   connect(replay_, &ReplayPanel::closed, this, [this] {
     replaying_ = false;
     showWorld(*session_->world());
     scene_->setGhostVisible(ghostShownBeforeReplay_);
     statusBar()->clearMessage();
   });
+}
+
+QString MainWindow::branchFromReplay(double time, bool quiet) {
+  if (!replay_->isOpen()) return tr("no log is being replayed");
+  const std::string log = replay_->player()->path();
+  connection_->close();
+  if (const std::string error = session_->branchFrom(log, time); !error.empty()) {
+    connectToRobot();
+    if (!quiet) showLoadErrors(tr("Simulate from here"), qs(error));
+    return qs(error);
+  }
+  replay_->close();
+  linkEvent(QStringLiteral("note"), tr("branch of %1 at t = %2 s").arg(qs(log)).arg(time, 0, 'f', 3));
+  feed_->clear();
+  wheelPlot_->clear();
+  sessionChanged();
+  return {};
 }
 
 QString MainWindow::openLog(const QString& path, bool quiet) {

@@ -85,6 +85,9 @@ class MainWindow : public QMainWindow {
   /// not (shown in a dialog unless `quiet`).
   QString openLog(const QString& path, bool quiet = false);
   bool replaying() const { return replaying_; }
+  /// Replay ▸ Simulate from here: the stand-in restarts from the replayed
+  /// log's state at `time`, the replay closes and the views show it live.
+  QString branchFromReplay(double time, bool quiet = false);
   WheelForcePlot* wheelForcePlot() const { return wheelPlot_; }
   LaserPlot* laserPlot() const { return laserPlot_; }
   PredictionErrorPlot* predictionErrorPlot() const { return errorPlot_; }

@@ -91,7 +91,15 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   track->addWidget(marks_);
   row->addLayout(track, 1);
   row->addWidget(timeLabel_);
+  auto* branch = new QPushButton(tr("Simulate from here"), this);
+  branch->setToolTip(tr("A new stand-in session starting from the logged state at the cursor (a new log naming this one)"));
+  branch->setFocusPolicy(Qt::NoFocus);
+  row->addWidget(branch);
   layout->addLayout(row);
+  connect(branch, &QPushButton::clicked, this, [this] {
+    pause();
+    emit branchRequested(cursor_);
+  });
   events_ = new QListWidget(this);
   layout->addWidget(events_, 1);
 

@@ -56,6 +56,8 @@ class ReplayPanel : public QWidget {
  signals:
   void opened(const sp::WorldModel& world);
   void closed();
+  /// Simulate from here: branch a new stand-in session from the cursor.
+  void branchRequested(double time);
   /// The robot at the cursor, for the views.
   void frame(const sp::RobotFrame& frame);
   void laser(const sp::LaserFrame& scan);

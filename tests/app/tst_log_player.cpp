@@ -11,6 +11,8 @@
 
 #include "app/headless_runner.h"
 #include "app/log_player.h"
+#include "app/resimulation.h"
+#include "app/stand_in.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/runner.h"
@@ -75,6 +77,41 @@ class TestLogPlayer : public QObject {
     QCOMPARE(player->frameAt(2.5)->base.p, player->frameAt(2.5)->base.p);
     QVERIFY(player->frameAt(1.0)->base.p.x < player->frameAt(3.0)->base.p.x);
     QVERIFY(player->laserAt(2.5).has_value());
+  }
+
+  // Branch: criterion, the state re-simulated to t = 3 s (from the snapshot
+  // at 3 s: hash rows and snapshots come every sim second) has the log's
+  // own hash there, bit for bit; a stand-in started from it logs a first
+  // snapshot with that same hash at that same step and names its parent.
+  // Control: branching at 3.5 s (re-simulated from the snapshot at 3 s)
+  // lands on a state whose hash differs from the one at 3 s.
+  void branchStartsFromTheLoggedState() {
+    std::string error;
+    const std::optional<BranchPoint> b = branchAt(log_, 3.0, error);
+    QVERIFY2(b, error.c_str());
+    QCOMPARE(b->step, int64_t{3000});
+    QVERIFY(b->loggedHash.has_value());
+    QCOMPARE(b->hash, *b->loggedHash);
+    const std::optional<BranchPoint> later = branchAt(log_, 3.5, error);
+    QVERIFY(later && later->fromSnapshot == 3000 && later->hash != b->hash && !later->loggedHash);
+
+    StandInOptions o;
+    o.worldFile = std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml";
+    o.port = 0;
+    o.startState = b->state;
+    o.logPath = dir_.filePath("branch.splog").toStdString();
+    o.logMeta = {{"parent_log", log_}, {"parent_time", "3"}};
+    Diagnostics diag;
+    auto robot = StandInRobot::create(o, diag);
+    QVERIFY2(robot, diag.format().c_str());
+    QCOMPARE(robot->start(), std::string());
+    robot->stop();
+    auto branch = SessionLogReader::open(o.logPath, error);
+    QVERIFY2(branch, error.c_str());
+    QCOMPARE(branch->snapshotSteps().front(), int64_t{3000});
+    QCOMPARE(branch->snapshot(3000)->second, b->hash);
+    QCOMPARE(branch->meta().at("parent_log"), log_);
+    QCOMPARE(branch->meta().at("parent_time"), std::string("3"));
   }
 
   void notALogIsRefused() {

@@ -57,6 +57,7 @@ class TestReplay : public QObject {
     const std::vector<LogEvent>& events = r->player()->events();
     const auto note = std::find_if(events.begin(), events.end(), [](const LogEvent& e) { return e.kind == "note"; });
     QVERIFY(note != events.end());
+    const double noteTime = note->time;  // the player (and its events) goes with the replay
     r->seekToEvent(static_cast<int>(note - events.begin()));
     QCOMPARE(r->cursor(), note->time);
 
@@ -83,6 +84,26 @@ class TestReplay : public QObject {
 
     r->close();
     QVERIFY(!w.replaying());
+
+    // Simulate from here: the stand-in restarts at the note's moment. Until
+    // the parent's next command (the stop, 1.5 s later) both run the same
+    // commands from the same state, so the branch's first telemetry frame
+    // is where the parent log has the robot at that time, bit for bit (the
+    // twin is deterministic; tst_log_player checks the state hash itself).
+    QCOMPARE(w.openLog(log, true), QString());
+    const double at = std::round(noteTime * 1000) / 1000;
+    r->seek(at);
+    const QString oldLog = w.logPath();
+    QCOMPARE(w.branchFromReplay(at, true), QString());
+    QVERIFY(!w.replaying());
+    QVERIFY(w.logPath() != oldLog);
+    QTRY_VERIFY_WITH_TIMEOUT(w.lastTelemetry().has_value() && w.lastTelemetry()->time >= at, 20000);
+    const net::TelemetryMsg first = *w.lastTelemetry();
+    const Pose parent = reference->frameAt(first.time)->base;
+    qInfo("branched at %.3f s: first telemetry at %.3f s, base x %.6f; the parent log then: %.6f", at, first.time,
+          first.pose.p.x, parent.p.x);
+    QVERIFY(first.time < at + 1.0);
+    QCOMPARE(first.pose.p, parent.p);
   }
 
  private:
