@@ -13,6 +13,7 @@
 #include "app/log_player.h"
 #include "app/resimulation.h"
 #include "app/stand_in.h"
+#include "app/telemetry_recorder.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/runner.h"
@@ -112,6 +113,41 @@ class TestLogPlayer : public QObject {
     QCOMPARE(branch->snapshot(3000)->second, b->hash);
     QCOMPARE(branch->meta().at("parent_log"), log_);
     QCOMPARE(branch->meta().at("parent_time"), std::string("3"));
+  }
+
+  // A remote robot's log (the console's telemetry recording: no snapshots,
+  // samples keyed by robot time) replays the same: the frame at a time is
+  // the telemetry frame at or before it, joints mapped by name.
+  void telemetryOnlyLogsReplay() {
+    Diagnostics diag;
+    const WorldModel world = *loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
+    const RobotModel& robot = world.robots[0].model;
+    const std::string path = dir_.filePath("remote.splog").toStdString();
+    std::string error;
+    {
+      auto recorder = TelemetryRecorder::open(path, world, "10.0.0.7:47800", error);
+      QVERIFY2(recorder, error.c_str());
+      for (int i = 0; i < 5; ++i) {
+        net::TelemetryMsg t;
+        t.time = 10 + 0.02 * i;
+        t.pose = Pose{{1.0 + 0.01 * i, 2.0, 0.8}, {1, 0, 0, 0}};
+        t.jointNames = {"knee_fl", "waist_yaw"};
+        t.jointPositions = {0.1 * i, -0.2};
+        t.jointVelocities = {0, 0};
+        recorder->telemetry(t, robot);
+      }
+    }
+    auto player = LogPlayer::open(path, error);
+    QVERIFY2(player, error.c_str());
+    QCOMPARE(player->startTime(), 10.0);
+    QCOMPARE(player->endTime(), 10.08);
+    const std::optional<RobotFrame> f = player->frameAt(10.05);
+    QVERIFY(f);
+    QCOMPARE(f->time, 10.04);
+    QCOMPARE(f->base.p.x, 1.02);
+    QCOMPARE(f->jointPositions[static_cast<size_t>(robot.findJoint("knee_fl"))], 0.2);
+    QCOMPARE(f->jointPositions[static_cast<size_t>(robot.findJoint("waist_yaw"))], -0.2);
+    QCOMPARE(f->jointPositions[static_cast<size_t>(robot.findJoint("hip_fl"))], 0.0);  // not reported
   }
 
   void notALogIsRefused() {
