@@ -123,6 +123,7 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
         {.worldFile = options.worldFile,
          .robotFile = robot.model.file,
          .paramsFile = options.paramsFile,
+         .terrainFile = model->terrain.file,
          .commandsFile = options.commandsFile,
          .overrides = options.overrides,
          .replacedRobotFile = {}},

@@ -48,8 +48,9 @@ std::optional<LoggedWorld> loggedWorld(const SessionLogReader& reader, const std
   files.add(worldName, get(meta, "world_contents"));
   files.add(replaced.empty() ? robotName : replaced, get(meta, "robot_contents"));
 
-  // A heightfield's data file is not stored in the log: it is read from the
-  // disk, beside the recorded world file.
+  // A heightfield's data file, where the log stores it (logs written before
+  // it was stored read it from the disk, beside the recorded world file).
+  if (meta.count("terrain_contents")) files.add(get(meta, "terrain_file"), get(meta, "terrain_contents"));
   Diagnostics diag;
   std::optional<WorldModel> model = loadWorld(worldName, diag, &files);
   if (!model || model->robots.empty()) {

@@ -7,11 +7,9 @@
 // The world is rebuilt from the logged file *contents*, never from the paths
 // on disk: the contents are held in memory (sim/file_set.h) under their
 // recorded paths, so a log still re-simulates after the files on disk were
-// edited or moved, and nothing is written. Limitations: a heightfield
-// terrain's data file is not stored in the log, so it is read from beside
-// the recorded world file (its heights are restored from the snapshot when
-// the snapshot carries them); parameter overrides come from the log's
-// "param_override" events.
+// edited or moved, and nothing is written; a heightfield's data file is
+// stored too (`terrain_*`; older logs read it from beside the recorded world
+// file). Parameter overrides come from the log's "param_override" events.
 
 #include <cstdint>
 #include <optional>

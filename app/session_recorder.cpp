@@ -34,6 +34,8 @@ std::unique_ptr<SessionLogWriter> openSessionLog(const std::string& path, const 
   info.files.push_back({"robot", sources.robotFile, readWholeFile(sources.robotFile)});
   if (!sources.paramsFile.empty())
     info.files.push_back({"params", sources.paramsFile, readWholeFile(sources.paramsFile)});
+  if (!sources.terrainFile.empty())
+    info.files.push_back({"terrain", sources.terrainFile, readWholeFile(sources.terrainFile)});
   if (!sources.commandsFile.empty())
     info.files.push_back({"commands", sources.commandsFile, readWholeFile(sources.commandsFile)});
   info.extraMeta = sources.extraMeta;

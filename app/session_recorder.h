@@ -21,6 +21,10 @@ struct SessionSources {
   std::string worldFile;
   std::string robotFile;               ///< the robot file the world refers to (RobotModel::file)
   std::string paramsFile;              ///< "" = built-in defaults (not stored)
+  /// The heightfield's data file (TerrainSpec::file, as the world resolved
+  /// it; "" for a plane): stored so that the log re-simulates and replays
+  /// anywhere, without the project's files.
+  std::string terrainFile = {};
   std::string commandsFile;            ///< "" = none (not stored)
   std::vector<std::string> overrides;  ///< key=value, logged as param_override events at step 0
   /// When the operator opened `robotFile` in place of the world's own robot:

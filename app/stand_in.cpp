@@ -115,6 +115,7 @@ std::string StandInRobot::start() {
                               {.worldFile = options_.worldFile,
                                .robotFile = world_.robots[0].model.file,
                                .paramsFile = options_.paramsFile,
+                               .terrainFile = world_.terrain.file,
                                .commandsFile = {},
                                .overrides = options_.overrides,
                                .replacedRobotFile = replacedRobotFile_,

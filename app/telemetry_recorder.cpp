@@ -15,6 +15,8 @@ std::unique_ptr<TelemetryRecorder> TelemetryRecorder::open(const std::string& pa
   info.files.push_back({"world", world.file, readWholeFile(world.file)});
   if (!world.robots.empty())
     info.files.push_back({"robot", world.robots[0].model.file, readWholeFile(world.robots[0].model.file)});
+  if (!world.terrain.file.empty())
+    info.files.push_back({"terrain", world.terrain.file, readWholeFile(world.terrain.file)});
   info.extraMeta["log_source"] = "telemetry";
   info.extraMeta["robot_endpoint"] = endpoint;
   std::unique_ptr<SessionLogWriter> writer = SessionLogWriter::open(path, info, error);

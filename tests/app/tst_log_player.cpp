@@ -4,8 +4,12 @@
 // running the same commands has at that sample's step (the twin is
 // deterministic), and the latest sample at or before the time asked.
 
+#include <QDir>
+#include <QFile>
 #include <QTemporaryDir>
 #include <QtTest>
+
+#include <sqlite3.h>
 
 #include <sstream>
 
@@ -148,6 +152,46 @@ class TestLogPlayer : public QObject {
     QCOMPARE(f->jointPositions[static_cast<size_t>(robot.findJoint("knee_fl"))], 0.2);
     QCOMPARE(f->jointPositions[static_cast<size_t>(robot.findJoint("waist_yaw"))], -0.2);
     QCOMPARE(f->jointPositions[static_cast<size_t>(robot.findJoint("hip_fl"))], 0.0);  // not reported
+  }
+
+  // Portable logs: a test-track session logged from the project root
+  // re-simulates and replays from a folder where none of its files exist
+  // (world, robot and heightfield data all come from the log). Control: the
+  // same log with its stored terrain removed cannot be rebuilt there.
+  void logsCarryTheirTerrain() {
+    RunOptions o;
+    o.worldFile = "terrains/test_track.world.xml";  // relative: the paths recorded do not exist elsewhere
+    o.duration = 1.2;
+    o.realTimeFactor = 0;
+    o.logFile = dir_.filePath("track.splog").toStdString();
+    o.progressInterval = 0;
+    std::ostringstream out, err;
+    QVERIFY2(runHeadless(o, out, err, [] { return 0.0; }, [](double) {}), err.str().c_str());
+    const QString root = QDir::currentPath();
+    QTemporaryDir elsewhere;
+    QVERIFY(QDir::setCurrent(elsewhere.path()));
+    std::string error;
+    const std::optional<ResimReport> resim = resimulate(o.logFile, {}, error);
+    auto player = LogPlayer::open(o.logFile, error);
+    // The control: without the stored terrain, the same log cannot be rebuilt here.
+    const QString stripped = QString::fromStdString(o.logFile) + ".stripped";
+    QFile::copy(QString::fromStdString(o.logFile), stripped);
+    bool deleted = false;
+    {
+      sqlite3* db = nullptr;
+      if (sqlite3_open(stripped.toUtf8().constData(), &db) == SQLITE_OK)
+        deleted = sqlite3_exec(db, "DELETE FROM meta WHERE key LIKE 'terrain_%'", nullptr, nullptr, nullptr) == SQLITE_OK;
+      sqlite3_close(db);
+    }
+    std::string strippedError;
+    const bool strippedOpens = LogPlayer::open(stripped.toStdString(), strippedError) != nullptr;
+    QVERIFY(QDir::setCurrent(root));
+    QVERIFY2(resim && !resim->divergence && resim->hashesCompared > 0, error.c_str());
+    QVERIFY2(player, error.c_str());
+    QCOMPARE(player->world().terrain.kind, TerrainSpec::Kind::Heightfield);
+    QVERIFY(deleted);
+    QVERIFY(!strippedOpens);
+    qInfo("without the stored terrain: %s", strippedError.c_str());
   }
 
   void notALogIsRefused() {
