@@ -1,6 +1,9 @@
 #include "app/log_player.h"
 
 #include <algorithm>
+#include <cmath>
+
+#include "sim/math.h"
 
 namespace sp {
 
@@ -47,6 +50,72 @@ std::optional<LaserFrame> LogPlayer::laserAt(double time) const {
   if (scans.empty()) return std::nullopt;
   const LogLaser& l = scans.back();
   return LaserFrame{l.time, l.angleMin, l.angleStep, l.ranges};
+}
+
+namespace {
+// The signals before the joints', in signalNames() order.
+constexpr const char* kBaseSignals[] = {"base x [m]", "base y [m]", "base z [m]", "roll [deg]", "pitch [deg]",
+                                        "yaw [deg]", "wheel FL normal [N]", "wheel FR normal [N]",
+                                        "wheel RL normal [N]", "wheel RR normal [N]"};
+constexpr int kBaseCount = 10;
+constexpr const char* kGhostSignals[] = {"ghost predicted x [m]", "ghost predicted y [m]", "ghost position error [m]",
+                                         "ghost heading error [deg]"};
+}  // namespace
+
+std::vector<std::string> LogPlayer::signalNames() const {
+  std::vector<std::string> out(std::begin(kBaseSignals), std::end(kBaseSignals));
+  for (const JointSpec& j : logged_.world.robots[0].model.joints) {
+    const bool slider = j.type == JointType::Slider;
+    out.push_back(j.name + (slider ? " position [m]" : " position [deg]"));
+    out.push_back(j.name + (slider ? " rate [m/s]" : " rate [deg/s]"));
+  }
+  out.insert(out.end(), std::begin(kGhostSignals), std::end(kGhostSignals));
+  return out;
+}
+
+std::vector<std::pair<double, double>> LogPlayer::signal(int index, double t0, double t1, int points) const {
+  std::vector<std::pair<double, double>> out;
+  const RobotModel& robot = logged_.world.robots[0].model;
+  const int joints = static_cast<int>(robot.joints.size());
+  const int ghost = kBaseCount + 2 * joints;
+  if (index < 0 || index >= ghost + 4 || points < 2 || !(t1 > t0)) return out;
+  if (index >= ghost) {
+    // Predictions are sparse (one per telemetry frame): read the range, keep
+    // about `points` of them.
+    const std::vector<LogPrediction> p = reader_->predictionsBetween(t0, t1);
+    const size_t every = std::max<size_t>(1, p.size() / static_cast<size_t>(points));
+    for (size_t i = 0; i < p.size(); i += every) {
+      const LogPrediction& q = p[i];
+      const double v[] = {q.base[0], q.base[1], q.positionError, radToDeg(q.headingError)};
+      out.emplace_back(q.time, v[index - ghost]);
+    }
+    return out;
+  }
+  for (int k = 0; k < points; ++k) {
+    const double t = t0 + (t1 - t0) * k / (points - 1);
+    const std::optional<RobotFrame> f = frameAt(t);
+    if (!f || (!out.empty() && f->time <= out.back().first)) continue;
+    double v = 0;
+    if (index < kBaseCount) {
+      const Vec3 up = rotate(conjugate(f->base.q), {0, 0, 1});
+      switch (index) {
+        case 0: v = f->base.p.x; break;
+        case 1: v = f->base.p.y; break;
+        case 2: v = f->base.p.z; break;
+        case 3: v = radToDeg(std::atan2(up.y, up.z)); break;
+        case 4: v = radToDeg(std::atan2(-up.x, std::hypot(up.y, up.z))); break;
+        case 5: v = radToDeg(heading(f->base.q)); break;
+        default: v = f->wheelNormal[static_cast<size_t>(index - 6)];
+      }
+    } else {
+      const int j = (index - kBaseCount) / 2;
+      const bool rate = (index - kBaseCount) % 2 == 1;
+      v = rate ? f->jointRates[static_cast<size_t>(j)] : f->jointPositions[static_cast<size_t>(j)];
+      if (robot.joints[static_cast<size_t>(j)].type != JointType::Slider) v = radToDeg(v);
+    }
+    out.emplace_back(f->time, v);
+  }
+  return out;
 }
 
 }  // namespace sp

@@ -45,6 +45,18 @@ class LogPlayer {
   /// The latest laser scan at or before `time`, if one is within 1 s.
   std::optional<LaserFrame> laserAt(double time) const;
 
+  /// The signals a replay can plot (PlotJuggler's habit: pick any): base
+  /// x, y, z, roll, pitch, yaw; the four wheel normal forces; every joint's
+  /// position and rate; the ghost's predicted x, y and its position and
+  /// heading error (logs with predictions). Names with units, e.g.
+  /// "base x [m]", "knee_fl position [deg]".
+  std::vector<std::string> signalNames() const;
+  /// Signal `index` of signalNames() at about `points` times evenly over
+  /// [t0, t1] (each the latest sample at or before it; a seek each, so a
+  /// one-hour log costs what a short one does): (time, value) pairs, times
+  /// of the samples found, without repeats.
+  std::vector<std::pair<double, double>> signal(int index, double t0, double t1, int points) const;
+
  private:
   LogPlayer() = default;
 

@@ -89,9 +89,10 @@ int main(int argc, char** argv) {
   const QCommandLineOption noGhost(QStringLiteral("no-ghost"), QStringLiteral("Do not run the predictive ghost."));
   const QCommandLineOption rules(QStringLiteral("rules"), QStringLiteral("Flight rules for rehearsals (default: built-in, see config/flight.rules)."), QStringLiteral("FILE"));
   const QCommandLineOption sequenceFile(QStringLiteral("sequence"), QStringLiteral("Open this command sequence in the Sequence dock."), QStringLiteral("FILE"));
+  const QCommandLineOption replay(QStringLiteral("replay"), QStringLiteral("Open this session log in the Replay dock."), QStringLiteral("LOG"));
   const QCommandLineOption drive(QStringLiteral("drive"), QStringLiteral("Drive at SPEED m/s once in control (for demonstrations)."), QStringLiteral("SPEED"));
   parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, delay, noGhost, monitor, screenshot, quitAfter, drive, rules,
-                     sequenceFile});
+                     sequenceFile, replay});
   if (!parser.parse(QCoreApplication::arguments())) {
     std::cerr << "<command line>: error: " << parser.errorText().toStdString() << "\n";
     return 2;
@@ -128,6 +129,7 @@ int main(int argc, char** argv) {
   options.takeControl = !parser.isSet(monitor);
   options.rules = parser.isSet(rules) ? findDataFile(parser.value(rules)) : QString();
   options.sequence = parser.isSet(sequenceFile) ? findDataFile(parser.value(sequenceFile)) : QString();
+  options.replay = parser.value(replay);
   std::optional<double> driveSpeed, quitSeconds;
   if (parser.isSet(rtf)) {
     const std::optional<double> x = numberOption(parser, rtf, 0, 1000);

@@ -213,15 +213,20 @@ double MainWindow::viewShare() const {
 void MainWindow::defaultLayout() {
   // Controls over the link on the right, full height; the plots under the
   // 3D view only. At 1280x800 the view gets over half the window.
-  for (QDockWidget* dock : {controlsDock_, sequenceDock_, linkDock_, plotsDock_}) {
+  for (QDockWidget* dock : {controlsDock_, sequenceDock_, linkDock_, plotsDock_, replayDock_}) {
     dock->setFloating(false);
     dock->show();
   }
   addDockWidget(Qt::RightDockWidgetArea, controlsDock_);
+  splitDockWidget(controlsDock_, linkDock_, Qt::Vertical);
+  // The Sequence dock a tab behind the controls; the Replay dock one behind
+  // the plots, shown only while a log is open (its tab bar costs the view).
   tabifyDockWidget(controlsDock_, sequenceDock_);
   controlsDock_->raise();
-  splitDockWidget(controlsDock_, linkDock_, Qt::Vertical);
   addDockWidget(Qt::BottomDockWidgetArea, plotsDock_);
+  tabifyDockWidget(plotsDock_, replayDock_);
+  replayDock_->setVisible(replaying_);
+  (replaying_ ? replayDock_ : plotsDock_)->raise();
   resizeDocks({controlsDock_}, {320}, Qt::Horizontal);
   resizeDocks({controlsDock_, linkDock_}, {height() / 2, height() / 2}, Qt::Vertical);
   resizeDocks({plotsDock_}, {178}, Qt::Vertical);
@@ -330,8 +335,13 @@ void MainWindow::buildDocks() {
   replay_ = new ReplayPanel;
   replayDock_ = new QDockWidget(tr("Replay"), this);
   replayDock_->setObjectName(QStringLiteral("replayDock"));
-  replayDock_->setWidget(replay_);
+  auto* replayScroll = new QScrollArea;  // as the Sequence dock: never wider or taller than the screen
+  replayScroll->setWidgetResizable(true);
+  replayScroll->setFrameShape(QFrame::NoFrame);
+  replayScroll->setWidget(replay_);
+  replayDock_->setWidget(replayScroll);
   tabifyDockWidget(plotsDock_, replayDock_);
+  replayDock_->hide();  // until a log is opened
   plotsDock_->raise();
   connect(replay_, &ReplayPanel::opened, this, [this](const WorldModel& world) {
     if (!replaying_) ghostShownBeforeReplay_ = scene_->ghostVisible();
@@ -354,6 +364,7 @@ void MainWindow::buildDocks() {
   connect(replay_, &ReplayPanel::branchRequested, this, [this](double t) { branchFromReplay(t); });
   connect(replay_, &ReplayPanel::closed, this, [this] {
     replaying_ = false;
+    replayDock_->hide();
     showWorld(*session_->world());
     scene_->setGhostVisible(ghostShownBeforeReplay_);
     statusBar()->clearMessage();
@@ -490,6 +501,7 @@ QString MainWindow::start() {
   }
   if (const std::string error = session_->start(); !error.empty()) return qs(error);
   sessionChanged();
+  if (!options_.replay.isEmpty()) return openLog(options_.replay, true);
   return {};
 }
 

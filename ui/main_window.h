@@ -61,6 +61,7 @@ struct ConsoleOptions {
   bool takeControl = true;    ///< ask for the lease as soon as connected
   QString rules;              ///< flight rules file for rehearsals; "" = the built-in defaults
   QString sequence;           ///< a sequence file to open in the Sequence dock
+  QString replay;             ///< a session log to open in the Replay dock
 };
 
 class MainWindow : public QMainWindow {

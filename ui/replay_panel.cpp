@@ -2,6 +2,14 @@
 
 #include <QBoxLayout>
 #include <QComboBox>
+#include <QFile>
+#include <QFileDialog>
+#include <QMessageBox>
+#include <QTextStream>
+#include <QtCharts/QChart>
+#include <QtCharts/QChartView>
+#include <QtCharts/QLineSeries>
+#include <QtCharts/QValueAxis>
 #include <QFileInfo>
 #include <QLabel>
 #include <QListWidget>
@@ -84,24 +92,68 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   row->addWidget(playButton_);
   row->addWidget(forward);
   row->addWidget(speedBox_);
-  auto* track = new QVBoxLayout;
-  track->setSpacing(0);
-  track->addWidget(slider_);
-  marks_ = new Marks(this);
-  track->addWidget(marks_);
-  row->addLayout(track, 1);
-  row->addWidget(timeLabel_);
+  row->addWidget(timeLabel_, 1);
   auto* branch = new QPushButton(tr("Simulate from here"), this);
   branch->setToolTip(tr("A new stand-in session starting from the logged state at the cursor (a new log naming this one)"));
   branch->setFocusPolicy(Qt::NoFocus);
   row->addWidget(branch);
   layout->addLayout(row);
+  // The timeline its own full width, the events ticked under it.
+  auto* track = new QVBoxLayout;
+  track->setSpacing(0);
+  track->addWidget(slider_);
+  marks_ = new Marks(this);
+  track->addWidget(marks_);
+  layout->addLayout(track);
   connect(branch, &QPushButton::clicked, this, [this] {
     pause();
     emit branchRequested(cursor_);
   });
+  auto* plotRow = new QHBoxLayout;
+  signalBox_ = new QComboBox(this);
+  signalBox_->setToolTip(tr("The logged signal to plot"));
+  signalBox_->setMinimumContentsLength(22);
+  auto* csv = new QPushButton(tr("CSV…"), this);
+  csv->setToolTip(tr("Export the visible range of the plotted signal as CSV"));
+  auto* png = new QPushButton(tr("PNG…"), this);
+  png->setToolTip(tr("Export the plot as a picture"));
+  readout_ = new QLabel(this);
+  plotRow->addWidget(signalBox_);
+  plotRow->addWidget(csv);
+  plotRow->addWidget(png);
+  plotRow->addWidget(readout_, 1);
+  layout->addLayout(plotRow);
+  auto* chart = new QChart;
+  chart->setAnimationOptions(QChart::NoAnimation);
+  chart->legend()->hide();
+  chart->setMargins({2, 2, 2, 2});
+  series_ = new QLineSeries;
+  cursorLine_ = new QLineSeries;
+  chart->addSeries(series_);
+  chart->addSeries(cursorLine_);
+  chart->createDefaultAxes();
+  chart_ = new QChartView(chart, this);
+  chart_->setRubberBand(QChartView::HorizontalRubberBand);
+  chart_->setMinimumHeight(110);
+  layout->addWidget(chart_, 2);
   events_ = new QListWidget(this);
   layout->addWidget(events_, 1);
+  replotTimer_ = new QTimer(this);
+  replotTimer_->setSingleShot(true);
+  replotTimer_->setInterval(100);
+  connect(replotTimer_, &QTimer::timeout, this, &ReplayPanel::replot);
+  // Zooming changes the time axis: the log is read again for that range.
+  connect(static_cast<QValueAxis*>(chart->axes(Qt::Horizontal).front()), &QValueAxis::rangeChanged, this,
+          [this] { replotTimer_->start(); });
+  connect(signalBox_, &QComboBox::currentIndexChanged, this, [this](int i) { setSignal(i); });
+  connect(csv, &QPushButton::clicked, this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, tr("Export CSV"), QString(), tr("CSV (*.csv)"));
+    if (const QString e = path.isEmpty() ? QString() : exportCsv(path); !e.isEmpty()) QMessageBox::warning(this, tr("Export CSV"), e);
+  });
+  connect(png, &QPushButton::clicked, this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, tr("Export PNG"), QString(), tr("PNG (*.png)"));
+    if (const QString e = path.isEmpty() ? QString() : exportPng(path); !e.isEmpty()) QMessageBox::warning(this, tr("Export PNG"), e);
+  });
 
   timer_ = new QTimer(this);
   timer_->setInterval(16);
@@ -140,7 +192,14 @@ QString ReplayPanel::open(const QString& path) {
                       static_cast<int>(std::ceil(player_->endTime() * 1000)));
   }
   emit opened(player_->world());
+  {
+    const QSignalBlocker block(signalBox_);
+    signalBox_->clear();
+    for (const std::string& name : player_->signalNames()) signalBox_->addItem(QString::fromStdString(name));
+    signalBox_->setCurrentIndex(6);  // wheel FL normal force
+  }
   cursor_ = player_->startTime();
+  setSignal(signalBox_->currentIndex());
   show(cursor_);
   marks_->update();
   return {};
@@ -150,6 +209,13 @@ void ReplayPanel::close() {
   pause();
   player_.reset();
   events_->clear();
+  series_->clear();
+  cursorLine_->clear();
+  readout_->clear();
+  {
+    const QSignalBlocker block(signalBox_);
+    signalBox_->clear();
+  }
   title_->setText(tr("No log open: File ▸ Open session log…"));
   setEnabled(false);
   title_->setEnabled(true);
@@ -193,6 +259,79 @@ void ReplayPanel::seekToEvent(int index) {
   show(player_->events()[static_cast<size_t>(index)].time);
 }
 
+void ReplayPanel::setSignal(int index) {
+  if (!player_ || index < 0 || index >= signalBox_->count()) return;
+  if (signalBox_->currentIndex() != index) {
+    const QSignalBlocker block(signalBox_);
+    signalBox_->setCurrentIndex(index);
+  }
+  setVisibleRange(player_->startTime(), player_->endTime());
+  replot();
+}
+
+int ReplayPanel::signalIndex() const { return signalBox_->currentIndex(); }
+
+void ReplayPanel::setVisibleRange(double t0, double t1) {
+  auto* x = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Horizontal).front());
+  x->setRange(t0, std::max(t1, t0 + 1e-3));
+}
+
+void ReplayPanel::replot() {
+  replotTimer_->stop();
+  if (!player_) return;
+  auto* x = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Horizontal).front());
+  auto* y = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Vertical).front());
+  const auto points = player_->signal(signalBox_->currentIndex(), x->min(), x->max(), kPlotPoints);
+  QList<QPointF> list;
+  double lo = 0, hi = 0;
+  for (const auto& [t, v] : points) {
+    if (list.isEmpty()) lo = hi = v;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+    list.append({t, v});
+  }
+  series_->replace(list);
+  const double pad = std::max(1e-6, 0.05 * (hi - lo));
+  y->setRange(lo - pad, hi + pad);
+  y->setTitleText(signalBox_->currentText());
+  moveCursorLine();
+}
+
+void ReplayPanel::moveCursorLine() {
+  auto* y = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Vertical).front());
+  cursorLine_->replace(QList<QPointF>{{cursor_, y->min()}, {cursor_, y->max()}});
+  readout_->setText(readout());
+}
+
+QList<QPointF> ReplayPanel::plotted() const { return series_->points(); }
+
+QString ReplayPanel::readout() const {
+  const QList<QPointF> p = series_->points();
+  if (p.isEmpty()) return {};
+  // The plotted point at or before the cursor.
+  auto it = std::upper_bound(p.begin(), p.end(), cursor_, [](double t, const QPointF& q) { return t < q.x(); });
+  const QPointF at = it == p.begin() ? p.front() : *(it - 1);
+  return tr("t = %1 s: %2 = %3").arg(cursor_, 0, 'f', 3).arg(signalBox_->currentText()).arg(at.y(), 0, 'g', 6);
+}
+
+QString ReplayPanel::exportCsv(const QString& path) const {
+  QFile f(path);
+  if (!f.open(QIODevice::WriteOnly | QIODevice::Truncate | QIODevice::Text)) return path + ": " + f.errorString();
+  QTextStream out(&f);
+  out << "time [s]," << signalBox_->currentText() << "\n";
+  auto* x = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Horizontal).front());
+  for (const QPointF& p : series_->points())
+    if (p.x() >= x->min() && p.x() <= x->max()) out << QString::number(p.x(), 'g', 17) << ',' << QString::number(p.y(), 'g', 17) << "\n";
+  out.flush();
+  if (out.status() != QTextStream::Ok || !f.flush()) return path + ": " + f.errorString();
+  return {};
+}
+
+QString ReplayPanel::exportPng(const QString& path) const {
+  const QPixmap picture = chart_->grab();
+  return picture.save(path, "PNG") ? QString() : path + tr(": cannot write the picture");
+}
+
 void ReplayPanel::tick() {
   // Wall time since the last tick, not the timer's nominal period: the pace
   // holds when ticks come late.
@@ -210,6 +349,7 @@ void ReplayPanel::show(double time) {
     slider_->setValue(static_cast<int>(std::lround(cursor_ * 1000)));
   }
   timeLabel_->setText(tr("%1 / %2 s").arg(cursor_, 0, 'f', 2).arg(player_->endTime(), 0, 'f', 1));
+  moveCursorLine();
   if (std::optional<RobotFrame> f = player_->frameAt(cursor_)) emit frame(*f);
   if (std::optional<LaserFrame> l = player_->laserAt(cursor_)) emit laser(*l);
 }

@@ -8,6 +8,8 @@
 // Thread: GUI thread.
 
 #include <QElapsedTimer>
+#include <QList>
+#include <QPointF>
 #include <QString>
 #include <QWidget>
 
@@ -21,6 +23,8 @@ class QListWidget;
 class QPushButton;
 class QSlider;
 class QTimer;
+QT_FORWARD_DECLARE_CLASS(QChartView)
+QT_FORWARD_DECLARE_CLASS(QLineSeries)
 
 namespace sp {
 
@@ -51,6 +55,21 @@ class ReplayPanel : public QWidget {
   void step(int direction);
   /// Seeks to event `index` of player()->events().
   void seekToEvent(int index);
+
+  /// The plot: signal `index` of player()->signalNames() over the visible
+  /// range (the whole log until zoomed: drag a rectangle to zoom, right
+  /// click to zoom out), about kPlotPoints points read from the log.
+  void setSignal(int index);
+  int signalIndex() const;
+  void setVisibleRange(double t0, double t1);
+  QList<QPointF> plotted() const;
+  /// "t = 2.500 s: knee_fl position [deg] = 12.3" at the cursor.
+  QString readout() const;
+  /// The plotted points of the visible range as CSV (time, value, with a
+  /// header naming the signal and units), or the chart as PNG; "" or why not.
+  QString exportCsv(const QString& path) const;
+  QString exportPng(const QString& path) const;
+  static constexpr int kPlotPoints = 1500;
   static constexpr double kStep = 0.1;
 
  signals:
@@ -80,6 +99,14 @@ class ReplayPanel : public QWidget {
   QListWidget* events_ = nullptr;
   class Marks;  // event ticks under the slider
   Marks* marks_ = nullptr;
+  void replot();
+  void moveCursorLine();
+  QComboBox* signalBox_ = nullptr;
+  QLabel* readout_ = nullptr;
+  QChartView* chart_ = nullptr;
+  QLineSeries* series_ = nullptr;
+  QLineSeries* cursorLine_ = nullptr;
+  QTimer* replotTimer_ = nullptr;
 };
 
 }  // namespace sp

@@ -5,6 +5,8 @@
 // at twice the wall clock's pace; closing the replay shows the live robot.
 
 #include <QElapsedTimer>
+#include <QFile>
+#include <QFileInfo>
 #include <QSettings>
 #include <QSurfaceFormat>
 #include <QTemporaryDir>
@@ -69,6 +71,33 @@ class TestReplay : public QObject {
     QVERIFY(logged.p.x - reference->frameAt(0)->base.p.x > 0.3);  // the robot had driven: the check is not at the start
     QTRY_VERIFY(std::hypot(w.sceneView()->drawnBasePose().p.x - logged.p.x,
                            w.sceneView()->drawnBasePose().p.y - logged.p.y) < 1e-9);
+
+    // The plot: a logged signal over the log, each point the log's value
+    // at its time; zoomed to [1, 2] s it is read again for that range;
+    // exported as CSV (the visible range) and PNG.
+    const std::vector<std::string> names = r->player()->signalNames();
+    const int fl = static_cast<int>(std::find(names.begin(), names.end(), "wheel FL normal [N]") - names.begin());
+    const int knee = static_cast<int>(std::find(names.begin(), names.end(), "knee_fl position [deg]") - names.begin());
+    QVERIFY(fl < static_cast<int>(names.size()) && knee < static_cast<int>(names.size()));
+    r->setSignal(fl);
+    QList<QPointF> points = r->plotted();
+    QVERIFY(points.size() > 100);
+    for (int i = 0; i < points.size(); i += 97)
+      QCOMPARE(points[i].y(), reference->frameAt(points[i].x())->wheelNormal[0]);
+    r->setSignal(knee);
+    r->setVisibleRange(1.0, 2.0);
+    QTRY_VERIFY(!r->plotted().isEmpty() && r->plotted().front().x() >= 0.99 && r->plotted().back().x() <= 2.0);
+    QVERIFY(r->plotted().size() > 50);  // read anew for the range: 10 ms samples, not the whole log's decimation
+    QVERIFY(r->readout().contains("knee_fl position [deg]"));
+    const QString csv = dir_.filePath(QStringLiteral("knee.csv")), png = dir_.filePath(QStringLiteral("knee.png"));
+    QCOMPARE(r->exportCsv(csv), QString());
+    QCOMPARE(r->exportPng(png), QString());
+    QFile csvFile(csv);
+    QVERIFY(csvFile.open(QIODevice::ReadOnly));
+    const QStringList lines = QString::fromUtf8(csvFile.readAll()).split('\n', Qt::SkipEmptyParts);
+    QCOMPARE(lines.front(), QStringLiteral("time [s],knee_fl position [deg]"));
+    QCOMPARE(lines.size() - 1, r->plotted().size());
+    QVERIFY(QFileInfo(png).size() > 1000);
 
     r->seek(r->player()->startTime());
     r->setSpeed(2);
