@@ -144,7 +144,13 @@ std::string ConsoleSession::startStandIn(const std::string& worldFile, const std
                "127.0.0.1:" + std::to_string(standIn_->port()) + " (stand-in, " +
                    std::filesystem::path(worldFile).filename().string() + ")"};
   setWorld(standIn_->world());
+  pruneLogs();
   return {};
+}
+
+void ConsoleSession::pruneLogs() {
+  // log.keep: the newest logs stay, the current one always.
+  if (options_.log && params_.logKeep > 0) pruneSessionLogs(options_.logDir, params_.logKeep, logPath());
 }
 
 std::string ConsoleSession::openWorld(const std::string& path) {
@@ -178,6 +184,7 @@ void ConsoleSession::openRemoteLog() {
   const std::string path = newSessionLogPath(options_.logDir, recorderError_);
   if (path.empty()) return;
   recorder_ = TelemetryRecorder::open(path, *world_, endpoint_.label, recorderError_);
+  pruneLogs();
 }
 
 std::string ConsoleSession::logPath() const {

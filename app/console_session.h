@@ -162,6 +162,8 @@ class ConsoleSession {
                            const Snapshot* startState = nullptr, std::map<std::string, std::string> logMeta = {});
   void setWorld(WorldModel world);
   void openRemoteLog();
+  /// Deletes logs beyond log.keep in the log folder (never the current one).
+  void pruneLogs();
   void logPrediction(const GhostError& error);
 
   ConsoleSessionOptions options_;

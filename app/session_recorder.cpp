@@ -1,6 +1,7 @@
 #include "app/session_recorder.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <ctime>
 #include <filesystem>
@@ -68,6 +69,57 @@ std::string newSessionLogPath(const std::string& dir, std::string& error) {
   }
   error = dir + ": no free session log name for " + stamp;
   return {};
+}
+
+std::vector<SessionLogFile> listSessionLogs(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::vector<SessionLogFile> out;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const fs::path& p = it->path();
+    if (p.extension() != ".splog" || !it->is_regular_file(ec)) continue;
+    SessionLogFile f;
+    f.path = p.string();
+    for (const char* suffix : {"", "-wal", "-shm"}) {
+      const uintmax_t n = fs::file_size(f.path + suffix, ec);
+      if (!ec) f.bytes += n;
+    }
+    ec.clear();
+    const auto t = fs::last_write_time(p, ec);
+    if (!ec)
+      f.modified = std::chrono::duration_cast<std::chrono::seconds>(
+                       std::chrono::file_clock::to_sys(t).time_since_epoch())
+                       .count();
+    ec.clear();
+    out.push_back(std::move(f));
+  }
+  std::sort(out.begin(), out.end(), [](const SessionLogFile& a, const SessionLogFile& b) {
+    return a.modified != b.modified ? a.modified > b.modified : a.path > b.path;
+  });
+  return out;
+}
+
+std::string deleteSessionLog(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::remove(path, ec) || ec) return path + ": cannot delete: " + (ec ? ec.message() : "no such file");
+  for (const char* suffix : {"-wal", "-shm"}) std::filesystem::remove(path + suffix, ec);
+  return {};
+}
+
+std::vector<std::string> pruneSessionLogs(const std::string& dir, int keep, const std::string& current) {
+  std::vector<std::string> deleted;
+  if (keep <= 0) return deleted;
+  int kept = 0;
+  std::error_code ec;
+  for (const SessionLogFile& f : listSessionLogs(dir)) {
+    const bool isCurrent = !current.empty() && std::filesystem::equivalent(f.path, current, ec);
+    if (isCurrent || kept < keep) {
+      ++kept;
+      continue;
+    }
+    if (deleteSessionLog(f.path).empty()) deleted.push_back(f.path);
+  }
+  return deleted;
 }
 
 SessionRecorder::SessionRecorder(std::unique_ptr<SessionLogWriter> writer, const World& world)

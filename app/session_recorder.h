@@ -54,6 +54,21 @@ std::unique_ptr<SessionLogWriter> openSessionLog(const std::string& path, const 
 /// robot and the console's log of a remote robot name their files so.
 std::string newSessionLogPath(const std::string& dir, std::string& error);
 
+/// A session log in a folder.
+struct SessionLogFile {
+  std::string path;
+  uint64_t bytes = 0;     ///< the file with its -wal and -shm companions
+  int64_t modified = 0;   ///< [s] since the epoch
+};
+/// The `*.splog` files of `dir`, newest first (by modification time, then
+/// name); none when the folder is missing.
+std::vector<SessionLogFile> listSessionLogs(const std::string& dir);
+/// Deletes a log and its -wal/-shm companions; "" or why not.
+std::string deleteSessionLog(const std::string& path);
+/// Deletes the logs of `dir` beyond the `keep` newest (`keep` <= 0: none),
+/// never `current`; returns the paths deleted.
+std::vector<std::string> pruneSessionLogs(const std::string& dir, int keep, const std::string& current);
+
 /// Feeds a session log from a physics loop: start() once before the first
 /// step, stepped() after every step. Owns the writer.
 ///

@@ -187,6 +187,8 @@ const std::vector<Entry>& table() {
             real(&SimParams::logRate, openClosed(0, kMaxRate))),
       entry("rate.csv", "rows per sim second written by run --csv [Hz], (0, 10000]",
             real(&SimParams::csvRate, openClosed(0, kMaxRate))),
+      entry("log.keep", "console: session logs kept in its log folder, the newest; older ones are deleted when a session starts; 0 = all, 0..100000",
+            integer(&SimParams::logKeep, 0, 100000)),
       entry("port.robot", "TCP port of the robot link, 1..65535", integer(&SimParams::robotPort, 1, 65535)),
       entry("link.deadman", "robot: longest gap between arrivals of the controller's keep-alives [s], [0.02, 60]",
             real(&SimParams::linkDeadman, closed(0.02, 60))),

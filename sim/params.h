@@ -32,6 +32,7 @@ struct SimParams {
   double laserRate = 20;
   double logRate = 100;
   double csvRate = 100;           ///< rows per sim second in `run --csv`
+  int logKeep = 0;                ///< session logs kept in the console's log folder (newest first); 0 = all
   // Ports
   int robotPort = 47800;          ///< TCP port of the robot link
   // Robot link timing (docs/protocol.md has settings per link); LAN defaults

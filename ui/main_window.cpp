@@ -4,6 +4,10 @@
 #include <QCloseEvent>
 #include <QDesktopServices>
 #include <QDir>
+#include <QDialog>
+#include <QDialogButtonBox>
+#include <QDateTime>
+#include <QTreeWidget>
 #include <QDockWidget>
 #include <QFile>
 #include <QFileDialog>
@@ -30,6 +34,7 @@
 #include <cmath>
 
 #include "app/console_session.h"
+#include "app/session_recorder.h"
 #include "ui/connect_dialog.h"
 #include "ui/control_panel.h"
 #include "ui/link_panel.h"
@@ -388,6 +393,57 @@ QString MainWindow::branchFromReplay(double time, bool quiet) {
   return {};
 }
 
+void MainWindow::showSessionLogs() {
+  // The log folder's logs, newest first, with their sizes: open one for
+  // replay, or delete old ones (never the one being written).
+  QDialog dialog(this);
+  dialog.setWindowTitle(tr("Session logs"));
+  auto* layout = new QVBoxLayout(&dialog);
+  const QString dir = qs(toSessionOptions(options_).logDir);
+  auto* where = new QLabel(tr("In %1 (parameter log.keep: how many are kept)").arg(dir), &dialog);
+  layout->addWidget(where);
+  auto* list = new QTreeWidget(&dialog);
+  list->setHeaderLabels({tr("Log"), tr("Size"), tr("Written")});
+  list->setRootIsDecorated(false);
+  list->setSelectionMode(QAbstractItemView::ExtendedSelection);
+  layout->addWidget(list);
+  const auto fill = [this, list, dir] {
+    list->clear();
+    for (const SessionLogFile& f : listSessionLogs(dir.toStdString())) {
+      auto* item = new QTreeWidgetItem(list, {QFileInfo(qs(f.path)).fileName(),
+                                              QStringLiteral("%1 MB").arg(static_cast<double>(f.bytes) / 1e6, 0, 'f', 1),
+                                              QDateTime::fromSecsSinceEpoch(f.modified).toString(Qt::ISODate)});
+      item->setData(0, Qt::UserRole, qs(f.path));
+      if (qs(f.path) == logPath()) item->setText(0, item->text(0) + tr(" (this session)"));
+    }
+    for (int c = 0; c < 3; ++c) list->resizeColumnToContents(c);
+  };
+  fill();
+  auto* buttons = new QDialogButtonBox(QDialogButtonBox::Close, &dialog);
+  QPushButton* open = buttons->addButton(tr("Replay"), QDialogButtonBox::ActionRole);
+  QPushButton* remove = buttons->addButton(tr("Delete…"), QDialogButtonBox::ActionRole);
+  layout->addWidget(buttons);
+  connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
+  connect(open, &QPushButton::clicked, &dialog, [&] {
+    if (QTreeWidgetItem* item = list->currentItem(); item && openLog(item->data(0, Qt::UserRole).toString()).isEmpty())
+      dialog.accept();
+  });
+  connect(remove, &QPushButton::clicked, &dialog, [&] {
+    QStringList paths;
+    for (QTreeWidgetItem* item : list->selectedItems())
+      if (item->data(0, Qt::UserRole).toString() != logPath()) paths << item->data(0, Qt::UserRole).toString();
+    if (paths.isEmpty()) return;
+    if (QMessageBox::question(&dialog, tr("Delete session logs"), tr("Delete %n log(s)? This cannot be undone.", "", static_cast<int>(paths.size())),
+                              QMessageBox::Yes | QMessageBox::Cancel, QMessageBox::Cancel) != QMessageBox::Yes)
+      return;
+    for (const QString& p : paths)
+      if (const std::string e = deleteSessionLog(p.toStdString()); !e.empty()) QMessageBox::warning(&dialog, tr("Delete"), qs(e));
+    fill();
+  });
+  dialog.resize(640, 400);
+  dialog.exec();
+}
+
 QString MainWindow::openLog(const QString& path, bool quiet) {
   const QString error = replay_->open(path);
   if (!error.isEmpty()) {
@@ -408,10 +464,11 @@ void MainWindow::buildMenus() {
     if (!path.isEmpty()) openWorld(path);
   });
   file->addAction(tr("Open session &log…"), QKeySequence(Qt::CTRL | Qt::Key_L), this, [this] {
-    const QString path = QFileDialog::getOpenFileName(this, tr("Open session log"), options_.logDir,
+    const QString path = QFileDialog::getOpenFileName(this, tr("Open session log"), qs(toSessionOptions(options_).logDir),
                                                       tr("Session logs (*.splog);;All files (*)"));
     if (!path.isEmpty()) openLog(path);
   });
+  file->addAction(tr("Session &logs…"), this, [this] { showSessionLogs(); });
   file->addAction(tr("Close replay"), this, [this] { replay_->close(); });
   file->addAction(tr("Open &robot…"), this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, tr("Open robot"), QStringLiteral("robots"),

@@ -85,6 +85,8 @@ class MainWindow : public QMainWindow {
   /// (the live link goes on unseen) until the replay is closed. "" or why
   /// not (shown in a dialog unless `quiet`).
   QString openLog(const QString& path, bool quiet = false);
+  /// File ▸ Session logs: the log folder's logs with sizes; replay or delete.
+  void showSessionLogs();
   bool replaying() const { return replaying_; }
   /// Replay ▸ Simulate from here: the stand-in restarts from the replayed
   /// log's state at `time`, the replay closes and the views show it live.

@@ -11,10 +11,14 @@
 
 #include <sqlite3.h>
 
+#include <chrono>
+#include <filesystem>
 #include <sstream>
 
 #include "app/headless_runner.h"
+#include "app/console_session.h"
 #include "app/log_player.h"
+#include "app/session_recorder.h"
 #include "app/resimulation.h"
 #include "app/stand_in.h"
 #include "app/telemetry_recorder.h"
@@ -192,6 +196,49 @@ class TestLogPlayer : public QObject {
     QVERIFY(deleted);
     QVERIFY(!strippedOpens);
     qInfo("without the stored terrain: %s", strippedError.c_str());
+  }
+
+  // The log folder: listed newest first with sizes (-wal included), other
+  // files ignored; log.keep deletes the oldest beyond the newest N when a
+  // console session starts, never the current one.
+  void logFolderListedAndPruned() {
+    namespace fs = std::filesystem;
+    QTemporaryDir logs;
+    const auto now = fs::file_time_type::clock::now();
+    const char* names[] = {"session-a.splog", "session-b.splog", "session-c.splog"};
+    for (int i = 0; i < 3; ++i) {
+      const std::string p = test::writeFile(logs, names[i], QByteArray(100 * (i + 1), 'x'));
+      fs::last_write_time(p, now - std::chrono::hours(3 - i));  // a oldest, c newest
+    }
+    test::writeFile(logs, "session-c.splog-wal", QByteArray(7, 'w'));
+    test::writeFile(logs, "notes.txt", "not a log");
+    std::vector<SessionLogFile> list = listSessionLogs(logs.path().toStdString());
+    QCOMPARE(list.size(), size_t(3));
+    QVERIFY(list[0].path.ends_with("session-c.splog") && list[2].path.ends_with("session-a.splog"));
+    QCOMPARE(list[0].bytes, uint64_t(307));
+    QVERIFY(list[0].modified > list[1].modified);
+    // The oldest is the current one: it stays whatever keep says.
+    const std::vector<std::string> gone = pruneSessionLogs(logs.path().toStdString(), 1, list[2].path);
+    QCOMPARE(gone.size(), size_t(1));
+    QVERIFY(gone[0].ends_with("session-b.splog"));
+    QVERIFY(!QFile::exists(logs.filePath("session-b.splog")));
+
+    ConsoleSessionOptions o;
+    o.world = std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml";
+    o.logDir = logs.path().toStdString();
+    o.overrides = {"log.keep=2"};
+    o.ghost = false;
+    {
+      ConsoleSession session(o);
+      QCOMPARE(session.start(), std::string());
+      list = listSessionLogs(logs.path().toStdString());
+      QCOMPARE(list.size(), size_t(2));
+      QCOMPARE(list[0].path, session.logPath());       // the new one
+      QVERIFY(list[1].path.ends_with("session-c.splog"));  // the newest before it
+    }
+    QCOMPARE(deleteSessionLog(logs.filePath("session-c.splog").toStdString()), std::string());
+    QVERIFY(!QFile::exists(logs.filePath("session-c.splog-wal")));
+    QVERIFY(!deleteSessionLog(logs.filePath("session-c.splog").toStdString()).empty());
   }
 
   void notALogIsRefused() {
