@@ -46,10 +46,10 @@ std::optional<RobotFrame> LogPlayer::frameAt(double time) const {
 }
 
 std::optional<LaserFrame> LogPlayer::laserAt(double time) const {
-  const std::vector<LogLaser> scans = reader_->laserBetween(time - 1.0, time);
-  if (scans.empty()) return std::nullopt;
-  const LogLaser& l = scans.back();
-  return LaserFrame{l.time, l.angleMin, l.angleStep, l.ranges};
+  // One row, not the second's scans: the replay asks at every tick.
+  std::optional<LogLaser> l = reader_->laserAt(time);
+  if (!l || l->time < time - 1.0) return std::nullopt;
+  return LaserFrame{l->time, l->angleMin, l->angleStep, std::move(l->ranges)};
 }
 
 namespace {
@@ -97,13 +97,13 @@ std::vector<std::pair<double, double>> LogPlayer::signal(int index, double t0, d
     if (!f || (!out.empty() && f->time <= out.back().first)) continue;
     double v = 0;
     if (index < kBaseCount) {
-      const Vec3 up = rotate(conjugate(f->base.q), {0, 0, 1});
+      const Vec3 tilted = tilt(f->base.q);
       switch (index) {
         case 0: v = f->base.p.x; break;
         case 1: v = f->base.p.y; break;
         case 2: v = f->base.p.z; break;
-        case 3: v = radToDeg(std::atan2(up.y, up.z)); break;
-        case 4: v = radToDeg(std::atan2(-up.x, std::hypot(up.y, up.z))); break;
+        case 3: v = radToDeg(tilted.x); break;
+        case 4: v = radToDeg(tilted.y); break;
         case 5: v = radToDeg(heading(f->base.q)); break;
         default: v = f->wheelNormal[static_cast<size_t>(index - 6)];
       }

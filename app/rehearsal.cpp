@@ -47,9 +47,9 @@ RehearsalSample sampleOf(const World& world, double margin, const RigidRobot* ri
   s.jointPositions.resize(robot.joints.size());
   for (size_t j = 0; j < robot.joints.size(); ++j) s.jointPositions[j] = world.jointPosition(0, static_cast<int>(j));
   if (rigid) s.jointPositions = fullJoints(*rigid, s.jointPositions);
-  const Vec3 up = rotate(conjugate(s.base.q), {0, 0, 1});
-  s.roll = std::atan2(up.y, up.z);
-  s.pitch = std::atan2(-up.x, std::hypot(up.y, up.z));
+  const Vec3 tilted = tilt(s.base.q);
+  s.roll = tilted.x;
+  s.pitch = tilted.y;
   s.margin = margin;
   const Vec3 v = world.linkLinearVelocity(0, 0);
   s.speed = std::hypot(v.x, v.y);

@@ -32,10 +32,39 @@ class SequenceGuard {
     std::lock_guard lock(mutex_);
     return relay_.guard(telemetry);
   }
-  /// A copy of where the relay stands.
-  SequenceRelay snapshot() const {
+  /// Where the relay stands, without the rehearsal it carries (the GUI
+  /// asks on every key and state; the rehearsal's path is large).
+  class Status {
+   public:
+    SequenceRelay::Phase phase() const { return phase_; }
+    const std::string& hash() const { return hash_; }
+    const std::string& reason() const { return reason_; }
+    uint64_t index() const { return index_; }
+    uint64_t count() const { return count_; }
+    double worstPosition() const { return worstPosition_; }
+    double worstHeading() const { return worstHeading_; }
+    int compared() const { return compared_; }
+
+   private:
+    friend class SequenceGuard;
+    SequenceRelay::Phase phase_ = SequenceRelay::Phase::Idle;
+    std::string hash_, reason_;
+    uint64_t index_ = 0, count_ = 0;
+    double worstPosition_ = 0, worstHeading_ = 0;
+    int compared_ = 0;
+  };
+  Status status() const {
     std::lock_guard lock(mutex_);
-    return relay_;
+    Status s;
+    s.phase_ = relay_.phase();
+    s.hash_ = relay_.hash();
+    s.reason_ = relay_.reason();
+    s.index_ = relay_.index();
+    s.count_ = relay_.count();
+    s.worstPosition_ = relay_.worstPosition();
+    s.worstHeading_ = relay_.worstHeading();
+    s.compared_ = relay_.compared();
+    return s;
   }
 
  private:

@@ -470,6 +470,14 @@ std::optional<std::pair<double, double>> SessionLogReader::sampleTimeRange() con
   return std::pair{q.f64(0), q.f64(1)};
 }
 
+std::optional<LogLaser> SessionLogReader::laserAt(double time) const {
+  Stmt q(db_, "SELECT step, time, angle_min, angle_step, ranges FROM laser WHERE time <= ? ORDER BY time DESC, step DESC LIMIT 1");
+  if (!q) return std::nullopt;
+  q.bind(1, time);
+  if (!q.row()) return std::nullopt;
+  return LogLaser{q.i64(0), q.f64(1), q.f64(2), q.f64(3), q.doubles(4)};
+}
+
 std::vector<LogLaser> SessionLogReader::laserBetween(double t0, double t1) const {
   std::vector<LogLaser> out;
   // Not INDEXED BY: logs written before laser_time existed read the same

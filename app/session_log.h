@@ -220,6 +220,8 @@ class SessionLogReader {
   /// The latest sample at or before `time` (one row from the time index);
   /// nullopt before the first.
   std::optional<LogSample> sampleAt(double time) const;
+  /// The latest laser scan at or before `time` (one row); nullopt before the first.
+  std::optional<LogLaser> laserAt(double time) const;
   /// The first and last sample times; nullopt without samples.
   std::optional<std::pair<double, double>> sampleTimeRange() const;
   /// Laser scans with t0 <= time <= t1 [s], in step order (uses the time

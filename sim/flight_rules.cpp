@@ -368,9 +368,9 @@ void RuleMonitor::check(const World& world) {
   }
 
   // Attitude, from where "up" lies in the base's frame.
-  const Vec3 up = rotate(conjugate(base.q), {0, 0, 1});
-  const double roll = radToDeg(std::atan2(up.y, up.z));
-  const double pitch = radToDeg(std::atan2(-up.x, std::hypot(up.y, up.z)));
+  const Vec3 tilted = tilt(base.q);
+  const double roll = radToDeg(tilted.x);
+  const double pitch = radToDeg(tilted.y);
   record(Rule::Roll, std::abs(roll) > rules_.maxRoll, roll, rules_.maxRoll, std::abs(roll), t, "");
   record(Rule::Pitch, std::abs(pitch) > rules_.maxPitch, pitch, rules_.maxPitch, std::abs(pitch), t, "");
 

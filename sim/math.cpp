@@ -23,6 +23,11 @@ Vec3 rotate(const Quat& q, Vec3 v) {
   return v + q.w * t + cross(u, t);
 }
 
+Vec3 tilt(const Quat& q) {
+  const Vec3 up = rotate(conjugate(q), {0, 0, 1});
+  return {std::atan2(up.y, up.z), std::atan2(-up.x, std::hypot(up.y, up.z)), 0};
+}
+
 double heading(const Quat& q) {
   const Vec3 x = rotate(q, {1, 0, 0});
   return std::atan2(x.y, x.x);

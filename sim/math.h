@@ -44,6 +44,10 @@ Quat quatFromAxisAngle(Vec3 axis, double angle);
 /// Where the frame's x axis points in the ground plane [rad] about z
 /// (its yaw, well defined for any roll and pitch short of vertical).
 double heading(const Quat& q);
+/// Roll and pitch [rad] of a frame, from where the world's "up" lies in it
+/// (x = roll about the frame's x, y = pitch; z unused): what an IMU and the
+/// flight rules report.
+Vec3 tilt(const Quat& q);
 
 /// A rigid transform: first rotate, then translate.
 struct Pose {

@@ -89,9 +89,9 @@ void World::sampleSensors() {
           imu.acceleration = rotate(toSensor, accelWorld - model_.gravity);
           imu.angularRate = rotate(toSensor, linkAngularVelocity(static_cast<int>(r), spec.link));
           // Roll and pitch from where gravity's "up" lies in the sensor frame.
-          const Vec3 up = rotate(toSensor, {0, 0, 1});
-          imu.roll = std::atan2(up.y, up.z);
-          imu.pitch = std::atan2(-up.x, std::hypot(up.y, up.z));
+          const Vec3 tilted = tilt(sensor.q);
+          imu.roll = tilted.x;
+          imu.pitch = tilted.y;
           imu.roll += noise();
           imu.pitch += noise();
           imu.angularRate = imu.angularRate + Vec3{noise(), noise(), noise()};

@@ -28,7 +28,7 @@ void RobotConnection::open(const net::RobotClientConfig& config) {
   callbacks.telemetry = [this](const net::TelemetryMsg& m) {
     // The guard first, here on the worker: its ABORT must not wait for the window.
     if (std::optional<GuardDeparture> d = guard_->telemetry(m)) {
-      const std::string hash = guard_->snapshot().hash();
+      const std::string hash = guard_->status().hash();
       client_->abortSequence(hash, "guard: " + d->message());
       post([this, h = QString::fromStdString(hash), d = *d] { emit guardTripped(h, d); });
     }

@@ -482,7 +482,7 @@ void SequencePanel::setGuard(std::shared_ptr<SequenceGuard> guard) {
 }
 
 void SequencePanel::abort(const QString& reason) {
-  const SequenceRelay r = relay();
+  const SequenceGuard::Status r = relay();
   if (r.phase() != SequenceRelay::Phase::Running && r.phase() != SequenceRelay::Phase::Sent) return;
   emit abortRequested(QString::fromStdString(r.hash()), reason);
   emit logEvent("relay", QStringLiteral("abort %1: %2").arg(QString::fromStdString(r.hash()), reason));
@@ -490,7 +490,7 @@ void SequencePanel::abort(const QString& reason) {
 }
 
 void SequencePanel::onSequenceState(const net::SequenceStateMsg& state) {
-  const SequenceRelay r = relay();
+  const SequenceGuard::Status r = relay();
   if (state.hash != r.hash()) return;
   const QString hash = QString::fromStdString(r.hash());
   switch (r.phase()) {

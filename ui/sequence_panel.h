@@ -102,8 +102,8 @@ class SequencePanel : public QWidget {
   /// The guard the link's worker feeds (RobotConnection::guard()); the
   /// panel arms it on Send and shows its state.
   void setGuard(std::shared_ptr<SequenceGuard> guard);
-  /// Where the relayed sequence stands (a copy).
-  SequenceRelay relay() const { return guard_->snapshot(); }
+  /// Where the relayed sequence stands.
+  SequenceGuard::Status relay() const { return guard_->status(); }
   QString status() const;
   /// Seeks the scrubber to `time` [s from the sequence's start].
   void scrubTo(double time);
