@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "app/headless_runner.h"  // loadRunParams
+#include "app/log_player.h"
 #include "app/resimulation.h"
 #include "app/session_recorder.h"
 #include "app/stand_in.h"
@@ -257,29 +258,37 @@ void ConsoleSession::logPrediction(const GhostError& e) {
 std::string ConsoleSession::branchFrom(const std::string& logPath, double time) {
   if (remote()) return "a branch runs on the stand-in: switch to it first (Robot > Use the stand-in)";
   std::string error;
-  std::optional<BranchPoint> b = branchAt(logPath, time, error);
+  std::unique_ptr<LogPlayer> player = LogPlayer::open(logPath, error);
+  if (!player) return error;
+  std::optional<BranchPoint> b = player->branchAt(time, error);
   if (!b) return error;
+  return branchFrom(logPath, *b);
+}
+
+std::string ConsoleSession::branchFrom(const std::string& logPath, const BranchPoint& b) {
+  if (remote()) return "a branch runs on the stand-in: switch to it first (Robot > Use the stand-in)";
   const auto meta = [&](const char* key) {
-    const auto it = b->meta.find(key);
-    return it == b->meta.end() ? std::string() : it->second;
+    const auto it = b.meta.find(key);
+    return it == b.meta.end() ? std::string() : it->second;
   };
   // The new session runs the files on disk: they must be the logged ones,
-  // or the state would be put into another robot or world.
+  // or the state would be put into another robot or world. (A remote
+  // robot's telemetry log holds no parameters: the console's apply.)
   const std::string worldFile = meta("world_file");
   const std::string robotFile = meta("replaced_robot_file").empty() ? std::string() : meta("robot_file");
-  for (const auto& [file, contents] : {std::pair{worldFile, meta("world_contents")},
-                                       std::pair{meta("robot_file"), meta("robot_contents")},
-                                       std::pair{options_.params, meta("params_contents")}})
+  std::vector<std::pair<std::string, std::string>> files{{worldFile, meta("world_contents")},
+                                                         {meta("robot_file"), meta("robot_contents")}};
+  if (b.meta.count("params_contents")) files.emplace_back(options_.params, meta("params_contents"));
+  for (const auto& [file, contents] : files)
     if (readWholeFile(file) != contents)
       return (file.empty() ? std::string("the parameters") : file) +
              ": differs from what the log was written with; a branch needs the logged files";
-  char hash[17];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(b->hash));
-  const std::string at = shortestText(static_cast<double>(b->step) * b->logged.params.step);
-  if (std::string e = startStandIn(worldFile, robotFile, &b->state, {{"parent_log", logPath}, {"parent_time", at}});
-      !e.empty())
-    return e;
-  standIn_->addNote("branch of " + logPath + " at t = " + at + " s (state hash " + hash + ")");
+  const std::string at = shortestText(static_cast<double>(b.step) * b.logged.params.step);
+  std::map<std::string, std::string> parent{{"parent_log", logPath}, {"parent_time", at}};
+  if (b.reconstructed) parent["parent_state"] = "reconstructed from telemetry";
+  if (std::string e = startStandIn(worldFile, robotFile, &b.state, parent); !e.empty()) return e;
+  standIn_->addNote("branch of " + logPath + " at t = " + at + " s (state hash " + hashHex(b.hash) +
+                    (b.reconstructed ? ", reconstructed from telemetry: contacts and controllers start afresh)" : ")"));
   return {};
 }
 

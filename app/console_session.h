@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "app/ghost.h"
+#include "app/resimulation.h"
 #include "app/robot_frame.h"
 #include "net/message.h"
 #include "sim/params.h"
@@ -93,11 +94,16 @@ class ConsoleSession {
   std::string resetRobot();
   /// Replay ▸ Simulate from here: a new stand-in starts from the state of
   /// the log at `logPath` at `time` [s] (re-simulated from the snapshot
-  /// before it), logging into a new log that names its parent and time;
-  /// it replaces the running stand-in once it runs. Needs the log's world,
-  /// robot and parameters to be the files the console runs (else says
-  /// which differs); a robot elsewhere cannot be branched. "" or why not.
+  /// before it, or reconstructed from a telemetry-only log's sample:
+  /// LogPlayer::branchAt), logging into a new log that names its parent
+  /// and time; it replaces the running stand-in once it runs. Needs the
+  /// log's world, robot and parameters to be the files the console runs
+  /// (else says which differs); a robot elsewhere cannot be branched. ""
+  /// or why not.
   std::string branchFrom(const std::string& logPath, double time);
+  /// The same from a branch point computed already (on a worker thread,
+  /// with progress: LogPlayer::branchAt).
+  std::string branchFrom(const std::string& logPath, const BranchPoint& point);
   /// The robot announced (WELCOME) the hashes of the files it runs ("" =
   /// not announced): "" when they match the files the console's twin and
   /// ghost are built from, else what differs, for the operator.

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "sim/math.h"
+#include "sim/world.h"
 
 namespace sp {
 
@@ -23,6 +24,7 @@ std::unique_ptr<LogPlayer> LogPlayer::open(const std::string& path, std::string&
   p->start_ = range->first;
   p->end_ = range->second;
   p->events_ = p->reader_->events();
+  p->hasSnapshots_ = !p->reader_->snapshotSteps().empty();
   return p;
 }
 
@@ -50,6 +52,61 @@ std::optional<LaserFrame> LogPlayer::laserAt(double time) const {
   std::optional<LogLaser> l = reader_->laserAt(time);
   if (!l || l->time < time - 1.0) return std::nullopt;
   return LaserFrame{l->time, l->angleMin, l->angleStep, std::move(l->ranges)};
+}
+
+std::optional<RehearsalStart> LogPlayer::startAt(double time) const {
+  const std::optional<RobotFrame> f = frameAt(time);
+  if (!f) return std::nullopt;
+  RehearsalStart s;
+  s.base = f->base;
+  s.jointPositions = f->jointPositions;
+  s.jointRates = f->jointRates;
+  // The base's twist by differencing with the sample before: the angular
+  // velocity (world frame) is 2 vec(q1 conj(q0)) / dt for a small turn.
+  if (const std::optional<RobotFrame> before = frameAt(f->time - 1e-9);
+      before && before->time < f->time && f->time - before->time <= 0.5) {
+    const double dt = f->time - before->time;
+    s.baseLinear = (1.0 / dt) * (f->base.p - before->base.p);
+    Quat d = f->base.q * conjugate(before->base.q);
+    if (d.w < 0) d = Quat{-d.w, -d.x, -d.y, -d.z};  // the shorter way
+    s.baseAngular = (2.0 / dt) * Vec3{d.x, d.y, d.z};
+  }
+  return s;
+}
+
+std::optional<BranchPoint> LogPlayer::branchAt(double time, std::string& error,
+                                               const std::function<bool(double)>& progress) const {
+  if (hasSnapshots_) return sp::branchAt(path_, time, error, progress);
+  const std::optional<RehearsalStart> start = startAt(time);
+  if (!start) {
+    error = path_ + ": no sample at t = " + std::to_string(time) + " s";
+    return std::nullopt;
+  }
+  Diagnostics diag;
+  std::unique_ptr<World> world = World::create(logged_.world, logged_.params, diag);
+  if (!world) {
+    error = path_ + ": cannot build the logged world:\n" + diag.format();
+    return std::nullopt;
+  }
+  if (std::string why = placeRobot(*world, *start); !why.empty()) {
+    error = path_ + ": the logged state at t = " + std::to_string(time) + " s does not fit the world: " + why;
+    return std::nullopt;
+  }
+  // At the logged time: the branch's clock goes on from the log's.
+  Snapshot at = world->snapshot();
+  at.step = std::llround(std::max(time, start_) / logged_.params.step);
+  if (std::string why = world->restore(at); !why.empty()) {
+    error = path_ + ": cannot set the reconstructed state: " + why;
+    return std::nullopt;
+  }
+  BranchPoint b;
+  b.logged = logged_;
+  b.state = world->snapshot();
+  b.hash = world->stateHash();
+  b.step = world->stepCount();
+  b.meta = reader_->meta();
+  b.reconstructed = true;
+  return b;
 }
 
 namespace {

@@ -14,11 +14,13 @@
 //
 // Thread: one at a time (it owns a SessionLogReader).
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "app/rehearsal.h"
 #include "app/resimulation.h"
 #include "app/robot_frame.h"
 #include "app/session_log.h"
@@ -34,6 +36,7 @@ class LogPlayer {
   const std::string& path() const { return path_; }
   /// The logged world (robots[0] is the robot the samples describe).
   const WorldModel& world() const { return logged_.world; }
+  const SimParams& params() const { return logged_.params; }
   /// First and last sample times [s].
   double startTime() const { return start_; }
   double endTime() const { return end_; }
@@ -44,6 +47,23 @@ class LogPlayer {
   std::optional<RobotFrame> frameAt(double time) const;
   /// The latest laser scan at or before `time`, if one is within 1 s.
   std::optional<LaserFrame> laserAt(double time) const;
+
+  /// The robot's state at `time` reconstructed from the samples, as a
+  /// rehearsal's or a branch's start: pose, joints and rates as logged;
+  /// the base's velocity from the sample before (samples hold no base
+  /// twist; zero when there is none within 0.5 s); objects where the
+  /// world puts them (samples hold none).
+  std::optional<RehearsalStart> startAt(double time) const;
+  /// Whether the log holds snapshots (a stand-in's or a headless run's
+  /// log; a remote robot's telemetry log holds none).
+  bool hasSnapshots() const { return hasSnapshots_; }
+  /// A new simulation's start at `time`. Logs with snapshots re-simulate
+  /// from the nearest one to the step (sp::branchAt: bit-exact, `progress`
+  /// as it goes, false cancels); telemetry-only logs are reconstructed:
+  /// startAt(time) placed in the logged world (BranchPoint::reconstructed).
+  /// Opens its own reader: any thread, while the player is used elsewhere.
+  std::optional<BranchPoint> branchAt(double time, std::string& error,
+                                      const std::function<bool(double)>& progress = {}) const;
 
   /// The signals a replay can plot (PlotJuggler's habit: pick any): base
   /// x, y, z, roll, pitch, yaw; the four wheel normal forces; every joint's
@@ -65,6 +85,7 @@ class LogPlayer {
   LoggedWorld logged_;
   double start_ = 0, end_ = 0;
   std::vector<LogEvent> events_;
+  bool hasSnapshots_ = false;
 };
 
 }  // namespace sp

@@ -118,6 +118,16 @@ std::vector<int> unmovedJoints(const RobotModel& robot, const std::vector<TimedC
   return held;
 }
 
+std::string placeRobot(World& world, const RehearsalStart& s, const RigidRobot* held) {
+  const RobotModel& robot = world.robotModel(0);
+  const std::vector<double> q = held ? rigidJoints(*held, s.jointPositions) : s.jointPositions;
+  const std::vector<double> dq = held ? rigidJoints(*held, s.jointRates) : s.jointRates;
+  const std::string why =
+      world.setRobotMotion(0, linkMotions(robot, s.base, s.baseLinear, s.baseAngular, q, dq), s.objects);
+  if (why.empty()) holdStartPose(world);
+  return why;
+}
+
 RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress) {
   const auto t0 = Clock::now();
   RehearsalResult result;
@@ -153,16 +163,10 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   const RobotModel& robot = world->robotModel(0);
   const RigidRobot* held = rigid ? &*rigid : nullptr;
   if (plan.start) {
-    const RehearsalStart& s = *plan.start;
-    const std::vector<double> q = held ? rigidJoints(*held, s.jointPositions) : s.jointPositions;
-    const std::vector<double> dq = held ? rigidJoints(*held, s.jointRates) : s.jointRates;
-    const std::string why =
-        world->setRobotMotion(0, linkMotions(robot, s.base, s.baseLinear, s.baseAngular, q, dq), s.objects);
-    if (!why.empty()) {
+    if (std::string why = placeRobot(*world, *plan.start, held); !why.empty()) {
       result.error = "the start state does not fit: " + why;
       return result;
     }
-    holdStartPose(*world);
   }
   result.duration = (plan.commands.empty() ? 0.0 : plan.commands.back().time) + plan.rules.settle;
   RuleMonitor monitor(plan.rules, robot);

@@ -55,6 +55,16 @@ struct RehearsalPlan {
   bool holdUnmoved = true;
 };
 
+class World;
+struct RigidRobot;
+
+/// Puts robot 0 of `world` in `start` (links' poses and velocities, the
+/// objects named) with its controllers holding that pose: position joints
+/// target where they are, velocity joints 0. `held`: the world runs this
+/// rigid form of the robot (start joints are the full robot's). "" or why
+/// the state does not fit.
+std::string placeRobot(World& world, const RehearsalStart& start, const RigidRobot* held = nullptr);
+
 /// The joints `commands` leave alone, as held subtrees: every joint whose
 /// subtree holds no commanded joint and no drive joint, outermost first.
 std::vector<int> unmovedJoints(const RobotModel& robot, const std::vector<TimedCommand>& commands);

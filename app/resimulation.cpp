@@ -133,9 +133,23 @@ std::optional<Replay> openReplay(const std::string& path, double from, std::stri
   return r;
 }
 
+// A Runner monitor that reports the fraction of [from, to] done about every
+// 1 % of the steps; false (stop) when `progress` says so.
+std::function<bool(const World&)> progressMonitor(const std::function<bool(double)>& progress, int64_t from,
+                                                 int64_t to, bool& cancelled) {
+  const int64_t every = std::max<int64_t>(1, (to - from) / 100);
+  return [&progress, &cancelled, from, to, every](const World& w) {
+    const int64_t done = w.stepCount() - from;
+    if (!progress || done % every != 0) return true;
+    cancelled = !progress(static_cast<double>(done) / static_cast<double>(std::max<int64_t>(1, to - from)));
+    return !cancelled;
+  };
+}
+
 }  // namespace
 
-std::optional<BranchPoint> branchAt(const std::string& path, double time, std::string& error) {
+std::optional<BranchPoint> branchAt(const std::string& path, double time, std::string& error,
+                                    const std::function<bool(double)>& progress) {
   std::optional<Replay> r = openReplay(path, time, error);
   if (!r) return std::nullopt;
   const int64_t step = std::llround(time / r->logged.params.step);
@@ -143,7 +157,14 @@ std::optional<BranchPoint> branchAt(const std::string& path, double time, std::s
     error = path + ": no snapshot at or before t = " + std::to_string(time) + " s";
     return std::nullopt;
   }
-  if (r->runner->advanceTo(step).stop == RunOutcome::Stop::Diverged) {
+  bool cancelled = false;
+  r->runner->setMonitor(progressMonitor(progress, r->start, step, cancelled));
+  const RunOutcome::Stop stop = r->runner->advanceTo(step).stop;
+  if (cancelled) {
+    error = path + ": cancelled re-simulating to t = " + std::to_string(time) + " s";
+    return std::nullopt;
+  }
+  if (stop == RunOutcome::Stop::Diverged) {
     error = path + ": the twin diverged re-simulating to t = " + std::to_string(time) + " s: " +
             r->world->health().message();
     return std::nullopt;
@@ -192,7 +213,8 @@ std::optional<ResimReport> resimulate(const std::string& path, const ResimOption
     return true;
   };
 
-  runner.setMonitor([&](const World&) { return compare(); });
+  const auto progress = progressMonitor(options.progress, start, end, report.cancelled);
+  runner.setMonitor([&](const World& w) { return compare() && progress(w); });
   if (compare() && runner.advanceTo(end).stop == RunOutcome::Stop::Diverged)
     report.healthMessage = world->health().message();
   report.commandsApplied = runner.commandsApplied();

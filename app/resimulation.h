@@ -12,6 +12,7 @@
 // file). Parameter overrides come from the log's "param_override" events.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -37,6 +38,9 @@ std::optional<LoggedWorld> loggedWorld(const SessionLogReader& reader, const std
 
 struct ResimOptions {
   double from = 0;  ///< start at the latest snapshot at or before this sim time [s]
+  /// Called with the fraction done about every 1 % of the steps; returning
+  /// false stops the re-simulation (ResimReport::cancelled).
+  std::function<bool(double)> progress;
 };
 
 /// The first logged hash that the re-simulation did not reproduce.
@@ -54,6 +58,7 @@ struct ResimReport {
   int commandsApplied = 0;
   std::optional<ResimDivergence> divergence;  ///< nullopt: every hash matched
   std::string healthMessage;  ///< the twin diverged physically while re-simulating, else ""
+  bool cancelled = false;     ///< stopped by ResimOptions::progress before the end
 };
 
 /// A moment of a log to branch a new simulation from: the state there,
@@ -66,10 +71,17 @@ struct BranchPoint {
   int64_t step = 0;
   int64_t fromSnapshot = 0;   ///< the snapshot's step it was re-simulated from
   std::map<std::string, std::string> meta;  ///< the log's meta (its files)
+  /// Not re-simulated but rebuilt from a telemetry-only log's sample
+  /// (LogPlayer::branchAt): the pose and joints are the logged ones, what
+  /// telemetry does not carry (contact state, controllers' integrators) is not.
+  bool reconstructed = false;
 };
 /// The state at `time` [s] (the step nearest it) of the log at `path`;
-/// nullopt and `error` when the log cannot be re-simulated there. Thread: any.
-std::optional<BranchPoint> branchAt(const std::string& path, double time, std::string& error);
+/// nullopt and `error` when the log cannot be re-simulated there.
+/// `progress(fraction)` while re-simulating; returning false cancels
+/// (nullopt, `error` says so). Thread: any.
+std::optional<BranchPoint> branchAt(const std::string& path, double time, std::string& error,
+                                    const std::function<bool(double)>& progress = {});
 
 /// Re-simulates the log at `path`. Returns nullopt and sets `error` when the
 /// log cannot be read or the world cannot be rebuilt. Thread: any; the

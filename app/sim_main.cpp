@@ -1,12 +1,15 @@
 // simpartner-sim: the headless twin. `check` validates files, `run` runs a
 // world paced against the monotonic clock.
 
+#include <unistd.h>
+
 #include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <fstream>
 #include <filesystem>
+#include <cstdio>
 #include <iostream>
 #include <string>
 #include <thread>
@@ -332,8 +335,15 @@ int resim(const std::vector<std::string>& args) {
     std::cerr << "<command line>: error: resim needs a LOG file\n";
     return 2;
   }
+  // Progress on a terminal only (a long log takes minutes): "\r 37 %".
+  if (isatty(STDERR_FILENO))
+    options.progress = [](double f) {
+      std::fprintf(stderr, "\rre-simulating: %3d %%", static_cast<int>(f * 100));
+      return true;
+    };
   std::string error;
   const auto report = sp::resimulate(log, options, error);
+  if (options.progress) std::fprintf(stderr, "\r                    \r");
   if (!report) {
     std::cerr << error << "\n";
     return 1;

@@ -366,7 +366,22 @@ void MainWindow::buildDocks() {
     scene_->setLaser(scan.angleMin, scan.angleStep, scan.ranges);
     laserPlot_->setScan(scan.angleMin, scan.angleStep, scan.ranges);
   });
-  connect(replay_, &ReplayPanel::branchRequested, this, [this](double t) { branchFromReplay(t); });
+  connect(replay_, &ReplayPanel::branchReady, this,
+          [this](const QString& log, std::shared_ptr<const BranchPoint> point) { startBranch(log, *point, false); });
+  connect(replay_, &ReplayPanel::failed, this, [this](const QString& message) {
+    if (!replay_->isOpen()) replayDock_->hide();  // a log that did not open
+    statusBar()->showMessage(message, 10000);
+    if (message != tr("Cancelled.")) showLoadErrors(tr("Replay"), message);
+  });
+  connect(replay_, &ReplayPanel::rehearsalStart, this,
+          [this](const RehearsalStart& start, const WorldModel& world, const SimParams& params, const QString& label) {
+            sequence_->pinStart(start, world, params, label);
+            sequenceDock_->show();
+            sequenceDock_->raise();
+            statusBar()->showMessage(tr("The Sequence dock rehearses from %1 now").arg(label), 8000);
+          });
+  connect(replay_, &ReplayPanel::verified, this,
+          [this](bool, const QString& verdict) { statusBar()->showMessage(verdict, 15000); });
   connect(replay_, &ReplayPanel::closed, this, [this] {
     replaying_ = false;
     replayDock_->hide();
@@ -378,15 +393,29 @@ void MainWindow::buildDocks() {
 
 QString MainWindow::branchFromReplay(double time, bool quiet) {
   if (!replay_->isOpen()) return tr("no log is being replayed");
-  const std::string log = replay_->player()->path();
+  std::string error;
+  const std::optional<BranchPoint> point = replay_->player()->branchAt(time, error);
+  if (!point) {
+    if (!quiet) showLoadErrors(tr("Simulate from here"), qs(error));
+    return qs(error);
+  }
+  return startBranch(qs(replay_->player()->path()), *point, quiet);
+}
+
+QString MainWindow::startBranch(const QString& logPath, const BranchPoint& point, bool quiet) {
+  const std::string log = logPath.toStdString();
   connection_->close();
-  if (const std::string error = session_->branchFrom(log, time); !error.empty()) {
+  if (const std::string error = session_->branchFrom(log, point); !error.empty()) {
     connectToRobot();
     if (!quiet) showLoadErrors(tr("Simulate from here"), qs(error));
     return qs(error);
   }
   replay_->close();
-  linkEvent(QStringLiteral("note"), tr("branch of %1 at t = %2 s").arg(qs(log)).arg(time, 0, 'f', 3));
+  const double time = static_cast<double>(point.step) * point.logged.params.step;
+  linkEvent(QStringLiteral("note"), tr("branch of %1 at t = %2 s%3")
+                                        .arg(logPath)
+                                        .arg(time, 0, 'f', 3)
+                                        .arg(point.reconstructed ? tr(" (reconstructed from telemetry)") : QString()));
   feed_->clear();
   wheelPlot_->clear();
   sessionChanged();
@@ -425,8 +454,10 @@ void MainWindow::showSessionLogs() {
   layout->addWidget(buttons);
   connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
   connect(open, &QPushButton::clicked, &dialog, [&] {
-    if (QTreeWidgetItem* item = list->currentItem(); item && openLog(item->data(0, Qt::UserRole).toString()).isEmpty())
+    if (QTreeWidgetItem* item = list->currentItem()) {
+      openLogInBackground(item->data(0, Qt::UserRole).toString());
       dialog.accept();
+    }
   });
   connect(remove, &QPushButton::clicked, &dialog, [&] {
     QStringList paths;
@@ -455,6 +486,12 @@ QString MainWindow::openLog(const QString& path, bool quiet) {
   return {};
 }
 
+void MainWindow::openLogInBackground(const QString& path) {
+  replayDock_->show();  // its progress row shows the opening, with Cancel
+  replayDock_->raise();
+  replay_->openInBackground(path);
+}
+
 void MainWindow::buildMenus() {
   QMenu* file = menuBar()->addMenu(tr("&File"));
   file->addAction(tr("Open &world…"), QKeySequence::Open, this, [this] {
@@ -466,7 +503,7 @@ void MainWindow::buildMenus() {
   file->addAction(tr("Open session &log…"), QKeySequence(Qt::CTRL | Qt::Key_L), this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, tr("Open session log"), qs(toSessionOptions(options_).logDir),
                                                       tr("Session logs (*.splog);;All files (*)"));
-    if (!path.isEmpty()) openLog(path);
+    if (!path.isEmpty()) openLogInBackground(path);
   });
   file->addAction(tr("Session &logs…"), this, [this] { showSessionLogs(); });
   file->addAction(tr("Close replay"), this, [this] { replay_->close(); });

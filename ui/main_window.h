@@ -34,6 +34,7 @@ class QDockWidget;
 
 namespace sp {
 
+struct BranchPoint;
 class ConsoleSession;
 class ControlPanel;
 class LiveLinkFeed;
@@ -91,6 +92,8 @@ class MainWindow : public QMainWindow {
   /// Replay ▸ Simulate from here: the stand-in restarts from the replayed
   /// log's state at `time`, the replay closes and the views show it live.
   QString branchFromReplay(double time, bool quiet = false);
+  /// Opens a log for replay on the Replay dock's worker, with progress.
+  void openLogInBackground(const QString& path);
   WheelForcePlot* wheelForcePlot() const { return wheelPlot_; }
   LaserPlot* laserPlot() const { return laserPlot_; }
   PredictionErrorPlot* predictionErrorPlot() const { return errorPlot_; }
@@ -177,6 +180,7 @@ class MainWindow : public QMainWindow {
   LinkPanel* link_ = nullptr;
   SequencePanel* sequence_ = nullptr;
   QDockWidget* sequenceDock_ = nullptr;
+  QString startBranch(const QString& logPath, const BranchPoint& point, bool quiet);
   ReplayPanel* replay_ = nullptr;
   QDockWidget* replayDock_ = nullptr;
   bool replaying_ = false;

@@ -15,6 +15,7 @@
 #include <QListWidget>
 #include <QMouseEvent>
 #include <QPainter>
+#include <QProgressBar>
 #include <QPushButton>
 #include <QSignalBlocker>
 #include <QSlider>
@@ -97,7 +98,32 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   branch->setToolTip(tr("A new stand-in session starting from the logged state at the cursor (a new log naming this one)"));
   branch->setFocusPolicy(Qt::NoFocus);
   row->addWidget(branch);
+  auto* rehearse = new QPushButton(tr("Rehearse from here"), this);
+  rehearse->setToolTip(tr("The Sequence dock rehearses from the logged state at the cursor, in the logged world"));
+  auto* verifyButton = new QPushButton(tr("Verify"), this);
+  verifyButton->setToolTip(tr("Re-simulate the whole log and compare every logged state hash"));
+  for (QPushButton* b : {branch, rehearse, verifyButton}) b->setFocusPolicy(Qt::NoFocus);
+  row->addWidget(rehearse);
+  row->addWidget(verifyButton);
   layout->addLayout(row);
+  connect(rehearse, &QPushButton::clicked, this, [this] { rehearseHere(); });
+  connect(verifyButton, &QPushButton::clicked, this, [this] { verify(); });
+  // What runs on the worker: what, how far, Cancel. Enabled while the rest
+  // of the panel is (a log opening is shown on the disabled panel too).
+  progressRow_ = new QWidget(this);
+  auto* progressLayout = new QHBoxLayout(progressRow_);
+  progressLayout->setContentsMargins(0, 0, 0, 0);
+  progressLabel_ = new QLabel(progressRow_);
+  progressBar_ = new QProgressBar(progressRow_);
+  progressBar_->setRange(0, 1000);
+  progressBar_->setTextVisible(false);
+  auto* cancelButton = new QPushButton(tr("Cancel"), progressRow_);
+  progressLayout->addWidget(progressLabel_);
+  progressLayout->addWidget(progressBar_, 1);
+  progressLayout->addWidget(cancelButton);
+  connect(cancelButton, &QPushButton::clicked, this, [this] { cancel(); });
+  layout->addWidget(progressRow_);
+  progressRow_->hide();
   // The timeline its own full width, the events ticked under it.
   auto* track = new QVBoxLayout;
   track->setSpacing(0);
@@ -105,10 +131,7 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   marks_ = new Marks(this);
   track->addWidget(marks_);
   layout->addLayout(track);
-  connect(branch, &QPushButton::clicked, this, [this] {
-    pause();
-    emit branchRequested(cursor_);
-  });
+  connect(branch, &QPushButton::clicked, this, [this] { branchHere(); });
   auto* plotRow = new QHBoxLayout;
   signalBox_ = new QComboBox(this);
   signalBox_->setToolTip(tr("The logged signal to plot"));
@@ -164,23 +187,51 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   connect(speedBox_, &QComboBox::currentIndexChanged, this, [this](int i) { setSpeed(speedBox_->itemData(i).toDouble()); });
   connect(slider_, &QSlider::valueChanged, this, [this](int ms) { show(ms / 1000.0); });
   connect(events_, &QListWidget::itemClicked, this, [this](QListWidgetItem* item) { seekToEvent(events_->row(item)); });
-  setEnabled(false);
-  title_->setEnabled(true);
+  setEnabled(false);  // until a log is open (or opening: Cancel)
 }
 
-ReplayPanel::~ReplayPanel() = default;
+ReplayPanel::~ReplayPanel() {
+  cancel_ = true;
+  if (worker_.joinable()) worker_.join();
+}
 
 QString ReplayPanel::open(const QString& path) {
   std::string error;
   std::unique_ptr<LogPlayer> player = LogPlayer::open(path.toStdString(), error);
   if (!player) return QString::fromStdString(error);
+  adopt(std::move(player), path, std::nullopt);
+  return {};
+}
+
+void ReplayPanel::openInBackground(const QString& path) {
+  runInBackground(tr("Opening %1").arg(QFileInfo(path).fileName()),
+                  [this, path](const std::function<bool(double)>& progress) -> std::function<void()> {
+                    std::string error;
+                    // Held by a shared pointer: std::function needs a copyable closure.
+                    auto player = std::make_shared<std::unique_ptr<LogPlayer>>(LogPlayer::open(path.toStdString(), error));
+                    if (!*player) return [this, e = QString::fromStdString(error)] { emit failed(e); };
+                    if (!progress(0.5)) return {};
+                    // The first plot: 1500 seeks, a second or more on a cold disk.
+                    const LogPlayer& p = **player;
+                    auto points = p.signal(kFirstSignal, p.startTime(), p.endTime(), kPlotPoints);
+                    return [this, player, path, points = std::move(points)] {
+                      // The player moves to the GUI thread now; the worker has let go of it.
+                      adopt(std::move(*player), path, points);
+                    };
+                  });
+}
+
+void ReplayPanel::adopt(std::unique_ptr<LogPlayer> player, const QString& path,
+                        std::optional<std::vector<std::pair<double, double>>> firstPlot) {
   pause();
   player_ = std::move(player);
+  lastResult_.clear();
   setEnabled(true);
-  title_->setText(tr("%1: %2 s, %3 events")
+  title_->setText(tr("%1: %2 s, %3 events%4")
                       .arg(QFileInfo(path).fileName())
                       .arg(player_->endTime() - player_->startTime(), 0, 'f', 1)
-                      .arg(player_->events().size()));
+                      .arg(player_->events().size())
+                      .arg(player_->hasSnapshots() ? QString() : tr(" (telemetry only)")));
   events_->clear();
   for (const LogEvent& e : player_->events())
     events_->addItem(QStringLiteral("%1 s  %2: %3")
@@ -196,13 +247,140 @@ QString ReplayPanel::open(const QString& path) {
     const QSignalBlocker block(signalBox_);
     signalBox_->clear();
     for (const std::string& name : player_->signalNames()) signalBox_->addItem(QString::fromStdString(name));
-    signalBox_->setCurrentIndex(6);  // wheel FL normal force
+    signalBox_->setCurrentIndex(kFirstSignal);
   }
   cursor_ = player_->startTime();
-  setSignal(signalBox_->currentIndex());
+  if (firstPlot) {
+    {
+      const QSignalBlocker block(chart_->chart()->axes(Qt::Horizontal).front());  // no re-read: the points are here
+      setVisibleRange(player_->startTime(), player_->endTime());
+    }
+    plot(*firstPlot);
+  } else {
+    setSignal(signalBox_->currentIndex());
+  }
   show(cursor_);
   marks_->update();
-  return {};
+}
+
+bool ReplayPanel::runInBackground(
+    const QString& what, std::function<std::function<void()>(const std::function<bool(double)>& progress)> work) {
+  if (busy_) {
+    emit failed(tr("%1: wait for \"%2\" to end, or cancel it").arg(what, progressLabel_->text()));
+    return false;
+  }
+  if (worker_.joinable()) worker_.join();  // the last one has ended
+  busy_ = true;
+  cancel_ = false;
+  progressLabel_->setText(what + QStringLiteral("…"));
+  progressBar_->setValue(0);
+  progressRow_->show();
+  setEnabled(true);  // for Cancel; every control checks for a player
+  worker_ = std::thread([this, work = std::move(work)] {
+    std::function<void()> done = work([this](double f) {
+      QMetaObject::invokeMethod(this, [this, f] { progressBar_->setValue(static_cast<int>(f * 1000)); },
+                                Qt::QueuedConnection);
+      return !cancel_.load();
+    });
+    QMetaObject::invokeMethod(
+        this,
+        [this, done = std::move(done)] {
+          finishBackground();
+          if (cancel_.load()) {
+            emit failed(tr("Cancelled."));
+            return;
+          }
+          if (done) done();
+        },
+        Qt::QueuedConnection);
+  });
+  return true;
+}
+
+void ReplayPanel::finishBackground() {
+  busy_ = false;
+  progressRow_->hide();
+  progressLabel_->clear();
+  setEnabled(player_ != nullptr);
+}
+
+void ReplayPanel::cancel() { cancel_ = true; }
+
+QString ReplayPanel::progressText() const { return busy_ ? progressLabel_->text() : QString(); }
+
+void ReplayPanel::branchHere() {
+  if (!player_) return;
+  pause();
+  const QString path = QString::fromStdString(player_->path());
+  const double at = cursor_;
+  if (!player_->hasSnapshots()) {
+    // Reconstructed from one sample: no re-simulation, nothing to wait for.
+    std::string error;
+    std::optional<BranchPoint> b = player_->branchAt(at, error);
+    if (!b) emit failed(QString::fromStdString(error));
+    else emit branchReady(path, std::make_shared<const BranchPoint>(std::move(*b)));
+    return;
+  }
+  runInBackground(tr("Re-simulating to t = %1 s").arg(at, 0, 'f', 3),
+                  [this, path, at](const std::function<bool(double)>& progress) -> std::function<void()> {
+                    std::string error;
+                    std::optional<BranchPoint> b = sp::branchAt(path.toStdString(), at, error, progress);
+                    if (!b) return [this, e = QString::fromStdString(error)] { emit failed(e); };
+                    auto point = std::make_shared<const BranchPoint>(std::move(*b));
+                    return [this, path, point] { emit branchReady(path, point); };
+                  });
+}
+
+bool ReplayPanel::rehearseHere() {
+  if (!player_) return false;
+  pause();
+  const std::optional<RehearsalStart> start = player_->startAt(cursor_);
+  if (!start) {
+    emit failed(tr("No sample at t = %1 s to rehearse from").arg(cursor_, 0, 'f', 3));
+    return false;
+  }
+  emit rehearsalStart(*start, player_->world(), player_->params(),
+                      tr("%1 at t = %2 s").arg(QFileInfo(QString::fromStdString(player_->path())).fileName())
+                          .arg(cursor_, 0, 'f', 2));
+  return true;
+}
+
+void ReplayPanel::verify() {
+  if (!player_) return;
+  if (!player_->hasSnapshots()) {
+    lastResult_ = tr("A telemetry-only log holds no snapshots or hashes: there is nothing to re-simulate.");
+    readout_->setText(lastResult_);
+    emit verified(false, lastResult_);
+    return;
+  }
+  const QString path = QString::fromStdString(player_->path());
+  runInBackground(tr("Verifying %1 (re-simulating it)").arg(QFileInfo(path).fileName()),
+                  [this, path](const std::function<bool(double)>& progress) -> std::function<void()> {
+                    std::string error;
+                    const std::optional<ResimReport> r = resimulate(path.toStdString(), {.from = 0, .progress = progress}, error);
+                    QString verdict;
+                    bool passed = false;
+                    if (!r) {
+                      verdict = QString::fromStdString(error);
+                    } else if (r->divergence) {
+                      verdict = tr("Diverges at t = %1 s (step %2): logged hash %3, re-simulated %4")
+                                    .arg(r->divergence->time, 0, 'f', 3)
+                                    .arg(r->divergence->step)
+                                    .arg(QString::fromStdString(hashHex(r->divergence->expected)),
+                                         QString::fromStdString(hashHex(r->divergence->actual)));
+                    } else {
+                      passed = r->hashesCompared > 0;
+                      verdict = tr("Reproduced: %1 logged hashes match, %2 commands re-applied")
+                                    .arg(r->hashesCompared)
+                                    .arg(r->commandsApplied);
+                    }
+                    return [this, passed, verdict] {
+                      lastResult_ = verdict;
+                      title_->setToolTip(verdict);
+                      readout_->setText(verdict);
+                      emit verified(passed, verdict);
+                    };
+                  });
 }
 
 void ReplayPanel::close() {
@@ -218,7 +396,6 @@ void ReplayPanel::close() {
   }
   title_->setText(tr("No log open: File ▸ Open session log…"));
   setEnabled(false);
-  title_->setEnabled(true);
   emit closed();
 }
 
@@ -280,8 +457,11 @@ void ReplayPanel::replot() {
   replotTimer_->stop();
   if (!player_) return;
   auto* x = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Horizontal).front());
+  plot(player_->signal(signalBox_->currentIndex(), x->min(), x->max(), kPlotPoints));
+}
+
+void ReplayPanel::plot(const std::vector<std::pair<double, double>>& points) {
   auto* y = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Vertical).front());
-  const auto points = player_->signal(signalBox_->currentIndex(), x->min(), x->max(), kPlotPoints);
   QList<QPointF> list;
   double lo = 0, hi = 0;
   for (const auto& [t, v] : points) {

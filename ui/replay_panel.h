@@ -1,11 +1,18 @@
 #pragma once
-// The console's third job, first part: replaying a session log. A timeline
-// over the log (play, pause, speed 0.1x-10x, step, seek by dragging) with
-// the log's events marked on it and listed (a click seeks to one); the
-// window's 3D view and plots follow the cursor through the frame and laser
-// signals. Reading is app/log_player.h: one indexed row per seek.
+// The console's third job: replaying a session log. A timeline over the log
+// (play, pause, speed 0.1x-10x, step, seek by dragging) with the log's
+// events marked on it and listed (a click seeks to one); the window's 3D
+// view and plots follow the cursor through the frame and laser signals.
+// Reading is app/log_player.h: one indexed row per seek.
 //
-// Thread: GUI thread.
+// What may take long runs on a worker thread with progress and Cancel, the
+// window staying responsive: opening a log (reading it, rebuilding its
+// world, the first plot), "Simulate from here" (re-simulating from the
+// snapshot before the cursor), "Verify" (re-simulating the whole log
+// against its hashes).
+//
+// Thread: GUI thread; one worker at a time, cancelled and joined by the
+// destructor. The worker never touches the open player: it opens its own.
 
 #include <QElapsedTimer>
 #include <QList>
@@ -13,13 +20,17 @@
 #include <QString>
 #include <QWidget>
 
+#include <atomic>
+#include <functional>
 #include <memory>
+#include <thread>
 
 #include "app/log_player.h"
 
 class QComboBox;
 class QLabel;
 class QListWidget;
+class QProgressBar;
 class QPushButton;
 class QSlider;
 class QTimer;
@@ -36,8 +47,27 @@ class ReplayPanel : public QWidget {
   ~ReplayPanel() override;
 
   /// Opens the log at `path` and shows its start; "" or why not (the
-  /// panel keeps what it had).
+  /// panel keeps what it had). Blocks until read.
   QString open(const QString& path);
+  /// The same on the worker, with progress: `opened` or `openFailed` follow.
+  void openInBackground(const QString& path);
+  /// Simulate from here, on the worker with progress: the state at the
+  /// cursor (re-simulated, or reconstructed from a telemetry-only log);
+  /// `branchReady` or `failed` follow.
+  void branchHere();
+  /// Rehearse from here: the sample at the cursor as a rehearsal's start
+  /// (`rehearsalStart`); false (and `failed`) without one.
+  bool rehearseHere();
+  /// Verify: re-simulates the whole log on the worker and compares every
+  /// logged hash; the verdict is shown and `verified` emitted.
+  void verify();
+  /// A worker task is running (opening, branching, verifying).
+  bool busy() const { return busy_; }
+  /// Stops the worker's task (its result is dropped).
+  void cancel();
+  /// What the progress row says ("" when idle), and the last task's verdict.
+  QString progressText() const;
+  QString lastResult() const { return lastResult_; }
   void close();
   bool isOpen() const { return player_ != nullptr; }
   const LogPlayer* player() const { return player_.get(); }
@@ -74,9 +104,16 @@ class ReplayPanel : public QWidget {
 
  signals:
   void opened(const sp::WorldModel& world);
+  /// A background task failed or was cancelled (the message says which).
+  void failed(const QString& message);
+  /// The branch point at the cursor of log `path` is ready to start from.
+  void branchReady(const QString& path, std::shared_ptr<const sp::BranchPoint> point);
+  /// Rehearse from here: start, and the logged world and parameters.
+  void rehearsalStart(const sp::RehearsalStart& start, const sp::WorldModel& world, const sp::SimParams& params,
+                      const QString& label);
+  /// Verify ended: passed = every logged hash reproduced.
+  void verified(bool passed, const QString& verdict);
   void closed();
-  /// Simulate from here: branch a new stand-in session from the cursor.
-  void branchRequested(double time);
   /// The robot at the cursor, for the views.
   void frame(const sp::RobotFrame& frame);
   void laser(const sp::LaserFrame& scan);
@@ -84,6 +121,26 @@ class ReplayPanel : public QWidget {
  private:
   void tick();
   void show(double time);
+  /// Shows a player opened (on the worker or here); `firstPlot`: the
+  /// default signal over the whole log, read already (else read here).
+  void adopt(std::unique_ptr<LogPlayer> player, const QString& path,
+             std::optional<std::vector<std::pair<double, double>>> firstPlot);
+  void plot(const std::vector<std::pair<double, double>>& points);
+  static constexpr int kFirstSignal = 6;  // wheel FL normal force
+  /// Runs `work(progress)` on the worker with the progress row showing
+  /// `what`; `work` returns what to do back on the GUI thread (dropped when
+  /// cancelled). Returns false if a task runs.
+  bool runInBackground(const QString& what,
+                       std::function<std::function<void()>(const std::function<bool(double)>& progress)> work);
+  void finishBackground();
+
+  std::thread worker_;
+  std::atomic<bool> cancel_{false};
+  bool busy_ = false;
+  QString lastResult_;
+  QWidget* progressRow_ = nullptr;
+  QLabel* progressLabel_ = nullptr;
+  QProgressBar* progressBar_ = nullptr;
 
   std::unique_ptr<LogPlayer> player_;
   double cursor_ = 0;

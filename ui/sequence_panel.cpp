@@ -95,6 +95,16 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
     editor_->setFocus();
   });
 
+  auto* startRow = new QHBoxLayout;
+  startLabel_ = new QLabel(this);
+  startLabel_->setWordWrap(true);
+  unpinButton_ = new QPushButton(tr("From the robot"), this);
+  unpinButton_->setToolTip(tr("Rehearse from the robot's state now again"));
+  startRow->addWidget(startLabel_, 1);
+  startRow->addWidget(unpinButton_);
+  layout->addLayout(startRow);
+  connect(unpinButton_, &QPushButton::clicked, this, &SequencePanel::unpinStart);
+
   auto* runRow = new QHBoxLayout;
   rehearseButton_ = new QPushButton(tr("Rehearse"), this);
   rehearseButton_->setToolTip(tr("Run the sequence on the console's twin from the robot's state now"));
@@ -218,6 +228,17 @@ void SequencePanel::setStartProvider(std::function<std::optional<RehearsalStart>
   startProvider_ = std::move(provider);
 }
 
+void SequencePanel::pinStart(const RehearsalStart& start, const WorldModel& world, const SimParams& params,
+                             const QString& label) {
+  pinned_ = Pinned{start, world, params, label};
+  updateButtons();
+}
+
+void SequencePanel::unpinStart() {
+  pinned_.reset();
+  updateButtons();
+}
+
 void SequencePanel::setLinkReady(bool ready) {
   linkReady_ = ready;
   updateButtons();
@@ -282,7 +303,8 @@ void SequencePanel::startWorker(std::function<void()> work) {
 bool SequencePanel::rehearse() {
   checkNow();
   if (busy_) return false;
-  if (!world_ || world_->robots.empty()) {
+  const WorldModel* world = pinned_ ? &pinned_->world : world_ ? &*world_ : nullptr;
+  if (!world || world->robots.empty()) {
     setStatus(tr("No world with a robot to rehearse on."));
     return false;
   }
@@ -291,16 +313,22 @@ bool SequencePanel::rehearse() {
     return false;
   }
   Diagnostics diag;
-  const RobotModel& robot = world_->robots[0].model;
+  const RobotModel& robot = world->robots[0].model;
   auto commands = parseCommandSequence(editor_->toPlainText().toStdString(), "sequence", diag, &robot);
   if (!commands || commands->empty()) {
     setStatus(tr("The sequence has no command."));
     return false;
   }
-  RehearsalPlan plan{*world_, params_, rules_, std::move(*commands), startProvider_ ? startProvider_() : std::nullopt};
+  RehearsalPlan plan{*world, pinned_ ? pinned_->params : params_, rules_, std::move(*commands),
+                     pinned_                ? std::optional(pinned_->start)
+                     : startProvider_ ? startProvider_()
+                                      : std::nullopt};
   const QString text = editor_->toPlainText();
-  setStatus(plan.start ? tr("Rehearsing from the robot's state now…") : tr("Rehearsing from the world's start…"));
-  startWorker([this, plan = std::move(plan), text]() mutable {
+  const bool pinned = pinned_.has_value();
+  setStatus(pinned       ? tr("Rehearsing from %1…").arg(pinned_->label)
+            : plan.start ? tr("Rehearsing from the robot's state now…")
+                         : tr("Rehearsing from the world's start…"));
+  startWorker([this, plan = std::move(plan), text, pinned]() mutable {
     RehearsalResult r = sp::rehearse(plan, [this](double f) {
       QMetaObject::invokeMethod(this, [this, f] { progress_->setValue(static_cast<int>(f * 1000)); },
                                 Qt::QueuedConnection);
@@ -308,8 +336,9 @@ bool SequencePanel::rehearse() {
     });
     QMetaObject::invokeMethod(
         this,
-        [this, plan = std::move(plan), r = std::move(r), text]() mutable {
+        [this, plan = std::move(plan), r = std::move(r), text, pinned]() mutable {
           rehearsedText_ = text;
+          planPinned_ = pinned;
           rehearsalDone(std::move(plan), std::move(r));
         },
         Qt::QueuedConnection);
@@ -461,6 +490,7 @@ bool SequencePanel::send() {
   std::string why;
   if (!plan_ || !result_) why = "rehearse the sequence first";
   else if (!rehearsalCurrent()) why = "the sequence changed since its rehearsal: rehearse it again";
+  else if (planPinned_) why = "it was rehearsed from a logged moment, not from the robot's state: rehearse it from the robot";
   else if (!linkReady_) why = "the robot cannot take a sequence now (not connected, no lease, or latched)";
   std::optional<net::SequenceMsg> msg;
   if (why.empty()) msg = sequenceMessage(*plan_, *result_, why);
@@ -536,7 +566,10 @@ void SequencePanel::updateButtons() {
   rehearseButton_->setEnabled(!busy_);
   robustButton_->setEnabled(!busy_ && rehearsalCurrent());
   cancelButton_->setEnabled(busy_);
-  sendButton_->setEnabled(!busy_ && linkReady_ && rehearsalCurrent() && result_->passed && !running);
+  sendButton_->setEnabled(!busy_ && linkReady_ && rehearsalCurrent() && result_->passed && !running && !planPinned_);
+  startLabel_->setText(pinned_ ? tr("Start: %1 (a what-if: it cannot be sent)").arg(pinned_->label)
+                               : tr("Start: the robot's state when Rehearse is pressed"));
+  unpinButton_->setVisible(pinned_.has_value());
   abortButton_->setEnabled(running);
 }
 

@@ -70,6 +70,14 @@ class SequencePanel : public QWidget {
   /// Where a rehearsal starts: the robot's state now (nullopt = not known:
   /// then the world's own start). Called when Rehearse is pressed.
   void setStartProvider(std::function<std::optional<RehearsalStart>()> provider);
+  /// Rehearse from a logged moment (Replay ▸ Rehearse from here): until
+  /// unpinned, rehearsals start from `start` in the logged `world` with its
+  /// `params` instead of the robot's state now. Such a rehearsal is a
+  /// what-if: it cannot be sent (the robot is not there).
+  void pinStart(const RehearsalStart& start, const WorldModel& world, const SimParams& params, const QString& label);
+  void unpinStart();
+  /// "" while rehearsals start from the robot; else where they start.
+  QString pinnedStart() const { return pinned_ ? pinned_->label : QString(); }
   /// Whether a sequence may go to the robot now (connected, holding the
   /// lease, nothing latched).
   void setLinkReady(bool ready);
@@ -180,6 +188,16 @@ class SequencePanel : public QWidget {
   std::atomic<bool> cancel_{false};
   std::thread worker_;
   std::optional<RehearsalPlan> plan_;  // of result_
+  struct Pinned {
+    RehearsalStart start;
+    WorldModel world;
+    SimParams params;
+    QString label;
+  };
+  std::optional<Pinned> pinned_;
+  bool planPinned_ = false;  // plan_ started from pinned_, not the robot
+  QLabel* startLabel_ = nullptr;
+  QPushButton* unpinButton_ = nullptr;
   std::optional<RehearsalResult> result_;
   QString rehearsedText_;              // the text result_ rehearsed
   std::optional<RobustnessResult> robust_;

@@ -6,6 +6,8 @@
 
 #include <QTemporaryDir>
 #include <QtTest>
+
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -60,7 +62,7 @@ class TestResimulation : public QObject {
     QCOMPARE(report->commandsApplied, 2);
     QCOMPARE(report->hashesCompared, 4);  // 0, 1, 2 and 2.5 s
     // From the snapshot at 1 s, after the edit: the snapshot carries the heights.
-    report = resimulate(path, {1.0}, error);
+    report = resimulate(path, {.from = 1.0, .progress = {}}, error);
     QVERIFY2(report && !report->divergence, error.c_str());
     QCOMPARE(report->startStep, int64_t{1000});
 
@@ -84,6 +86,27 @@ class TestResimulation : public QObject {
     QCOMPARE(report->hashesCompared, 4);  // steps 0, 1 s, 2 s, 3 s
     QCOMPARE(report->commandsApplied, 1);  // the 1.0 s drive
     QCOMPARE(report->healthMessage, std::string());
+  }
+
+  // Progress: reported rising from about 0 to 1 as the re-simulation goes,
+  // and returning false stops it there (cancelled, short of the end, no
+  // divergence claimed).
+  void progressAndCancel() {
+    QTemporaryDir dir;
+    const std::string path = dir.filePath("session.sqlite").toStdString();
+    QVERIFY(logRun(path));
+    std::vector<double> seen;
+    std::string error;
+    auto report = resimulate(path, {.from = 0, .progress = [&](double f) { seen.push_back(f); return true; }}, error);
+    QVERIFY2(report && !report->cancelled, error.c_str());
+    QVERIFY(seen.size() >= 50);
+    QVERIFY(std::is_sorted(seen.begin(), seen.end()));
+    QVERIFY(seen.front() < 0.05 && seen.back() > 0.95 && seen.back() <= 1.0);
+    const int64_t end = report->endStep;
+    report = resimulate(path, {.from = 0, .progress = [](double f) { return f < 0.5; }}, error);
+    QVERIFY2(report, error.c_str());
+    QVERIFY(report->cancelled && !report->divergence);
+    QVERIFY(report->endStep < end * 6 / 10 && report->endStep >= end * 4 / 10);
   }
 
   // Altering the logged command's text makes the hashes differ from the
