@@ -391,17 +391,6 @@ void MainWindow::buildDocks() {
   });
 }
 
-QString MainWindow::branchFromReplay(double time, bool quiet) {
-  if (!replay_->isOpen()) return tr("no log is being replayed");
-  std::string error;
-  const std::optional<BranchPoint> point = replay_->player()->branchAt(time, error);
-  if (!point) {
-    if (!quiet) showLoadErrors(tr("Simulate from here"), qs(error));
-    return qs(error);
-  }
-  return startBranch(qs(replay_->player()->path()), *point, quiet);
-}
-
 QString MainWindow::startBranch(const QString& logPath, const BranchPoint& point, bool quiet) {
   const std::string log = logPath.toStdString();
   connection_->close();

@@ -89,9 +89,6 @@ class MainWindow : public QMainWindow {
   /// File ▸ Session logs: the log folder's logs with sizes; replay or delete.
   void showSessionLogs();
   bool replaying() const { return replaying_; }
-  /// Replay ▸ Simulate from here: the stand-in restarts from the replayed
-  /// log's state at `time`, the replay closes and the views show it live.
-  QString branchFromReplay(double time, bool quiet = false);
   /// Opens a log for replay on the Replay dock's worker, with progress.
   void openLogInBackground(const QString& path);
   WheelForcePlot* wheelForcePlot() const { return wheelPlot_; }
@@ -180,6 +177,8 @@ class MainWindow : public QMainWindow {
   LinkPanel* link_ = nullptr;
   SequencePanel* sequence_ = nullptr;
   QDockWidget* sequenceDock_ = nullptr;
+  /// Replay ▸ Simulate from here, once the dock has the state: the
+  /// stand-in restarts from it, the replay closes and the views show it live.
   QString startBranch(const QString& logPath, const BranchPoint& point, bool quiet);
   ReplayPanel* replay_ = nullptr;
   QDockWidget* replayDock_ = nullptr;

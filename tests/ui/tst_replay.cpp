@@ -12,6 +12,8 @@
 #include <QTemporaryDir>
 #include <QtTest>
 
+#include <sqlite3.h>
+
 #include <cmath>
 
 #include "app/log_player.h"
@@ -19,6 +21,7 @@
 #include "tests/ui/console_fixture.h"
 #include "ui/main_window.h"
 #include "ui/replay_panel.h"
+#include "ui/sequence_panel.h"
 #include "ui/scene_view.h"
 
 using namespace sp;
@@ -119,13 +122,15 @@ class TestReplay : public QObject {
     // commands from the same state, so the branch's first telemetry frame
     // is where the parent log has the robot at that time, bit for bit (the
     // twin is deterministic; tst_log_player checks the state hash itself).
-    QCOMPARE(w.openLog(log, true), QString());
+    // Opened and branched as the operator does: on the dock's worker.
+    w.openLogInBackground(log);
+    QTRY_VERIFY_WITH_TIMEOUT(r->isOpen() && !r->busy(), 20000);
     const double at = std::round(noteTime * 1000) / 1000;
     r->seek(at);
     const QString oldLog = w.logPath();
-    QCOMPARE(w.branchFromReplay(at, true), QString());
+    r->branchHere();  // "Simulate from here"
+    QTRY_VERIFY_WITH_TIMEOUT(w.logPath() != oldLog, 20000);
     QVERIFY(!w.replaying());
-    QVERIFY(w.logPath() != oldLog);
     QTRY_VERIFY_WITH_TIMEOUT(w.lastTelemetry().has_value() && w.lastTelemetry()->time >= at, 20000);
     const net::TelemetryMsg first = *w.lastTelemetry();
     const Pose parent = reference->frameAt(first.time)->base;
@@ -133,12 +138,81 @@ class TestReplay : public QObject {
           first.pose.p.x, parent.p.x);
     QVERIFY(first.time < at + 1.0);
     QCOMPARE(first.pose.p, parent.p);
+    log_ = log;
+    noteTime_ = noteTime;
+  }
+
+  // Verify re-simulates the whole log on the worker: the window's own log
+  // reproduces every logged hash. Control: a copy whose drive command was
+  // altered diverges, and Verify says so.
+  void verifyReSimulatesTheLog() {
+    QVERIFY(!log_.isEmpty());
+    MainWindow& w = *window_;
+    ReplayPanel* r = w.replayPanel();
+    QSignalSpy verified(r, &ReplayPanel::verified);
+    w.openLogInBackground(log_);
+    QVERIFY(r->busy() && r->progressText().startsWith(QStringLiteral("Opening")));  // shown while it opens
+    QTRY_VERIFY_WITH_TIMEOUT(r->isOpen() && !r->busy(), 20000);
+    r->verify();
+    QTRY_VERIFY_WITH_TIMEOUT(verified.count() == 1, 60000);
+    qInfo("verify: %s", qPrintable(verified[0][1].toString()));
+    QVERIFY(verified[0][0].toBool());
+
+    const QString altered = dir_.filePath(QStringLiteral("altered.splog"));
+    QVERIFY(QFile::copy(log_, altered));
+    sqlite3* db = nullptr;
+    QCOMPARE(sqlite3_open(altered.toUtf8().constData(), &db), SQLITE_OK);
+    QCOMPARE(sqlite3_exec(db, "UPDATE commands SET text = 'drive 0.4 0' WHERE text LIKE 'drive 0.5%'", nullptr, nullptr, nullptr),
+             SQLITE_OK);
+    const int changed = sqlite3_changes(db);
+    sqlite3_close(db);
+    QVERIFY(changed >= 1);
+    w.openLogInBackground(altered);
+    QTRY_VERIFY_WITH_TIMEOUT(r->isOpen() && !r->busy() && r->player()->path() == altered.toStdString(), 20000);
+    r->verify();
+    QTRY_VERIFY_WITH_TIMEOUT(verified.count() == 2, 60000);
+    qInfo("verify (altered): %s", qPrintable(verified[1][1].toString()));
+    QVERIFY(!verified[1][0].toBool());
+    QVERIFY(verified[1][1].toString().startsWith(QStringLiteral("Diverges")));
+  }
+
+  // Rehearse from here: the Sequence dock rehearses from the logged state
+  // at the cursor. Criteria: the rehearsal's first sample is the logged
+  // base pose there (1e-9 m), it runs, and Send refuses it (the robot is
+  // not there); unpinned, the dock rehearses from the robot again.
+  void rehearseFromALoggedMoment() {
+    QVERIFY(!log_.isEmpty());
+    MainWindow& w = *window_;
+    ReplayPanel* r = w.replayPanel();
+    w.openLogInBackground(log_);
+    QTRY_VERIFY_WITH_TIMEOUT(r->isOpen() && !r->busy() && r->player()->path() == log_.toStdString(), 20000);
+    r->seek(noteTime_);
+    const Pose logged = r->player()->frameAt(noteTime_)->base;
+    QVERIFY(r->rehearseHere());
+    SequencePanel* s = w.sequencePanel();
+    QVERIFY(s->pinnedStart().contains(QFileInfo(log_).fileName()));
+    s->setText(QStringLiteral("0 drive 0.3 0\n1.5 stop\n"));
+    QVERIFY(s->rehearse());
+    QTRY_VERIFY_WITH_TIMEOUT(!s->busy(), 30000);
+    QVERIFY(s->result() && s->result()->error.empty());
+    const Pose first = s->result()->path.front().base;
+    qInfo("rehearsed from %.4f, %.4f (logged %.4f, %.4f): %s", first.p.x, first.p.y, logged.p.x, logged.p.y,
+          s->result()->summary().c_str());
+    QVERIFY(std::hypot(first.p.x - logged.p.x, first.p.y - logged.p.y) < 1e-9);
+    QVERIFY(s->result()->path.back().base.p.x - first.p.x > 0.2);  // it drove from there
+    QVERIFY(!s->send());
+    QVERIFY(s->status().contains(QStringLiteral("logged moment")));
+    s->unpinStart();
+    QVERIFY(s->pinnedStart().isEmpty());
+    r->close();
   }
 
  private:
   QTemporaryDir dir_;
   ConsoleOptions options_;
   std::unique_ptr<MainWindow> window_;
+  QString log_;  // the scripted session's log
+  double noteTime_ = 0;
 };
 
 int main(int argc, char** argv) { return sp::test::glTestMain<TestReplay>(argc, argv); }
