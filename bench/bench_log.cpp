@@ -101,12 +101,17 @@ void removeLog(const std::string& path, const std::string& dir) {
   rmdir(dir.c_str());
 }
 
-// A new log with no files in its meta; nullptr (with a message) if it
-// cannot be created.
-std::unique_ptr<SessionLogWriter> openLog(const std::string& path) {
+// A new log; nullptr (with a message) if it cannot be created. With
+// `model`, its world and robot files are stored, so that the console can
+// replay it (bench_replay).
+std::unique_ptr<SessionLogWriter> openLog(const std::string& path, const WorldModel* model = nullptr) {
   std::string error;
   SessionInfo info;
   info.programVersion = "bench";
+  if (model) {
+    info.files.push_back({"world", model->file, readWholeFile(model->file)});
+    info.files.push_back({"robot", model->robots[0].model.file, readWholeFile(model->robots[0].model.file)});
+  }
   auto writer = SessionLogWriter::open(path, info, error);
   if (!writer) std::fprintf(stderr, "%s\n", error.c_str());
   return writer;
@@ -199,7 +204,7 @@ bool writeHour(const WorldModel& model, const std::string& path) {
   Snapshot snapshot = world->snapshot();
   const uint64_t hash = world->stateHash();
 
-  auto writer = openLog(path);
+  auto writer = openLog(path, &model);
   if (!writer) return false;
   const int64_t steps = 3'600'000;  // one hour at 1 kHz
   const double dt = params.step;

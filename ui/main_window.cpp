@@ -349,6 +349,11 @@ void MainWindow::buildDocks() {
   replayDock_->hide();  // until a log is opened
   plotsDock_->raise();
   connect(replay_, &ReplayPanel::opened, this, [this](const WorldModel& world) {
+    QStringList recent = recentLogs();
+    const QString path = QFileInfo(qs(replay_->player()->path())).absoluteFilePath();
+    recent.removeAll(path);
+    recent.prepend(path);
+    QSettings().setValue(QStringLiteral("replay/recent"), recent.mid(0, kRecentLogs));
     if (!replaying_) ghostShownBeforeReplay_ = scene_->ghostVisible();
     replaying_ = true;
     scene_->setWorld(world);
@@ -409,6 +414,13 @@ QString MainWindow::startBranch(const QString& logPath, const BranchPoint& point
   wheelPlot_->clear();
   sessionChanged();
   return {};
+}
+
+QStringList MainWindow::recentLogs() const {
+  QStringList logs;
+  for (const QString& path : QSettings().value(QStringLiteral("replay/recent")).toStringList())
+    if (QFileInfo::exists(path)) logs << path;
+  return logs;
 }
 
 void MainWindow::showSessionLogs() {
@@ -494,6 +506,16 @@ void MainWindow::buildMenus() {
                                                       tr("Session logs (*.splog);;All files (*)"));
     if (!path.isEmpty()) openLogInBackground(path);
   });
+  // The last logs replayed, newest first (settings "replay/recent"); a
+  // file gone since is left out when the menu opens.
+  QMenu* recent = file->addMenu(tr("&Recent session logs"));
+  connect(recent, &QMenu::aboutToShow, this, [this, recent] {
+    recent->clear();
+    for (const QString& path : recentLogs())
+      recent->addAction(QFileInfo(path).fileName(), this, [this, path] { openLogInBackground(path); })->setToolTip(path);
+    if (recent->isEmpty()) recent->addAction(tr("(none yet)"))->setEnabled(false);
+  });
+  recent->setToolTipsVisible(true);
   file->addAction(tr("Session &logs…"), this, [this] { showSessionLogs(); });
   file->addAction(tr("Close replay"), this, [this] { replay_->close(); });
   file->addAction(tr("Open &robot…"), this, [this] {

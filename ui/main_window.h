@@ -91,6 +91,10 @@ class MainWindow : public QMainWindow {
   bool replaying() const { return replaying_; }
   /// Opens a log for replay on the Replay dock's worker, with progress.
   void openLogInBackground(const QString& path);
+  /// File ▸ Recent session logs: the last kRecentLogs logs opened for
+  /// replay that still exist, newest first.
+  QStringList recentLogs() const;
+  static constexpr int kRecentLogs = 8;
   WheelForcePlot* wheelForcePlot() const { return wheelPlot_; }
   LaserPlot* laserPlot() const { return laserPlot_; }
   PredictionErrorPlot* predictionErrorPlot() const { return errorPlot_; }

@@ -10,6 +10,9 @@
 #include <QSettings>
 #include <QSurfaceFormat>
 #include <QTemporaryDir>
+#include <QTreeWidget>
+#include <QPushButton>
+#include <QDialog>
 #include <QtTest>
 
 #include <sqlite3.h>
@@ -174,6 +177,46 @@ class TestReplay : public QObject {
     qInfo("verify (altered): %s", qPrintable(verified[1][1].toString()));
     QVERIFY(!verified[1][0].toBool());
     QVERIFY(verified[1][1].toString().startsWith(QStringLiteral("Diverges")));
+
+    // File ▸ Recent session logs: newest first; a log deleted since is left out.
+    const QString absolute = QFileInfo(altered).absoluteFilePath();
+    QCOMPARE(w.recentLogs().value(0), absolute);
+    QVERIFY(w.recentLogs().contains(QFileInfo(log_).absoluteFilePath()));
+    r->close();
+    QVERIFY(QFile::remove(altered));
+    QVERIFY(!w.recentLogs().contains(absolute));
+  }
+
+  // File ▸ Session logs: the dialog lists the log folder (the scripted
+  // session's log among them, this session's marked) and Replay opens the
+  // one selected.
+  void sessionLogsDialogReplaysALog() {
+    QVERIFY(!log_.isEmpty());
+    MainWindow& w = *window_;
+    int rows = 0;
+    bool marked = false, clicked = false;
+    QTimer::singleShot(300, this, [&] {
+      auto* dialog = qobject_cast<QDialog*>(QApplication::activeModalWidget());
+      if (!dialog) return;
+      auto* list = dialog->findChild<QTreeWidget*>();
+      rows = list ? list->topLevelItemCount() : 0;
+      for (int i = 0; i < rows; ++i) {
+        QTreeWidgetItem* item = list->topLevelItem(i);
+        if (item->text(0).contains(QStringLiteral("this session"))) marked = true;
+        if (item->data(0, Qt::UserRole).toString() == log_) list->setCurrentItem(item);
+      }
+      for (QPushButton* b : dialog->findChildren<QPushButton*>())
+        if (b->text() == QStringLiteral("Replay") && list && list->currentItem()) {
+          b->click();
+          clicked = true;
+        }
+      if (!clicked) dialog->reject();
+    });
+    w.showSessionLogs();
+    qInfo("the dialog listed %d logs", rows);
+    QVERIFY(rows >= 2 && marked && clicked);
+    QTRY_VERIFY_WITH_TIMEOUT(w.replayPanel()->isOpen() && w.replayPanel()->player()->path() == log_.toStdString(), 20000);
+    w.replayPanel()->close();
   }
 
   // Rehearse from here: the Sequence dock rehearses from the logged state
