@@ -33,6 +33,8 @@ constexpr const char* kUsage = R"(usage:
       --log-dir DIR     write it to a new DIR/session-YYYYMMDD-HHMMSS.splog
                         (default: sessions/ under the current directory)
       --no-log          write no session log
+      --no-terrain-edits  refuse terrain edits as a real robot does (the
+                        stand-in, a simulator, takes them by default)
   Prints `logging to PATH`, then `listening on ADDRESS:PORT` when ready;
   connections, lease changes and e-stops go to stderr. Stops on SIGINT or
   SIGTERM. The session log (docs/session-format.md) re-simulates with
@@ -56,6 +58,10 @@ int main(int argc, char** argv) {
     }
     if (a == "--no-log") {
       options.log = false;
+      continue;
+    }
+    if (a == "--no-terrain-edits") {
+      options.terrainEdits = false;
       continue;
     }
     if (i + 1 >= args.size()) {

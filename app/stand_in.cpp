@@ -87,6 +87,8 @@ std::string StandInRobot::start() {
   config.link.telemetryRate = params_.telemetryRate;
   config.link.worldHash = fileHash(world_.file);
   config.link.robotHash = fileHash(world_.robots[0].model.file);
+  if (options_.terrainEdits) config.link.capabilities = "terrain_edit";
+  host_->acceptTerrainEdits(options_.terrainEdits);
   config.link.deadman = params_.linkDeadman;
   config.link.leaseConfirm = params_.linkLeaseConfirm;
   config.maxConnections = static_cast<size_t>(params_.linkMaxConnections);

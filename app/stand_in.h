@@ -65,6 +65,9 @@ struct StandInOptions {
   /// of a logged session: app/resimulation.h branchAt); it must fit the
   /// world (the same files).
   std::optional<Snapshot> startState;
+  /// Take terrain edits over the link (a simulator's capability, announced
+  /// in WELCOME as `terrain_edit`); false behaves as a real robot: refused.
+  bool terrainEdits = true;
   /// Further meta for the session log (`parent_log`, `parent_time`).
   std::map<std::string, std::string> logMeta;
   /// Lines for the operator (no newline): connections, refusals, lease

@@ -6,6 +6,7 @@
 #include "sim/pacer.h"
 #include "sim/readout.h"
 #include "sim/runner.h"
+#include "sim/terrain_brush.h"
 
 namespace sp {
 
@@ -18,6 +19,7 @@ double monotonic() {
 TwinHost::TwinHost(std::unique_ptr<World> world, double realTimeFactor)
     : world_(std::move(world)), model_(world_->robotModel(0)), realTimeFactor_(realTimeFactor) {
   for (const JointSpec& j : model_.joints) jointNames_.push_back(j.name);
+  if (const HeightGrid* g = world_->terrainGrid()) terrainShape_ = HeightGrid{g->columns, g->rows, g->width, g->depth, {}};
   publish();
 }
 
@@ -60,10 +62,13 @@ void TwinHost::logPrediction(const LogPrediction& prediction) {
 }
 
 CommandCheck TwinHost::check(const Command& command) const {
-  // The robot's side of the link takes robot commands only: a terrain edit
-  // is the simulator's, and a real robot could not carry it out.
-  if (std::holds_alternative<TerrainPatchCmd>(command))
-    return {CommandCheck::Kind::Invalid, "terrain: a simulator edit, not a robot command"};
+  // A terrain edit is the simulator's: a real robot could not carry it out.
+  if (const auto* patch = std::get_if<TerrainPatchCmd>(&command)) {
+    if (!terrainEdits_) return {CommandCheck::Kind::Invalid, "terrain: a simulator edit, not a robot command"};
+    if (std::string why = patchFits(terrainShape_ ? &*terrainShape_ : nullptr, *patch); !why.empty())
+      return {CommandCheck::Kind::Invalid, why};
+    return {};
+  }
   return checkCommand(command, model_);
 }
 

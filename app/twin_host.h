@@ -40,6 +40,11 @@ class TwinHost : public net::RobotPort {
   /// state hash every sim second and at stop(), a "health" event when the
   /// twin diverges, and the events of logEvent(). Call before start().
   void logTo(std::unique_ptr<SessionLogWriter> writer);
+  /// Takes terrain edits (`terrain` commands, checked against the
+  /// heightfield) over the link: a simulator's capability, announced in
+  /// WELCOME as `terrain_edit`. Off by default: a robot refuses them.
+  void acceptTerrainEdits(bool on) { terrainEdits_ = on; }
+  bool acceptsTerrainEdits() const { return terrainEdits_; }
   /// Starts the physics thread. Once only.
   void start();
   /// Stops and joins the physics thread, then logs the last snapshot and
@@ -99,6 +104,10 @@ class TwinHost : public net::RobotPort {
 
   std::unique_ptr<World> world_;
   const RobotModel model_;  // a copy: read by the server thread
+  // The heightfield's size, for checking terrain edits on the server thread
+  // (the heights themselves are the physics thread's); null for a plane.
+  std::optional<HeightGrid> terrainShape_;
+  std::atomic<bool> terrainEdits_{false};
   std::vector<std::string> jointNames_;  // model order, sent in every state
   double realTimeFactor_;
   std::unique_ptr<SessionRecorder> log_;  // fed by the physics thread only

@@ -173,6 +173,7 @@ void forEachField(M& m, F& f) {
     f("deadman", m.deadman, Need::Optional);
     f("world_hash", m.worldHash, Need::Optional);
     f("robot_hash", m.robotHash, Need::Optional);
+    f("capabilities", m.capabilities, Need::Optional);
   } else if constexpr (std::is_same_v<T, LeaseStateMsg>) {
     f("holder", m.holder, R);
     f("yours", m.yours, R);
@@ -300,6 +301,9 @@ struct Validator {
       if (std::string e = hexDigits(key, *value, 16, "16 hex digits"); !e.empty()) return e;
       if (value->size() != 16) return std::string("key '") + key + "': expected 16 hex digits, got " + std::to_string(value->size());
     }
+    for (char c : m.capabilities)
+      if (!((c >= 'a' && c <= 'z') || c == '_' || c == ' '))
+        return "key 'capabilities': expected words of a-z and _ separated by spaces";
     return {};
   }
   std::string operator()(const CommandMsg& m) const {

@@ -101,6 +101,10 @@ struct WelcomeMsg {
   /// each (optional keys `world_hash`, `robot_hash`; "" = not
   /// announced): a console checks its own twin's files against them.
   std::string worldHash, robotHash;
+  /// What the robot takes beyond robot commands (optional key
+  /// `capabilities`: words of a-z and _, space-separated; "" = none).
+  /// `terrain_edit`: a simulator that takes `terrain` commands.
+  std::string capabilities;
   friend bool operator==(const WelcomeMsg&, const WelcomeMsg&) = default;
 };
 /// LEASE_ACQUIRE: no keys.

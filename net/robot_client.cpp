@@ -470,6 +470,7 @@ class RobotClient::Impl {
       s.robotDeadman = m.deadman;
       s.robotWorldHash = m.worldHash;
       s.robotRobotHash = m.robotHash;
+      s.robotCapabilities = m.capabilities;
     });
     // Keep-alives at least four per deadman period, so one late or lost
     // keep-alive never trips it.

@@ -98,6 +98,7 @@ struct RobotClientStats {
   double telemetryRateAnnounced = 0;  ///< [Hz] WELCOME `telemetry_rate`
   double robotDeadman = 0;            ///< [s] WELCOME `deadman`: the robot's deadman (0 = not announced)
   std::string robotWorldHash, robotRobotHash;  ///< WELCOME `world_hash`, `robot_hash` ("" = not announced)
+  std::string robotCapabilities;  ///< WELCOME `capabilities` ("" = none)
   double telemetryRateHz = 0;         ///< [Hz] TELEMETRY frames received per second, over the last ~1 s
   uint64_t telemetryFrames = 0;       ///< TELEMETRY frames received
   uint64_t telemetryLost = 0;         ///< frames missing from gaps in TELEMETRY `seq` (within each connection)

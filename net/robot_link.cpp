@@ -142,7 +142,7 @@ void RobotLink::received(ClientId client, const Message& message, double now) {
     c.role = hello->role;
     notice("link", who(client) + " authenticated as " + toString(c.role));
     send(client, WelcomeMsg{config_.robotName, ++session_, config_.telemetryRate, config_.deadman,
-                                config_.worldHash, config_.robotHash});
+                                config_.worldHash, config_.robotHash, config_.capabilities});
     if (robot_) send(client, limitsOf(*robot_));
     const std::string holderName = holder_ ? clients_[holder_].name : std::string();
     send(client, LeaseStateMsg{holderName, false});

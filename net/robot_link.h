@@ -44,6 +44,8 @@ struct RobotLinkConfig {
   /// FNV-1a 64 of the world and robot files (16 hex digits; "" = not
   /// announced), in WELCOME: a console checks its twin's files against them.
   std::string worldHash = {}, robotHash = {};
+  /// WELCOME `capabilities` (net/message.h WelcomeMsg), e.g. "terrain_edit".
+  std::string capabilities = {};
   /// Whether a HELLO may carry the token in clear (`token`) instead of a
   /// proof over this connection's CHALLENGE: only for a robot listening on
   /// loopback, where nobody without the machine can read the link

@@ -10,6 +10,12 @@ inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double degToRad(double deg) { return deg * kPi / 180.0; }
 inline constexpr double radToDeg(double rad) { return rad * 180.0 / kPi; }
 
+/// A point or vector in a plane (the ground, a grid) [m].
+struct Vec2 {
+  double x = 0, y = 0;
+  friend bool operator==(const Vec2&, const Vec2&) = default;
+};
+
 struct Vec3 {
   double x = 0, y = 0, z = 0;
 

@@ -2,6 +2,7 @@
 // queue, and the read-out of state between steps. The stages a step runs are
 // in world_*.cpp (see sim/world_impl.h).
 #include "sim/world.h"
+#include "sim/terrain_brush.h"
 
 #include <algorithm>
 #include <cstdarg>
@@ -208,13 +209,17 @@ double World::terrainHeight(double x, double y) const {
 
 std::string World::checkTerrainPatch(const TerrainPatchCmd& c) const {
   const Impl& m = *impl_;
+  return patchFits(m.heightData ? &*m.grid : nullptr, c);
+}
+
+std::string patchFits(const HeightGrid* grid, const TerrainPatchCmd& c) {
   if (c.columns <= 0 || c.rows <= 0 || c.column < 0 || c.row < 0 ||
       c.heights.size() != static_cast<size_t>(c.columns) * static_cast<size_t>(c.rows))
     return "terrain: the patch's position, size and heights disagree";
   for (double h : c.heights)
     if (!std::isfinite(h)) return "terrain: a height is not finite";
-  if (!m.heightData) return "terrain: the world's terrain is a plane, not a heightfield";
-  const HeightGrid& g = *m.grid;
+  if (!grid) return "terrain: the world's terrain is a plane, not a heightfield";
+  const HeightGrid& g = *grid;
   if (c.column + c.columns > g.columns || c.row + c.rows > g.rows)
     return "terrain: the patch (columns " + std::to_string(c.column) + ".." + std::to_string(c.column + c.columns - 1) +
            ", rows " + std::to_string(c.row) + ".." + std::to_string(c.row + c.rows - 1) +
@@ -225,9 +230,7 @@ std::string World::checkTerrainPatch(const TerrainPatchCmd& c) const {
 void World::applyTerrainPatch(const TerrainPatchCmd& c) {
   Impl& m = *impl_;
   if (m.grid.use_count() > 1) m.grid = std::make_shared<HeightGrid>(*m.grid);  // a snapshot shares it
-  for (int r = 0; r < c.rows; ++r)
-    for (int k = 0; k < c.columns; ++k)
-      m.grid->at(c.column + k, c.row + r) = c.heights[static_cast<size_t>(r) * static_cast<size_t>(c.columns) + k];
+  applyPatch(*m.grid, c);
   dGeomHeightfieldDataSetBounds(m.heightData, m.grid->minHeight(), m.grid->maxHeight());
   // The bounds feed the geom's AABB, which ODE recomputes only for a moved
   // geom: setting the same position marks it dirty.

@@ -152,8 +152,9 @@ void TestMessage::roundTrip_data() {
       << Message(SequenceStateMsg{"0123456789abcdef", SequenceStateKind::Refused, 0, 0, 0, "stale rehearsal"});
   QTest::newRow("ABORT") << Message(AbortMsg{"0123456789abcdef", "guard: position 0.31 m"});
   QTest::newRow("LIMITS without drive") << Message(LimitsMsg{{"arm"}, {0}, {1}, {2}, {3}, 0, 0, ""});
-  QTest::newRow("WELCOME") << Message(WelcomeMsg{"workpartner", 18446744073709551615u, 50, 0, "", ""});
-  QTest::newRow("WELCOME with files") << Message(WelcomeMsg{"workpartner", 3, 50, 0.5, "0123456789abcdef", "fedcba9876543210"});
+  QTest::newRow("WELCOME") << Message(WelcomeMsg{"workpartner", 18446744073709551615u, 50, 0, "", "", ""});
+  QTest::newRow("WELCOME with files") << Message(WelcomeMsg{"workpartner", 3, 50, 0.5, "0123456789abcdef", "fedcba9876543210", ""});
+  QTest::newRow("WELCOME with capabilities") << Message(WelcomeMsg{"workpartner", 4, 50, 0.5, "", "", "terrain_edit"});
   QTest::newRow("LEASE_ACQUIRE") << Message(LeaseAcquireMsg{});
   QTest::newRow("LEASE_KEEPALIVE") << Message(LeaseKeepaliveMsg{});
   QTest::newRow("LEASE_RELEASE") << Message(LeaseReleaseMsg{});
@@ -353,6 +354,8 @@ void TestMessage::decodeErrors_data() {
       "WELCOME: key 'world_hash': expected 16 hex digits, got 3");
   row("robot hash not hex", 2, "robot=r\nsession=1\ntelemetry_rate=50\nrobot_hash=0123456789abcdeg\n",
       "WELCOME: key 'robot_hash': expected hex digits only");
+  row("bad capability", 2, "robot=r\nsession=1\ntelemetry_rate=50\ncapabilities=terrain-edit\n",
+      "WELCOME: key 'capabilities': expected words of a-z and _ separated by spaces");
   row("zero rate", 2, "robot=r\nsession=1\ntelemetry_rate=0\n",
       "WELCOME: key 'telemetry_rate': must be finite and > 0, got 0");
   row("nan rate", 2, "robot=r\nsession=1\ntelemetry_rate=nan\n",

@@ -577,7 +577,7 @@ class TestRobotClient : public QObject {
     QVERIFY(hello->token.empty());
     QCOMPARE(hello->proof, helloProof(kToken, nonce, "operator", Role::Control));
     QCOMPARE(hello->role, Role::Control);
-    fake.send(WelcomeMsg{"fake", 1, 50, 0, "", ""});
+    fake.send(WelcomeMsg{"fake", 1, 50, 0, "", "", ""});
     QVERIFY(c.waitReady());
     for (uint64_t seq : {1, 2, 5, 6, 10, 11}) fake.send(telemetryFrame(seq));
     QVERIFY(c.rec.waitFor([&] { return c.rec.telemetry.size() == 6; }));
@@ -607,7 +607,7 @@ class TestRobotClient : public QObject {
     fake.accept();
     fake.send(ChallengeMsg{"0123456789abcdef0123456789abcdef"});
     QVERIFY(fake.nextOf<HelloMsg>());
-    fake.send(WelcomeMsg{"fake", 1, 50, 0, "", ""});
+    fake.send(WelcomeMsg{"fake", 1, 50, 0, "", "", ""});
     QVERIFY(c.waitReady());
     const uint64_t seq = c.client.sendCommandText("stop", 100);
     const auto sent = fake.nextOf<CommandMsg>();
