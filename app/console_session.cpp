@@ -11,6 +11,7 @@
 #include "app/stand_in.h"
 #include "app/telemetry_recorder.h"
 #include "sim/model_loader.h"
+#include "sim/terrain_brush.h"
 #include "sim/text.h"
 
 namespace sp {
@@ -241,6 +242,15 @@ std::string ConsoleSession::commandRefusal(bool leaseHeld) const {
 void ConsoleSession::commandSent(const Command& command) {
   if (recorder_) recorder_->command(command, robot());
   if (ghost_) ghost_->commandSent(command);
+}
+
+bool ConsoleSession::terrainEdited(const TerrainPatchCmd& patch) {
+  if (!world_ || !patchFits(world_->terrain.kind == TerrainSpec::Kind::Heightfield ? &world_->terrain.grid : nullptr,
+                            patch).empty())
+    return false;
+  applyPatch(world_->terrain.grid, patch);
+  commandSent(patch);
+  return true;
 }
 
 void ConsoleSession::logPrediction(const GhostError& e) {

@@ -154,6 +154,12 @@ class ConsoleSession {
   /// A command went out: logged when the robot is remote (the stand-in logs
   /// what it applies itself), and handed to the ghost.
   void commandSent(const Command& command);
+  /// A terrain edit made in the console: the console's world (what is
+  /// drawn, rehearsed and saved) and the ghost take it now, and a remote
+  /// robot's telemetry log records it (the stand-in logs what it applies).
+  /// Sending it to the robot's twin is the caller's (when the robot
+  /// announces `terrain_edit`). False when it does not fit the terrain.
+  bool terrainEdited(const TerrainPatchCmd& patch);
   /// An operator note into the session log.
   void note(const std::string& text);
   /// Something the console did or decided (kind "rehearsal", "relay",

@@ -45,6 +45,7 @@
 #include "ui/replay_panel.h"
 #include "ui/scene_view.h"
 #include "ui/sequence_panel.h"
+#include "ui/terrain_panel.h"
 
 namespace sp {
 
@@ -118,6 +119,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
     // Losing or giving up control stops the robot: the controls show that.
     if (leaseHeld_ && !lease.yours) controls_->syncToRobot(modelPositions_);
     leaseHeld_ = lease.yours;
+    updateTerrainReach();
     updateControlsEnabled();
   });
   connect(connection_, &RobotConnection::connectionChanged, this, [this](net::ConnectionState s, const QString& d) {
@@ -130,6 +132,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
       filesMismatch_ = qs(session_->filesMismatch(stats.robotWorldHash, stats.robotRobotHash));
       if (!filesMismatch_.isEmpty()) linkEvent(QStringLiteral("link"), filesMismatch_);
     }
+    updateTerrainReach();
     if (s != net::ConnectionState::Ready && leaseHeld_) {
       leaseHeld_ = false;
       controls_->syncToRobot(modelPositions_);
@@ -218,7 +221,7 @@ double MainWindow::viewShare() const {
 void MainWindow::defaultLayout() {
   // Controls over the link on the right, full height; the plots under the
   // 3D view only. At 1280x800 the view gets over half the window.
-  for (QDockWidget* dock : {controlsDock_, sequenceDock_, linkDock_, plotsDock_, replayDock_}) {
+  for (QDockWidget* dock : {controlsDock_, sequenceDock_, terrainDock_, linkDock_, plotsDock_, replayDock_}) {
     dock->setFloating(false);
     dock->show();
   }
@@ -227,6 +230,7 @@ void MainWindow::defaultLayout() {
   // The Sequence dock a tab behind the controls; the Replay dock one behind
   // the plots, shown only while a log is open (its tab bar costs the view).
   tabifyDockWidget(controlsDock_, sequenceDock_);
+  tabifyDockWidget(controlsDock_, terrainDock_);
   controlsDock_->raise();
   addDockWidget(Qt::BottomDockWidgetArea, plotsDock_);
   tabifyDockWidget(plotsDock_, replayDock_);
@@ -245,6 +249,19 @@ MainWindow::~MainWindow() {
   delete connection_;
   connection_ = nullptr;
   session_.reset();
+}
+
+QDockWidget* MainWindow::scrolledDock(const QString& title, const QString& name, QWidget* panel) {
+  auto* dock = new QDockWidget(title, this);
+  dock->setObjectName(name);  // QSettings restores docks by name
+  // Scrolled: a panel's plots and lists must not make the window taller
+  // or wider than the screen.
+  auto* scroll = new QScrollArea;
+  scroll->setWidgetResizable(true);
+  scroll->setFrameShape(QFrame::NoFrame);
+  scroll->setWidget(panel);
+  dock->setWidget(scroll);
+  return dock;
 }
 
 void MainWindow::buildDocks() {
@@ -294,15 +311,25 @@ void MainWindow::buildDocks() {
   connect(link_, &LinkPanel::estopRequested, this, &MainWindow::emergencyStop);
   connect(link_, &LinkPanel::rearmRequested, this, &MainWindow::rearm);
 
+  terrain_ = new TerrainPanel;
+  terrainDock_ = scrolledDock(tr("Terrain"), QStringLiteral("terrainDock"), terrain_);
+  tabifyDockWidget(controlsDock_, terrainDock_);
+  connect(terrain_, &TerrainPanel::editingChanged, this, [this](bool on) {
+    scene_->setTerrainEditing(on);
+    if (on) statusBar()->showMessage(tr("Terrain editing: the left button paints; right drag and wheel move the camera"), 8000);
+  });
+  connect(terrain_, &TerrainPanel::brushRadiusChanged, scene_, &SceneView::setBrushRadius);
+  scene_->setBrushRadius(terrain_->brush().radius);
+  connect(terrain_, &TerrainPanel::pickRequested, scene_, &SceneView::pickGround);
+  connect(scene_, &SceneView::groundPicked, this, [this](const Vec3& g) { terrain_->setFlattenHeight(g.z); });
+  connect(scene_, &SceneView::terrainDab, terrain_, &TerrainPanel::dabAt);
+  connect(scene_, &SceneView::terrainStrokeEnded, terrain_, &TerrainPanel::endStroke);
+  connect(terrain_, &TerrainPanel::strokeEnded, scene_, &SceneView::finishTerrainEdit);
+  connect(terrain_, &TerrainPanel::patch, this, &MainWindow::applyTerrainEdit);
+  connect(terrain_, &TerrainPanel::openWorldRequested, this, [this](const QString& path) { openWorld(path); });
+
   sequence_ = new SequencePanel;
-  sequenceDock_ = new QDockWidget(tr("Sequence"), this);
-  sequenceDock_->setObjectName(QStringLiteral("sequenceDock"));
-  // Scrolled: its plot and lists must not make the window taller than the screen.
-  auto* scroll = new QScrollArea;
-  scroll->setWidgetResizable(true);
-  scroll->setFrameShape(QFrame::NoFrame);
-  scroll->setWidget(sequence_);
-  sequenceDock_->setWidget(scroll);
+  sequenceDock_ = scrolledDock(tr("Sequence"), QStringLiteral("sequenceDock"), sequence_);
   tabifyDockWidget(controlsDock_, sequenceDock_);
   controlsDock_->raise();
   sequence_->setStartProvider([this]() -> std::optional<RehearsalStart> {
@@ -338,13 +365,7 @@ void MainWindow::buildDocks() {
   });
 
   replay_ = new ReplayPanel;
-  replayDock_ = new QDockWidget(tr("Replay"), this);
-  replayDock_->setObjectName(QStringLiteral("replayDock"));
-  auto* replayScroll = new QScrollArea;  // as the Sequence dock: never wider or taller than the screen
-  replayScroll->setWidgetResizable(true);
-  replayScroll->setFrameShape(QFrame::NoFrame);
-  replayScroll->setWidget(replay_);
-  replayDock_->setWidget(replayScroll);
+  replayDock_ = scrolledDock(tr("Replay"), QStringLiteral("replayDock"), replay_);
   tabifyDockWidget(plotsDock_, replayDock_);
   replayDock_->hide();  // until a log is opened
   plotsDock_->raise();
@@ -577,7 +598,8 @@ void MainWindow::buildMenus() {
   connect(ghostAction_, &QAction::toggled, scene_, &SceneView::setGhostVisible);
   scene_->setGhostVisible(ghostAction_->isChecked());
   view->addSeparator();
-  for (QDockWidget* dock : {controlsDock_, plotsDock_, linkDock_}) view->addAction(dock->toggleViewAction());
+  for (QDockWidget* dock : {controlsDock_, sequenceDock_, terrainDock_, plotsDock_, linkDock_})
+    view->addAction(dock->toggleViewAction());
 
   QMenu* help = menuBar()->addMenu(tr("&Help"));
   help->addAction(tr("&Keys"), this, [this] {
@@ -648,6 +670,10 @@ void MainWindow::showWorld(const WorldModel& world) {
   }
   scene_->setWorld(world);
   sequence_->setWorld(world, session_->params());
+  if (terrainWorld_ != shownWorld_) {  // a new world, not the same one shown again after a replay
+    terrain_->setWorld(world);
+    terrainWorld_ = shownWorld_;
+  }
   if (!world.robots.empty()) {
     const RobotModel& robot = world.robots[0].model;
     controls_->setRobot(robot);
@@ -800,6 +826,34 @@ void MainWindow::updateStale() {
     scene_->setStale(stale);
     refreshStatus();
   }
+}
+
+void MainWindow::applyTerrainEdit(const TerrainPatchCmd& patch) {
+  if (replaying_) return;  // the view shows the log's world
+  if (!session_->terrainEdited(patch)) return;
+  scene_->applyTerrainPatch(patch);
+  sequence_->terrainEdited(patch);
+  // The robot's twin, when it is a simulator that takes edits (WELCOME
+  // capability terrain_edit), in frame-sized parts; it logs them.
+  if (robotTakesTerrainEdits() && link_->leaseHeld())
+    for (const TerrainPatchCmd& part : splitPatch(patch, kTerrainPartHeights)) connection_->send(part, session_->robot());
+  ++terrainEdits_;
+}
+
+bool MainWindow::robotTakesTerrainEdits() const {
+  if (connectionState_ != net::ConnectionState::Ready) return false;
+  const std::string caps = " " + connection_->stats().robotCapabilities + " ";
+  return caps.find(" terrain_edit ") != std::string::npos;
+}
+
+void MainWindow::updateTerrainReach() {
+  if (!terrain_) return;
+  if (robotTakesTerrainEdits())
+    terrain_->setReach(link_->leaseHeld() ? tr("Edits reach the robot's twin (a simulator) and the console's.")
+                                          : tr("Take control to edit the robot's twin too; now only the console's twin."));
+  else
+    terrain_->setReach(tr("The robot does not take terrain edits (a real robot, or not connected): only the "
+                          "console's twin, ghost and rehearsals see them."));
 }
 
 void MainWindow::sendCommand(const Command& command) {

@@ -45,6 +45,7 @@ class RobotConnection;
 class ReplayPanel;
 class SceneView;
 class SequencePanel;
+class TerrainPanel;
 class WheelForcePlot;
 
 /// What the console starts with (the `simpartner` command line).
@@ -81,6 +82,9 @@ class MainWindow : public QMainWindow {
   ControlPanel* controlPanel() const { return controls_; }
   LinkPanel* linkPanel() const { return link_; }
   SequencePanel* sequencePanel() const { return sequence_; }
+  TerrainPanel* terrainPanel() const { return terrain_; }
+  /// Terrain edits applied since the start (each dab, undo or redo).
+  int64_t terrainEdits() const { return terrainEdits_; }
   ReplayPanel* replayPanel() const { return replay_; }
   /// File ▸ Open session log: the views show the log at the replay cursor
   /// (the live link goes on unseen) until the replay is closed. "" or why
@@ -180,6 +184,16 @@ class MainWindow : public QMainWindow {
   ControlPanel* controls_ = nullptr;
   LinkPanel* link_ = nullptr;
   SequencePanel* sequence_ = nullptr;
+  TerrainPanel* terrain_ = nullptr;
+  QDockWidget* terrainDock_ = nullptr;
+  int64_t terrainWorld_ = -1;  // the world version the terrain panel edits
+  int64_t terrainEdits_ = 0;
+  static constexpr size_t kTerrainPartHeights = 2000;  // per COMMAND: fits a 64 KiB frame
+  void applyTerrainEdit(const TerrainPatchCmd& patch);
+  /// A dock named `name` holding `panel` in a scroll area.
+  QDockWidget* scrolledDock(const QString& title, const QString& name, QWidget* panel);
+  bool robotTakesTerrainEdits() const;
+  void updateTerrainReach();
   QDockWidget* sequenceDock_ = nullptr;
   /// Replay ▸ Simulate from here, once the dock has the state: the
   /// stand-in restarts from it, the replay closes and the views show it live.

@@ -16,7 +16,14 @@ RobotConnection::~RobotConnection() {
 
 template <typename F>
 void RobotConnection::post(F&& emitIt) {
-  QMetaObject::invokeMethod(this, std::forward<F>(emitIt), Qt::QueuedConnection);
+  // Tagged with the connection it came from: what a closed connection
+  // queued before it stopped is dropped, never shown as the new robot's.
+  QMetaObject::invokeMethod(
+      this,
+      [this, generation = generation_.load(), emitIt = std::forward<F>(emitIt)]() mutable {
+        if (generation == generation_.load()) emitIt();
+      },
+      Qt::QueuedConnection);
 }
 
 void RobotConnection::open(const net::RobotClientConfig& config) {
@@ -57,6 +64,7 @@ void RobotConnection::close() {
   client_->releaseLease();
   client_->stop();  // writes what is queued (the release) first
   client_.reset();
+  ++generation_;  // drops what the old client queued and the window has not taken yet
   emit connectionChanged(net::ConnectionState::Stopped, tr("disconnected"));
 }
 

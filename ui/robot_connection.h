@@ -9,6 +9,7 @@
 #include <QObject>
 #include <QString>
 
+#include <atomic>
 #include <memory>
 
 #include "app/sequence_guard.h"
@@ -68,6 +69,7 @@ class RobotConnection : public QObject {
 
   net::RobotClientConfig config_;
   std::unique_ptr<net::RobotClient> client_;
+  std::atomic<uint64_t> generation_{0};  // of the client; post() reads it on the worker
   std::shared_ptr<SequenceGuard> guard_ = std::make_shared<SequenceGuard>();
 };
 

@@ -1,5 +1,7 @@
 #include "ui/scene_view.h"
 
+#include "sim/terrain_brush.h"
+
 #include <QElapsedTimer>
 #include <QLabel>
 #include <QMouseEvent>
@@ -171,14 +173,41 @@ osg::ref_ptr<osg::Node> planeNode(double z) {
   return geode;
 }
 
+/// The heightfield's mesh as drawn: which grid samples its vertices are
+/// (every stride-th, the last row and column always), so that an edit
+/// updates those vertices in place.
+struct TerrainMesh {
+  osg::ref_ptr<osg::Geometry> geometry;
+  std::vector<int> columns, rows;  // grid sample of each mesh column and row
+  double low = 0, span = 1;        // the colour ramp, fixed when built
+  /// Sets mesh vertex (a, b) from the grid: height, normal (central
+  /// differences on the full grid, one-sided at the edges), colour.
+  void update(const HeightGrid& grid, size_t a, size_t b) {
+    const int i = columns[a], j = rows[b];
+    const size_t k = b * columns.size() + a;
+    const double sx = grid.spacingX(), sy = grid.spacingY(), h = grid.at(i, j);
+    auto& v = static_cast<osg::Vec3Array&>(*geometry->getVertexArray());
+    auto& n = static_cast<osg::Vec3Array&>(*geometry->getNormalArray());
+    auto& c = static_cast<osg::Vec4Array&>(*geometry->getColorArray());
+    v[k] = {f(-grid.width / 2 + i * sx), f(-grid.depth / 2 + j * sy), f(h)};
+    const int i0 = std::max(i - 1, 0), i1 = std::min(i + 1, grid.columns - 1);
+    const int j0 = std::max(j - 1, 0), j1 = std::min(j + 1, grid.rows - 1);
+    const double dx = (grid.at(i1, j) - grid.at(i0, j)) / ((i1 - i0) * sx);
+    const double dy = (grid.at(i, j1) - grid.at(i, j0)) / ((j1 - j0) * sy);
+    osg::Vec3 normal(f(-dx), f(-dy), 1.0f);
+    normal.normalize();
+    n[k] = normal;
+    c[k] = heightColor((h - low) / span);
+  }
+};
+
 /// The heightfield as a smooth-shaded mesh in the terrain frame, split along
 /// the same cell diagonals as ODE's, placed by the terrain pose (grid centre).
-osg::ref_ptr<osg::Node> heightfieldNode(const TerrainSpec& t) {
+osg::ref_ptr<osg::Node> heightfieldNode(const TerrainSpec& t, TerrainMesh& mesh) {
   const HeightGrid& grid = t.grid;
   osg::ref_ptr<osg::MatrixTransform> xf = new osg::MatrixTransform(toMatrix(t.pose));
   const int nx = grid.columns, ny = grid.rows;
   if (nx < 2 || ny < 2 || grid.heights.size() != static_cast<size_t>(nx) * static_cast<size_t>(ny)) return xf;
-  const double sx = grid.spacingX(), sy = grid.spacingY();
   // Drawn at no finer than kMinDisplayCell: software GL pays for every
   // vertex every frame, and a finer mesh than that shows nothing more of
   // the ground an operator drives on. The last row and column are always
@@ -190,35 +219,24 @@ osg::ref_ptr<osg::Node> heightfieldNode(const TerrainSpec& t) {
     at.push_back(n - 1);
     return at;
   };
-  const std::vector<int> cols = samples(nx, sx), rows = samples(ny, sy);
-  const int mx = static_cast<int>(cols.size()), my = static_cast<int>(rows.size());
+  mesh.columns = samples(nx, grid.spacingX());
+  mesh.rows = samples(ny, grid.spacingY());
   // The colour ramp spans at least 0.5 m, so gentle bumps stay gentle.
-  const double lo = grid.minHeight(), span = std::max(grid.maxHeight() - lo, 0.5);
-  osg::ref_ptr<osg::Geometry> g = newGeometry();
-  auto* v = new osg::Vec3Array;
-  auto* n = new osg::Vec3Array;
-  auto* c = new osg::Vec4Array;
-  for (int j : rows) {
-    for (int i : cols) {
-      const double h = grid.at(i, j);
-      v->push_back({f(-grid.width / 2 + i * sx), f(-grid.depth / 2 + j * sy), f(h)});
-      // Central differences on the full grid (one-sided at the edges).
-      const int i0 = std::max(i - 1, 0), i1 = std::min(i + 1, nx - 1);
-      const int j0 = std::max(j - 1, 0), j1 = std::min(j + 1, ny - 1);
-      const double dx = (grid.at(i1, j) - grid.at(i0, j)) / ((i1 - i0) * sx);
-      const double dy = (grid.at(i, j1) - grid.at(i, j0)) / ((j1 - j0) * sy);
-      osg::Vec3 normal(f(-dx), f(-dy), 1.0f);
-      normal.normalize();
-      n->push_back(normal);
-      c->push_back(heightColor((h - lo) / span));
-    }
-  }
-  g->setVertexArray(v);
-  g->setNormalArray(n, osg::Array::BIND_PER_VERTEX);
-  g->setColorArray(c, osg::Array::BIND_PER_VERTEX);
-  g->addPrimitiveSet(gridTriangles(mx, my));
+  mesh.low = grid.minHeight();
+  mesh.span = std::max(grid.maxHeight() - mesh.low, 0.5);
+  mesh.geometry = newGeometry();
+  // Edited in place (applyTerrainPatch): not shared between frames' draws.
+  mesh.geometry->setDataVariance(osg::Object::DYNAMIC);
+  const size_t count = mesh.columns.size() * mesh.rows.size();
+  mesh.geometry->setVertexArray(new osg::Vec3Array(static_cast<unsigned>(count)));
+  mesh.geometry->setNormalArray(new osg::Vec3Array(static_cast<unsigned>(count)), osg::Array::BIND_PER_VERTEX);
+  mesh.geometry->setColorArray(new osg::Vec4Array(static_cast<unsigned>(count)), osg::Array::BIND_PER_VERTEX);
+  for (size_t b = 0; b < mesh.rows.size(); ++b)
+    for (size_t a = 0; a < mesh.columns.size(); ++a) mesh.update(grid, a, b);
+  mesh.geometry->addPrimitiveSet(
+      gridTriangles(static_cast<int>(mesh.columns.size()), static_cast<int>(mesh.rows.size())));
   osg::ref_ptr<osg::Geode> geode = new osg::Geode;
-  geode->addDrawable(g);
+  geode->addDrawable(mesh.geometry);
   xf->addChild(geode);
   return xf;
 }
@@ -356,6 +374,20 @@ struct SceneView::Impl {
   Phantom ghost, rehearsal;
   osg::ref_ptr<osg::Geode> laserNode;
   osg::ref_ptr<osg::Geometry> beams, hits;
+  // The terrain as drawn (its heights kept up to date by edits), its mesh,
+  // and the draped grid lines (rebuilt when a stroke ends).
+  TerrainSpec terrain;
+  TerrainMesh mesh;
+  osg::ref_ptr<osg::Node> gridLines;
+  // Terrain editing: the mode, a stroke under way, a pick asked for, the
+  // brush's footprint (a ring draped on the ground under the cursor).
+  bool editing = false, painting = false, picking = false;
+  double brushRadius = 1.0;
+  std::optional<Vec3> hover;
+  bool footprintDirty = false;
+  osg::ref_ptr<osg::Geode> footprintNode;
+  osg::ref_ptr<osg::Geometry> footprint;
+  void updateFootprint();
   osg::ref_ptr<osg::Fog> fog;
 
   // The robot as last set, and whether the graph still shows an older state.
@@ -425,6 +457,20 @@ SceneView::Impl::Impl() {
   buildPhantom(rehearsal, {1.00f, 0.70f, 0.15f, 0.38f}, {0.95f, 0.45f, 0.00f, 1.0f});
   buildLaser();
   root->addChild(laserNode);
+  // The brush footprint: a yellow ring, unlit, drawn over the ground.
+  footprintNode = new osg::Geode;
+  footprint = newGeometry();
+  footprint->setVertexArray(new osg::Vec3Array);
+  auto* ringColor = new osg::Vec4Array;
+  ringColor->push_back({1.0f, 0.85f, 0.1f, 1.0f});
+  footprint->setColorArray(ringColor, osg::Array::BIND_OVERALL);
+  footprint->addPrimitiveSet(new osg::DrawArrays(GL_LINE_LOOP, 0, 0));
+  footprint->setDataVariance(osg::Object::DYNAMIC);
+  footprintNode->addDrawable(footprint);
+  footprintNode->getOrCreateStateSet()->setMode(GL_LIGHTING, osg::StateAttribute::OFF);
+  footprintNode->getOrCreateStateSet()->setAttributeAndModes(new osg::LineWidth(2.0f));
+  footprintNode->setNodeMask(0);
+  root->addChild(footprintNode);
 
   osg::StateSet* s = root->getOrCreateStateSet();
   // Geometry colours drive ambient and diffuse; a little gloss on the shapes.
@@ -592,9 +638,30 @@ void SceneView::Impl::syncPhantom(Phantom& p) {
   p.pathNode->setNodeMask(p.visible && hasRobot && p.pathPoints.size() > 1 ? ~0u : 0u);
 }
 
+// The footprint ring at the hovered ground point, draped 3 cm above the
+// ground; hidden outside edit mode or off the ground.
+void SceneView::Impl::updateFootprint() {
+  footprintDirty = false;
+  const bool shown = editing && hover.has_value();
+  footprintNode->setNodeMask(shown ? ~0u : 0u);
+  if (!shown) return;
+  auto* v = static_cast<osg::Vec3Array*>(footprint->getVertexArray());
+  v->clear();
+  constexpr int kSegments = 64;
+  for (int k = 0; k < kSegments; ++k) {
+    const double a = 2 * kPi * k / kSegments;
+    const double x = hover->x + brushRadius * std::cos(a), y = hover->y + brushRadius * std::sin(a);
+    v->push_back({f(x), f(y), f(groundHeight(terrain, x, y) + 0.03)});
+  }
+  v->dirty();
+  static_cast<osg::DrawArrays*>(footprint->getPrimitiveSet(0))->setCount(kSegments);
+  footprint->dirtyBound();
+}
+
 // Brings the scene graph and camera up to the stored state; called before
 // each frame, so setters never touch the graph.
 void SceneView::Impl::sync() {
+  if (footprintDirty) updateFootprint();
   if (robotDirty) {
     linkWorld = linkPoses(robot, base, joints);
     for (size_t i = 0; i < links.size() && i < linkWorld.size(); ++i) links[i]->setMatrix(toMatrix(linkWorld[i]));
@@ -687,8 +754,10 @@ void SceneView::setWorld(const WorldModel& world) {
   m.objects.clear();
   m.objectsDirty = false;
 
-  const TerrainSpec& t = world.terrain;
-  osg::ref_ptr<osg::Node> terrain = t.kind == TerrainSpec::Kind::Plane ? planeNode(t.pose.p.z) : heightfieldNode(t);
+  m.terrain = world.terrain;
+  m.mesh = {};
+  const TerrainSpec& t = m.terrain;
+  osg::ref_ptr<osg::Node> terrain = t.kind == TerrainSpec::Kind::Plane ? planeNode(t.pose.p.z) : heightfieldNode(t, m.mesh);
   // Matte ground, pushed back in depth so the grid lines on it always win.
   auto* matte = new osg::Material;
   matte->setColorMode(osg::Material::AMBIENT_AND_DIFFUSE);
@@ -696,7 +765,9 @@ void SceneView::setWorld(const WorldModel& world) {
   terrain->getOrCreateStateSet()->setAttributeAndModes(matte);
   terrain->getOrCreateStateSet()->setAttributeAndModes(new osg::PolygonOffset(1.0f, 1.0f));
   m.worldNode->addChild(terrain);
-  m.worldNode->addChild(gridNode(t));
+  m.gridLines = gridNode(t);
+  m.worldNode->addChild(m.gridLines);
+  m.footprintDirty = true;
   m.worldNode->addChild(axesNode(groundHeight(t, 0, 0)));
   // Objects start where the file puts them; dynamic ones move with setObjectPoses.
   for (const ObjectSpec& o : world.objects) {
@@ -899,6 +970,21 @@ void SceneView::paintGL() {
 }
 
 void SceneView::mousePressEvent(QMouseEvent* event) {
+  Impl& m = *m_;
+  if (event->button() == Qt::LeftButton && (m.editing || m.picking)) {
+    if (const std::optional<Vec3> g = groundAt(event->position())) {
+      if (m.picking) {
+        m.picking = false;
+        unsetCursor();
+        emit groundPicked(*g);
+      } else {
+        m.painting = true;
+        emit terrainDab(*g);
+      }
+    }
+    event->accept();
+    return;
+  }
   if (m_->dragButton == Qt::NoButton) {
     m_->dragButton = event->button();
     m_->lastMouse = event->position() * m_->dpr;
@@ -908,6 +994,11 @@ void SceneView::mousePressEvent(QMouseEvent* event) {
 
 void SceneView::mouseMoveEvent(QMouseEvent* event) {
   Impl& m = *m_;
+  if (m.editing) {
+    m.hover = groundAt(event->position());
+    m.footprintDirty = true;
+    if (m.painting && m.hover) emit terrainDab(*m.hover);
+  }
   if (m.dragButton == Qt::NoButton) return;
   const QPointF p = event->position() * m.dpr;
   const QPointF d = p - m.lastMouse;
@@ -930,6 +1021,10 @@ void SceneView::mouseMoveEvent(QMouseEvent* event) {
 }
 
 void SceneView::mouseReleaseEvent(QMouseEvent* event) {
+  if (event->button() == Qt::LeftButton && m_->painting) {
+    m_->painting = false;
+    emit terrainStrokeEnded();
+  }
   if (event->button() == m_->dragButton) m_->dragButton = Qt::NoButton;
   event->accept();
 }
@@ -939,6 +1034,110 @@ void SceneView::wheelEvent(QWheelEvent* event) {
   const double notches = event->angleDelta().y() / 120.0;
   m_->distance = std::clamp(m_->distance * std::pow(0.88, notches), kMinDistance, kMaxDistance);
   event->accept();
+}
+
+}  // namespace sp
+
+namespace sp {
+
+void SceneView::setTerrainEditing(bool on) {
+  Impl& m = *m_;
+  if (m.painting && !on) {
+    m.painting = false;
+    emit terrainStrokeEnded();
+  }
+  m.editing = on;
+  setMouseTracking(on);  // the footprint follows the cursor without a button down
+  setCursor(on ? Qt::CrossCursor : Qt::ArrowCursor);
+  if (!on) m.hover.reset();
+  m.footprintDirty = true;
+}
+
+bool SceneView::terrainEditing() const { return m_->editing; }
+
+void SceneView::setBrushRadius(double radius) {
+  m_->brushRadius = radius;
+  m_->footprintDirty = true;
+}
+
+void SceneView::pickGround() {
+  m_->picking = true;
+  setCursor(Qt::PointingHandCursor);
+}
+
+std::optional<Vec3> SceneView::groundAt(QPointF pixel) const {
+  const Impl& m = *m_;
+  const osg::Camera* camera = m.viewer->getCamera();
+  const osg::Matrixd toWindow = camera->getViewMatrix() * camera->getProjectionMatrix() *
+                                camera->getViewport()->computeWindowMatrix();
+  const osg::Matrixd fromWindow = osg::Matrixd::inverse(toWindow);
+  // Window coordinates have y up; Qt's have it down.
+  const double x = pixel.x() * m.dpr, y = m.pixelHeight - pixel.y() * m.dpr;
+  const osg::Vec3d nearPoint = osg::Vec3d(x, y, 0.0) * fromWindow, farPoint = osg::Vec3d(x, y, 1.0) * fromWindow;
+  osg::Vec3d dir = farPoint - nearPoint;
+  const double length = std::min(dir.length(), 500.0);
+  dir.normalize();
+  // March along the ray in 5 cm steps to the first point below the ground,
+  // then bisect: the heightfield is a function of (x, y).
+  const auto below = [&](double t) {
+    const osg::Vec3d p = nearPoint + dir * t;
+    return p.z() <= groundHeight(m.terrain, p.x(), p.y());
+  };
+  if (below(0)) return std::nullopt;
+  double lo = 0;
+  for (double t = 0.05; t <= length; t += 0.05) {
+    if (!below(t)) {
+      lo = t;
+      continue;
+    }
+    double hi = t;
+    for (int k = 0; k < 30; ++k) (below((lo + hi) / 2) ? hi : lo) = (lo + hi) / 2;
+    const osg::Vec3d p = nearPoint + dir * hi;
+    return Vec3{p.x(), p.y(), groundHeight(m.terrain, p.x(), p.y())};
+  }
+  return std::nullopt;
+}
+
+void SceneView::applyTerrainPatch(const TerrainPatchCmd& patch) {
+  Impl& m = *m_;
+  HeightGrid& grid = m.terrain.grid;
+  if (m.terrain.kind != TerrainSpec::Kind::Heightfield || !patchFits(&grid, patch).empty()) return;
+  applyPatch(grid, patch);
+  if (!m.mesh.geometry) return;
+  // The drawn samples in the patch and one beyond (their normals change).
+  const auto range = [](const std::vector<int>& at, int from, int to) {
+    const auto a = std::lower_bound(at.begin(), at.end(), from - 1);
+    const auto b = std::upper_bound(at.begin(), at.end(), to + 1);
+    return std::pair{static_cast<size_t>(a - at.begin()), static_cast<size_t>(b - at.begin())};
+  };
+  const auto [a0, a1] = range(m.mesh.columns, patch.column, patch.column + patch.columns - 1);
+  const auto [b0, b1] = range(m.mesh.rows, patch.row, patch.row + patch.rows - 1);
+  for (size_t b = b0; b < b1; ++b)
+    for (size_t a = a0; a < a1; ++a) m.mesh.update(grid, a, b);
+  for (osg::Array* array : {m.mesh.geometry->getVertexArray(), m.mesh.geometry->getNormalArray(),
+                            m.mesh.geometry->getColorArray()})
+    array->dirty();
+  m.mesh.geometry->dirtyBound();
+  m.footprintDirty = true;
+}
+
+void SceneView::finishTerrainEdit() {
+  Impl& m = *m_;
+  if (!m.gridLines) return;
+  // The grid lines drape over the ground: laid again over the edited heights.
+  osg::ref_ptr<osg::Node> lines = gridNode(m.terrain);
+  m.worldNode->replaceChild(m.gridLines, lines);
+  m.gridLines = lines;
+}
+
+std::optional<double> SceneView::drawnTerrainHeight(int i, int j) const {
+  const TerrainMesh& mesh = m_->mesh;
+  if (!mesh.geometry) return std::nullopt;
+  const auto a = std::find(mesh.columns.begin(), mesh.columns.end(), i);
+  const auto b = std::find(mesh.rows.begin(), mesh.rows.end(), j);
+  if (a == mesh.columns.end() || b == mesh.rows.end()) return std::nullopt;
+  const auto& v = static_cast<const osg::Vec3Array&>(*mesh.geometry->getVertexArray());
+  return v[static_cast<size_t>(b - mesh.rows.begin()) * mesh.columns.size() + static_cast<size_t>(a - mesh.columns.begin())].z();
 }
 
 }  // namespace sp

@@ -13,9 +13,11 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "sim/command.h"
 #include "sim/math.h"
 #include "sim/robot_model.h"
 
@@ -126,6 +128,27 @@ class SceneView : public QOpenGLWidget {
   /// first second of drawing.
   double framesPerSecond() const;
 
+  // Terrain editing (issue 16). In edit mode the left button paints: a
+  // `terrainDab` at the ground under the cursor on press and on every move,
+  // `terrainStrokeEnded` on release; the brush's footprint (a ring of
+  // `setBrushRadius` metres draped on the ground) follows the cursor. The
+  // right and middle buttons and the wheel move the camera as always. In
+  // pick mode the next left click emits `groundPicked` instead (once).
+  void setTerrainEditing(bool on);
+  bool terrainEditing() const;
+  void setBrushRadius(double radius);
+  void pickGround();
+  /// The ground under the view's point `pixel` (logical pixels): the first
+  /// crossing of the camera ray with the terrain; nullopt when it misses.
+  std::optional<Vec3> groundAt(QPointF pixel) const;
+  /// Changes the drawn heightfield in place: the vertices of the patch's
+  /// samples and the normals around them (no rebuild); the draped grid lines
+  /// follow at the end of the stroke (finishTerrainEdit).
+  void applyTerrainPatch(const TerrainPatchCmd& patch);
+  void finishTerrainEdit();
+  /// The drawn height of grid sample (i, j) (for tests: the mesh follows edits).
+  std::optional<double> drawnTerrainHeight(int i, int j) const;
+
  protected:
   void initializeGL() override;
   void resizeGL(int w, int h) override;
@@ -140,6 +163,9 @@ class SceneView : public QOpenGLWidget {
   /// date: a source that changes every frame (the ghost) sets its state in
   /// a direct connection and is drawn in this very frame.
   void frameStarting();
+  void terrainDab(const sp::Vec3& ground);
+  void terrainStrokeEnded();
+  void groundPicked(const sp::Vec3& ground);
 
  private:
   struct Impl;

@@ -24,6 +24,7 @@
 #include <cmath>
 
 #include "sim/command_file.h"
+#include "sim/terrain_brush.h"
 
 namespace sp {
 namespace {
@@ -289,7 +290,18 @@ void SequencePanel::checkNow() {
   updateButtons();
 }
 
-bool SequencePanel::rehearsalCurrent() const { return result_ && rehearsedText_ == editor_->toPlainText(); }
+bool SequencePanel::rehearsalCurrent() const {
+  return result_ && rehearsedText_ == editor_->toPlainText() && !terrainEditedSince_;
+}
+
+void SequencePanel::terrainEdited(const TerrainPatchCmd& patch) {
+  if (world_ && patchFits(&world_->terrain.grid, patch).empty()) applyPatch(world_->terrain.grid, patch);
+  if (result_ && !terrainEditedSince_) {
+    terrainEditedSince_ = true;
+    setStatus(tr("The terrain was edited since the rehearsal: rehearse again before sending."));
+    updateButtons();
+  }
+}
 
 void SequencePanel::startWorker(std::function<void()> work) {
   if (worker_.joinable()) worker_.join();  // the last one has ended (busy_ is false)
@@ -339,6 +351,7 @@ bool SequencePanel::rehearse() {
         [this, plan = std::move(plan), r = std::move(r), text, pinned]() mutable {
           rehearsedText_ = text;
           planPinned_ = pinned;
+          terrainEditedSince_ = false;
           rehearsalDone(std::move(plan), std::move(r));
         },
         Qt::QueuedConnection);
@@ -490,6 +503,7 @@ bool SequencePanel::send() {
   std::string why;
   if (!plan_ || !result_) why = "rehearse the sequence first";
   else if (!rehearsalCurrent()) why = "the sequence changed since its rehearsal: rehearse it again";
+  else if (terrainEditedSince_) why = "the terrain was edited since the rehearsal: rehearse it again";
   else if (planPinned_) why = "it was rehearsed from a logged moment, not from the robot's state: rehearse it from the robot";
   else if (!linkReady_) why = "the robot cannot take a sequence now (not connected, no lease, or latched)";
   std::optional<net::SequenceMsg> msg;

@@ -78,6 +78,9 @@ class SequencePanel : public QWidget {
   void unpinStart();
   /// "" while rehearsals start from the robot; else where they start.
   QString pinnedStart() const { return pinned_ ? pinned_->label : QString(); }
+  /// The terrain was edited: rehearsals run on the edited heights, and the
+  /// last rehearsal (on the old ones) cannot be sent until rehearsed again.
+  void terrainEdited(const TerrainPatchCmd& patch);
   /// Whether a sequence may go to the robot now (connected, holding the
   /// lease, nothing latched).
   void setLinkReady(bool ready);
@@ -195,7 +198,8 @@ class SequencePanel : public QWidget {
     QString label;
   };
   std::optional<Pinned> pinned_;
-  bool planPinned_ = false;  // plan_ started from pinned_, not the robot
+  bool planPinned_ = false;
+  bool terrainEditedSince_ = false;  // the terrain changed after result_  // plan_ started from pinned_, not the robot
   QLabel* startLabel_ = nullptr;
   QPushButton* unpinButton_ = nullptr;
   std::optional<RehearsalResult> result_;

@@ -1,0 +1,130 @@
+// Editing the terrain in the console under Xvfb (issue 16), as an operator
+// does: Terrain dock, Edit terrain, a drag with the left button in the 3D
+// view over the ground by the robot. The drawn mesh, the console's world
+// and the robot (the window's stand-in, a simulator that announces
+// terrain_edit) all follow; Undo restores the heights bit for bit and the
+// robot settles back; Save writes a terrain and a world that load as edited.
+
+#include <QMouseEvent>
+#include <QTemporaryDir>
+#include <QtTest>
+
+#include <cmath>
+
+#include "app/console_session.h"
+#include "sim/model_loader.h"
+#include "tests/ui/console_fixture.h"
+#include "ui/control_panel.h"
+#include "ui/main_window.h"
+#include "ui/scene_view.h"
+#include "ui/terrain_panel.h"
+
+using namespace sp;
+
+namespace {
+
+void mouse(QWidget* w, QEvent::Type type, QPointF at, Qt::MouseButtons buttons) {
+  QMouseEvent e(type, at, w->mapToGlobal(at), type == QEvent::MouseMove ? Qt::NoButton : Qt::LeftButton, buttons,
+                Qt::NoModifier);
+  QApplication::sendEvent(w, &e);
+}
+
+}  // namespace
+
+class TestTerrainPanel : public QObject {
+  Q_OBJECT
+
+ private slots:
+  void initTestCase() {
+    if (QGuiApplication::platformName() == QLatin1String("offscreen"))
+      QSKIP("the 3D view needs an X server: run under xvfb-run");
+    QVERIFY(dir_.isValid());
+    const QString error =
+        test::startConsole(dir_, QStringLiteral(SP_SOURCE_DIR "/terrains/test_track.world.xml"), options_, window_);
+    QVERIFY2(error.isEmpty(), qPrintable(error));
+    QTRY_VERIFY_WITH_TIMEOUT(window_->lastTelemetry().has_value() && window_->controlPanel()->controlsEnabled(), 20000);
+    QTRY_VERIFY_WITH_TIMEOUT(window_->lastTelemetry()->time > 2.0, 20000);  // settled on the track
+  }
+  void cleanupTestCase() { window_.reset(); }
+
+  // Criteria (before the run): a drag of the raise brush (radius 1.5 m,
+  // 0.05 m a dab) beside the robot changes the console's world exactly as
+  // the editor's grid (bit for bit), the drawn mesh follows (its vertex at
+  // the dab's sample is the edited height, 1e-6 m: floats), and the robot,
+  // on raised ground, rises at least 3 cm. Undo: the world's heights are the
+  // loaded ones bit for bit, the mesh too, and the robot settles back within
+  // 1 cm of where it stood.
+  void paintUndoAndSave() {
+    MainWindow& w = *window_;
+    TerrainPanel* t = w.terrainPanel();
+    SceneView* view = w.sceneView();
+    QVERIFY(t->editable());
+    Diagnostics diag;
+    const HeightGrid loaded = loadWorld(SP_SOURCE_DIR "/terrains/test_track.world.xml", diag)->terrain.grid;
+    const double z0 = w.lastTelemetry()->pose.p.z;
+
+    t->setBrush(Brush{BrushKind::Raise, 1.5, 0.05, 0, 1});
+    t->setEditing(true);
+    QVERIFY(view->terrainEditing());
+    // The pixel whose ground is nearest the robot's base, 0.4 m behind it
+    // (between its axles): the brush is put down under the robot.
+    const Pose base = w.lastTelemetry()->pose;
+    QPointF centre;
+    double best = 1e9;
+    for (int y = 0; y < view->height(); y += 8)
+      for (int x = 0; x < view->width(); x += 8)
+        if (const std::optional<Vec3> g = view->groundAt(QPointF(x, y))) {
+          const double d = std::hypot(g->x - (base.p.x - 0.4), g->y - base.p.y);
+          if (d < best) best = d, centre = QPointF(x, y);
+        }
+    QVERIFY(best < 0.2);
+    const std::optional<Vec3> ground = view->groundAt(centre);
+    QVERIFY(ground);
+    qInfo("painting at %.2f, %.2f (robot at %.2f, %.2f)", ground->x, ground->y, w.lastTelemetry()->pose.p.x,
+          w.lastTelemetry()->pose.p.y);
+    mouse(view, QEvent::MouseButtonPress, centre, Qt::LeftButton);
+    for (int k = 1; k <= 20; ++k) {
+      mouse(view, QEvent::MouseMove, centre + QPointF(4.0 * k, 0), Qt::LeftButton);
+      QTest::qWait(16);
+    }
+    mouse(view, QEvent::MouseButtonRelease, centre + QPointF(80, 0), Qt::NoButton);
+    QVERIFY(w.terrainEdits() >= 2);
+    QCOMPARE(t->editor()->undoLevels(), size_t{1});
+    const HeightGrid& edited = t->editor()->grid();
+    QVERIFY(edited.heights != loaded.heights);
+    QCOMPARE(w.session()->world()->terrain.grid.heights, edited.heights);
+    const Vec2 at = gridPoint(w.session()->world()->terrain, {base.p.x, base.p.y});  // the sample under the robot
+    const int i = static_cast<int>(std::lround((at.x + edited.width / 2) / edited.spacingX()) / 2 * 2);  // a drawn sample (every 2nd)
+    const int j = static_cast<int>(std::lround((at.y + edited.depth / 2) / edited.spacingY()) / 2 * 2);
+    QVERIFY(view->drawnTerrainHeight(i, j).has_value());
+    QVERIFY(std::abs(*view->drawnTerrainHeight(i, j) - edited.at(i, j)) < 1e-6);
+    QVERIFY(edited.at(i, j) - loaded.at(i, j) > 0.05);
+    QTRY_VERIFY_WITH_TIMEOUT(w.lastTelemetry()->pose.p.z - z0 > 0.03, 10000);
+    qInfo("raised %.3f m under the brush; the robot rose %.3f m", edited.at(i, j) - loaded.at(i, j),
+          w.lastTelemetry()->pose.p.z - z0);
+
+    // Save: the terrain and a world using it load as edited.
+    const QString csv = dir_.filePath(QStringLiteral("edited.csv")), world = dir_.filePath(QStringLiteral("edited.world.xml"));
+    QCOMPARE(t->save(csv, world), QString());
+    const std::optional<WorldModel> saved = loadWorld(world.toStdString(), diag);
+    QVERIFY2(saved, diag.format().c_str());
+    QCOMPARE(saved->terrain.grid.heights, edited.heights);
+
+    t->undo();
+    QCOMPARE(t->editor()->redoLevels(), size_t{1});
+    QCOMPARE(w.session()->world()->terrain.grid.heights, loaded.heights);
+    QVERIFY(std::abs(*view->drawnTerrainHeight(i, j) - loaded.at(i, j)) < 1e-6);
+    QTRY_VERIFY_WITH_TIMEOUT(std::abs(w.lastTelemetry()->pose.p.z - z0) < 0.01, 10000);
+    t->setEditing(false);
+    QVERIFY(!view->terrainEditing());
+  }
+
+ private:
+  QTemporaryDir dir_;
+  ConsoleOptions options_;
+  std::unique_ptr<MainWindow> window_;
+};
+
+int main(int argc, char** argv) { return sp::test::glTestMain<TestTerrainPanel>(argc, argv); }
+
+#include "tst_terrain_panel.moc"
