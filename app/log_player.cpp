@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sim/command_file.h"
 #include "sim/math.h"
+#include "sim/terrain_brush.h"
 #include "sim/world.h"
 
 namespace sp {
@@ -25,6 +27,15 @@ std::unique_ptr<LogPlayer> LogPlayer::open(const std::string& path, std::string&
   p->end_ = range->second;
   p->events_ = p->reader_->events();
   p->hasSnapshots_ = !p->reader_->snapshotSteps().empty();
+  // Terrain edits: few, read once (a drag logs one per dab).
+  for (const LogCommand& c : p->reader_->commands()) {
+    if (c.text.rfind("terrain ", 0) != 0) continue;
+    std::string why;
+    std::optional<Command> command = parseCommand(c.text, why, &p->logged_.world.robots[0].model);
+    if (const auto* patch = command ? std::get_if<TerrainPatchCmd>(&*command) : nullptr;
+        patch && patchFits(&p->logged_.world.terrain.grid, *patch).empty())
+      p->terrainEdits_.emplace_back(static_cast<double>(c.step) * p->logged_.params.step, *patch);
+  }
   return p;
 }
 
@@ -52,6 +63,19 @@ std::optional<LaserFrame> LogPlayer::laserAt(double time) const {
   std::optional<LogLaser> l = reader_->laserAt(time);
   if (!l || l->time < time - 1.0) return std::nullopt;
   return LaserFrame{l->time, l->angleMin, l->angleStep, std::move(l->ranges)};
+}
+
+size_t LogPlayer::terrainEditsAt(double time) const {
+  // A command logged at step s applies in the step from s: drawn from s on.
+  return static_cast<size_t>(std::upper_bound(terrainEdits_.begin(), terrainEdits_.end(), time,
+                                              [](double t, const auto& e) { return t < e.first; }) -
+                             terrainEdits_.begin());
+}
+
+HeightGrid LogPlayer::terrainAfter(size_t count) const {
+  HeightGrid grid = logged_.world.terrain.grid;
+  for (size_t i = 0; i < count && i < terrainEdits_.size(); ++i) applyPatch(grid, terrainEdits_[i].second);
+  return grid;
 }
 
 std::optional<RehearsalStart> LogPlayer::startAt(double time) const {

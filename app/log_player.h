@@ -65,6 +65,12 @@ class LogPlayer {
   std::optional<BranchPoint> branchAt(double time, std::string& error,
                                       const std::function<bool(double)>& progress = {}) const;
 
+  /// Terrain edits made during the session (its `terrain` commands), for
+  /// drawing the ground as it was: how many apply at or before `time`, and
+  /// the logged heightfield with the first `count` of them applied.
+  size_t terrainEditsAt(double time) const;
+  HeightGrid terrainAfter(size_t count) const;
+
   /// The signals a replay can plot (PlotJuggler's habit: pick any): base
   /// x, y, z, roll, pitch, yaw; the four wheel normal forces; every joint's
   /// position and rate; the ghost's predicted x, y and its position and
@@ -86,6 +92,7 @@ class LogPlayer {
   double start_ = 0, end_ = 0;
   std::vector<LogEvent> events_;
   bool hasSnapshots_ = false;
+  std::vector<std::pair<double, TerrainPatchCmd>> terrainEdits_;  // (time, edit), in order
 };
 
 }  // namespace sp

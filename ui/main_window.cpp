@@ -388,6 +388,11 @@ void MainWindow::buildDocks() {
     wheelPlot_->addSample(f.time, f.wheelNormal);
     simTime_->setText(tr("replay t = %1 s").arg(formatFixed(f.time, 2)));
   });
+  connect(replay_, &ReplayPanel::terrain, this, [this](const HeightGrid& grid) {
+    // The whole grid as one patch: the mesh updated in place.
+    scene_->applyTerrainPatch(TerrainPatchCmd{0, 0, grid.columns, grid.rows, grid.heights});
+    scene_->finishTerrainEdit();
+  });
   connect(replay_, &ReplayPanel::laser, this, [this](const LaserFrame& scan) {
     scene_->setLaser(scan.angleMin, scan.angleStep, scan.ranges);
     laserPlot_->setScan(scan.angleMin, scan.angleStep, scan.ranges);

@@ -250,6 +250,7 @@ void ReplayPanel::adopt(std::unique_ptr<LogPlayer> player, const QString& path,
     signalBox_->setCurrentIndex(kFirstSignal);
   }
   cursor_ = player_->startTime();
+  terrainShown_ = 0;  // opened() drew the terrain as loaded
   if (firstPlot) {
     {
       const QSignalBlocker block(chart_->chart()->axes(Qt::Horizontal).front());  // no re-read: the points are here
@@ -532,6 +533,10 @@ void ReplayPanel::show(double time) {
   moveCursorLine();
   if (std::optional<RobotFrame> f = player_->frameAt(cursor_)) emit frame(*f);
   if (std::optional<LaserFrame> l = player_->laserAt(cursor_)) emit laser(*l);
+  if (const size_t edits = player_->terrainEditsAt(cursor_); edits != terrainShown_) {
+    terrainShown_ = edits;
+    emit terrain(player_->terrainAfter(edits));
+  }
 }
 
 }  // namespace sp

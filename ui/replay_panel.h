@@ -117,6 +117,9 @@ class ReplayPanel : public QWidget {
   /// The robot at the cursor, for the views.
   void frame(const sp::RobotFrame& frame);
   void laser(const sp::LaserFrame& scan);
+  /// The ground at the cursor changed (terrain edits made in the session):
+  /// the logged heightfield with the edits up to the cursor.
+  void terrain(const sp::HeightGrid& grid);
 
  private:
   void tick();
@@ -137,6 +140,7 @@ class ReplayPanel : public QWidget {
   std::thread worker_;
   std::atomic<bool> cancel_{false};
   bool busy_ = false;
+  size_t terrainShown_ = 0;  // terrain edits drawn (those up to the cursor)
   QString lastResult_;
   QWidget* progressRow_ = nullptr;
   QLabel* progressLabel_ = nullptr;

@@ -12,6 +12,7 @@
 #include <deque>
 #include <random>
 
+#include "app/log_player.h"
 #include "app/resimulation.h"
 #include "app/stand_in.h"
 #include "app/terrain_editor.h"
@@ -199,6 +200,15 @@ class TestTerrainEdit : public QObject {
       qInfo("re-simulated: %d hashes, %d commands", r->hashesCompared, r->commandsApplied);
       QVERIFY(!r->divergence && r->hashesCompared >= 2);
       QCOMPARE(r->commandsApplied, static_cast<int>(parts.size()));
+      // Replayed, the ground is as loaded before the edit and edited after it.
+      auto player = LogPlayer::open(log, error);
+      QVERIFY2(player, error.c_str());
+      QCOMPARE(player->terrainEditsAt(player->startTime()), size_t{0});
+      QCOMPARE(player->terrainEditsAt(player->endTime()), parts.size());
+      HeightGrid expected = model.terrain.grid;
+      applyPatch(expected, *patch);
+      QCOMPARE(player->terrainAfter(parts.size()).heights, expected.heights);
+      QCOMPARE(player->terrainAfter(0).heights, model.terrain.grid.heights);
     }
   }
 };
