@@ -230,8 +230,22 @@ std::string patchFits(const HeightGrid* grid, const TerrainPatchCmd& c) {
 void World::applyTerrainPatch(const TerrainPatchCmd& c) {
   Impl& m = *impl_;
   if (m.grid.use_count() > 1) m.grid = std::make_shared<HeightGrid>(*m.grid);  // a snapshot shares it
+  // The bounds stay exact without reading the whole grid (0.3 ms for 512 x
+  // 512) unless the patch replaces a sample at the lowest or highest height.
+  bool rescan = false;
+  for (int r = 0; r < c.rows && !rescan; ++r)
+    for (int k = 0; k < c.columns; ++k) {
+      const double old = m.grid->at(c.column + k, c.row + r);
+      if (old == m.gridMin || old == m.gridMax) rescan = true;
+    }
   applyPatch(*m.grid, c);
-  dGeomHeightfieldDataSetBounds(m.heightData, m.grid->minHeight(), m.grid->maxHeight());
+  if (rescan) {
+    m.setTerrainBounds(m.grid->minHeight(), m.grid->maxHeight());
+  } else {
+    double lo = m.gridMin, hi = m.gridMax;
+    for (double h : c.heights) lo = std::min(lo, h), hi = std::max(hi, h);
+    m.setTerrainBounds(lo, hi);
+  }
   // The bounds feed the geom's AABB, which ODE recomputes only for a moved
   // geom: setting the same position marks it dirty.
   const dReal* pos = dGeomGetPosition(m.terrainGeom);

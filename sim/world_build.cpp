@@ -182,7 +182,7 @@ bool World::build(Diagnostics& diag) {
     m.heightData = dGeomHeightfieldDataCreate();
     dGeomHeightfieldDataBuildCallback(m.heightData, &m, &Impl::heightAt, g.width, g.depth, g.columns, g.rows,
                                       1.0, 0.0, 1.0, 0);
-    dGeomHeightfieldDataSetBounds(m.heightData, g.minHeight(), g.maxHeight());
+    m.setTerrainBounds(g.minHeight(), g.maxHeight());
     m.terrainGeom = dCreateHeightfield(m.space, m.heightData, 1);
     // ODE's heightfield is y-up: turn it +90 deg about x so heights point up z.
     const Quat q = t.pose.q * quatFromAxisAngle({1, 0, 0}, kPi / 2);

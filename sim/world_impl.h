@@ -120,6 +120,12 @@ struct World::Impl {
   // Live heights, read by the ODE callback. Shared with snapshots and
   // copied on the first edit after one (copy on write).
   std::shared_ptr<HeightGrid> grid;
+  double gridMin = 0, gridMax = 0;  // the grid's lowest and highest height (ODE's bounds)
+  void setTerrainBounds(double lo, double hi) {
+    gridMin = lo;
+    gridMax = hi;
+    dGeomHeightfieldDataSetBounds(heightData, lo, hi);
+  }
   double planeHeight = 0;
   dGeomID ray = nullptr;  // for castRay(); in no space
   struct RayTarget {

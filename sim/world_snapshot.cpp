@@ -88,7 +88,7 @@ std::string World::restore(const Snapshot& s) {
   if (m.heightData && s.terrain && s.terrain != m.grid) {
     m.grid = std::const_pointer_cast<HeightGrid>(s.terrain);
     // Shared with the snapshot from now on: the next edit copies it first.
-    dGeomHeightfieldDataSetBounds(m.heightData, m.grid->minHeight(), m.grid->maxHeight());
+    m.setTerrainBounds(m.grid->minHeight(), m.grid->maxHeight());
     const dReal* pos = dGeomGetPosition(m.terrainGeom);
     dGeomSetPosition(m.terrainGeom, pos[0], pos[1], pos[2]);
   }

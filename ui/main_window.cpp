@@ -220,20 +220,26 @@ double MainWindow::viewShare() const {
 
 void MainWindow::defaultLayout() {
   // Controls over the link on the right, full height; the plots under the
-  // 3D view only. At 1280x800 the view gets over half the window.
-  for (QDockWidget* dock : {controlsDock_, sequenceDock_, terrainDock_, linkDock_, plotsDock_, replayDock_}) {
+  // 3D view only. At 1280x800 the view gets over half the window. Every
+  // dock is taken out first: re-adding one out of a tab group can leave
+  // another in the group (the link dock ended up a tab of the controls).
+  const std::initializer_list<QDockWidget*> docks{controlsDock_, sequenceDock_, terrainDock_,
+                                                  linkDock_,     plotsDock_,    replayDock_};
+  for (QDockWidget* dock : docks) {
+    removeDockWidget(dock);
     dock->setFloating(false);
-    dock->show();
   }
   addDockWidget(Qt::RightDockWidgetArea, controlsDock_);
   splitDockWidget(controlsDock_, linkDock_, Qt::Vertical);
-  // The Sequence dock a tab behind the controls; the Replay dock one behind
-  // the plots, shown only while a log is open (its tab bar costs the view).
+  // The Sequence and Terrain docks tabs behind the controls; the Replay
+  // dock one behind the plots, shown only while a log is open (its tab bar
+  // costs the view).
   tabifyDockWidget(controlsDock_, sequenceDock_);
   tabifyDockWidget(controlsDock_, terrainDock_);
-  controlsDock_->raise();
   addDockWidget(Qt::BottomDockWidgetArea, plotsDock_);
   tabifyDockWidget(plotsDock_, replayDock_);
+  for (QDockWidget* dock : docks) dock->show();
+  controlsDock_->raise();
   replayDock_->setVisible(replaying_);
   (replaying_ ? replayDock_ : plotsDock_)->raise();
   resizeDocks({controlsDock_}, {320}, Qt::Horizontal);

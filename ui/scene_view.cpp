@@ -174,30 +174,61 @@ osg::ref_ptr<osg::Node> planeNode(double z) {
 }
 
 /// The heightfield's mesh as drawn: which grid samples its vertices are
-/// (every stride-th, the last row and column always), so that an edit
-/// updates those vertices in place.
+/// (every stride-th, the last row and column always), in tiles of at most
+/// kTile x kTile cells, each its own geometry, so that an edit re-uploads
+/// only the tiles it touches (a vertex buffer is sent whole when dirtied).
+/// Tiles share their edge vertices.
 struct TerrainMesh {
-  osg::ref_ptr<osg::Geometry> geometry;
+  static constexpr size_t kTile = 64;  // cells per tile side
+  struct Tile {
+    osg::ref_ptr<osg::Geometry> geometry;
+    size_t a0, b0, columns;  // first mesh column and row, vertices per row
+    bool dirty = false;
+  };
   std::vector<int> columns, rows;  // grid sample of each mesh column and row
+  size_t tilesX = 0, tilesY = 0;
+  std::vector<Tile> tiles;         // row by row
   double low = 0, span = 1;        // the colour ramp, fixed when built
-  /// Sets mesh vertex (a, b) from the grid: height, normal (central
-  /// differences on the full grid, one-sided at the edges), colour.
+
+  /// Sets mesh vertex (a, b) from the grid, in each tile holding it:
+  /// height, normal (central differences on the full grid, one-sided at
+  /// the edges), colour.
   void update(const HeightGrid& grid, size_t a, size_t b) {
     const int i = columns[a], j = rows[b];
-    const size_t k = b * columns.size() + a;
     const double sx = grid.spacingX(), sy = grid.spacingY(), h = grid.at(i, j);
-    auto& v = static_cast<osg::Vec3Array&>(*geometry->getVertexArray());
-    auto& n = static_cast<osg::Vec3Array&>(*geometry->getNormalArray());
-    auto& c = static_cast<osg::Vec4Array&>(*geometry->getColorArray());
-    v[k] = {f(-grid.width / 2 + i * sx), f(-grid.depth / 2 + j * sy), f(h)};
+    const osg::Vec3 vertex(f(-grid.width / 2 + i * sx), f(-grid.depth / 2 + j * sy), f(h));
     const int i0 = std::max(i - 1, 0), i1 = std::min(i + 1, grid.columns - 1);
     const int j0 = std::max(j - 1, 0), j1 = std::min(j + 1, grid.rows - 1);
     const double dx = (grid.at(i1, j) - grid.at(i0, j)) / ((i1 - i0) * sx);
     const double dy = (grid.at(i, j1) - grid.at(i, j0)) / ((j1 - j0) * sy);
     osg::Vec3 normal(f(-dx), f(-dy), 1.0f);
     normal.normalize();
-    n[k] = normal;
-    c[k] = heightColor((h - low) / span);
+    const osg::Vec4 colour = heightColor((h - low) / span);
+    // The tile a / kTile, and the one before when (a, b) is on its edge.
+    for (size_t ty = b / kTile - (b % kTile == 0 && b > 0 ? 1 : 0); ty <= std::min(b / kTile, tilesY - 1); ++ty)
+      for (size_t tx = a / kTile - (a % kTile == 0 && a > 0 ? 1 : 0); tx <= std::min(a / kTile, tilesX - 1); ++tx) {
+        Tile& t = tiles[ty * tilesX + tx];
+        const size_t k = (b - t.b0) * t.columns + (a - t.a0);
+        static_cast<osg::Vec3Array&>(*t.geometry->getVertexArray())[k] = vertex;
+        static_cast<osg::Vec3Array&>(*t.geometry->getNormalArray())[k] = normal;
+        static_cast<osg::Vec4Array&>(*t.geometry->getColorArray())[k] = colour;
+        t.dirty = true;
+      }
+  }
+  /// Sends the changed tiles' arrays to the GPU at the next frame.
+  void flush() {
+    for (Tile& t : tiles) {
+      if (!t.dirty) continue;
+      for (osg::Array* array : {t.geometry->getVertexArray(), t.geometry->getNormalArray(), t.geometry->getColorArray()})
+        array->dirty();
+      t.geometry->dirtyBound();
+      t.dirty = false;
+    }
+  }
+  /// The drawn height of mesh vertex (a, b).
+  float height(size_t a, size_t b) const {
+    const Tile& t = tiles[std::min(b / kTile, tilesY - 1) * tilesX + std::min(a / kTile, tilesX - 1)];
+    return static_cast<const osg::Vec3Array&>(*t.geometry->getVertexArray())[(b - t.b0) * t.columns + (a - t.a0)].z();
   }
 };
 
@@ -224,19 +255,31 @@ osg::ref_ptr<osg::Node> heightfieldNode(const TerrainSpec& t, TerrainMesh& mesh)
   // The colour ramp spans at least 0.5 m, so gentle bumps stay gentle.
   mesh.low = grid.minHeight();
   mesh.span = std::max(grid.maxHeight() - mesh.low, 0.5);
-  mesh.geometry = newGeometry();
-  // Edited in place (applyTerrainPatch): not shared between frames' draws.
-  mesh.geometry->setDataVariance(osg::Object::DYNAMIC);
-  const size_t count = mesh.columns.size() * mesh.rows.size();
-  mesh.geometry->setVertexArray(new osg::Vec3Array(static_cast<unsigned>(count)));
-  mesh.geometry->setNormalArray(new osg::Vec3Array(static_cast<unsigned>(count)), osg::Array::BIND_PER_VERTEX);
-  mesh.geometry->setColorArray(new osg::Vec4Array(static_cast<unsigned>(count)), osg::Array::BIND_PER_VERTEX);
+  const size_t cellsX = mesh.columns.size() - 1, cellsY = mesh.rows.size() - 1;
+  mesh.tilesX = (cellsX + TerrainMesh::kTile - 1) / TerrainMesh::kTile;
+  mesh.tilesY = (cellsY + TerrainMesh::kTile - 1) / TerrainMesh::kTile;
+  osg::ref_ptr<osg::Geode> geode = new osg::Geode;
+  for (size_t ty = 0; ty < mesh.tilesY; ++ty)
+    for (size_t tx = 0; tx < mesh.tilesX; ++tx) {
+      TerrainMesh::Tile tile;
+      tile.a0 = tx * TerrainMesh::kTile;
+      tile.b0 = ty * TerrainMesh::kTile;
+      tile.columns = std::min(cellsX, tile.a0 + TerrainMesh::kTile) - tile.a0 + 1;
+      const size_t tileRows = std::min(cellsY, tile.b0 + TerrainMesh::kTile) - tile.b0 + 1;
+      const auto count = static_cast<unsigned>(tile.columns * tileRows);
+      tile.geometry = newGeometry();
+      // Edited in place (applyTerrainPatch).
+      tile.geometry->setDataVariance(osg::Object::DYNAMIC);
+      tile.geometry->setVertexArray(new osg::Vec3Array(count));
+      tile.geometry->setNormalArray(new osg::Vec3Array(count), osg::Array::BIND_PER_VERTEX);
+      tile.geometry->setColorArray(new osg::Vec4Array(count), osg::Array::BIND_PER_VERTEX);
+      tile.geometry->addPrimitiveSet(gridTriangles(static_cast<int>(tile.columns), static_cast<int>(tileRows)));
+      geode->addDrawable(tile.geometry);
+      mesh.tiles.push_back(std::move(tile));
+    }
   for (size_t b = 0; b < mesh.rows.size(); ++b)
     for (size_t a = 0; a < mesh.columns.size(); ++a) mesh.update(grid, a, b);
-  mesh.geometry->addPrimitiveSet(
-      gridTriangles(static_cast<int>(mesh.columns.size()), static_cast<int>(mesh.rows.size())));
-  osg::ref_ptr<osg::Geode> geode = new osg::Geode;
-  geode->addDrawable(mesh.geometry);
+  mesh.flush();
   xf->addChild(geode);
   return xf;
 }
@@ -1103,7 +1146,7 @@ void SceneView::applyTerrainPatch(const TerrainPatchCmd& patch) {
   HeightGrid& grid = m.terrain.grid;
   if (m.terrain.kind != TerrainSpec::Kind::Heightfield || !patchFits(&grid, patch).empty()) return;
   applyPatch(grid, patch);
-  if (!m.mesh.geometry) return;
+  if (m.mesh.tiles.empty()) return;
   // The drawn samples in the patch and one beyond (their normals change).
   const auto range = [](const std::vector<int>& at, int from, int to) {
     const auto a = std::lower_bound(at.begin(), at.end(), from - 1);
@@ -1114,10 +1157,7 @@ void SceneView::applyTerrainPatch(const TerrainPatchCmd& patch) {
   const auto [b0, b1] = range(m.mesh.rows, patch.row, patch.row + patch.rows - 1);
   for (size_t b = b0; b < b1; ++b)
     for (size_t a = a0; a < a1; ++a) m.mesh.update(grid, a, b);
-  for (osg::Array* array : {m.mesh.geometry->getVertexArray(), m.mesh.geometry->getNormalArray(),
-                            m.mesh.geometry->getColorArray()})
-    array->dirty();
-  m.mesh.geometry->dirtyBound();
+  m.mesh.flush();
   m.footprintDirty = true;
 }
 
@@ -1132,12 +1172,11 @@ void SceneView::finishTerrainEdit() {
 
 std::optional<double> SceneView::drawnTerrainHeight(int i, int j) const {
   const TerrainMesh& mesh = m_->mesh;
-  if (!mesh.geometry) return std::nullopt;
+  if (mesh.tiles.empty()) return std::nullopt;
   const auto a = std::find(mesh.columns.begin(), mesh.columns.end(), i);
   const auto b = std::find(mesh.rows.begin(), mesh.rows.end(), j);
   if (a == mesh.columns.end() || b == mesh.rows.end()) return std::nullopt;
-  const auto& v = static_cast<const osg::Vec3Array&>(*mesh.geometry->getVertexArray());
-  return v[static_cast<size_t>(b - mesh.rows.begin()) * mesh.columns.size() + static_cast<size_t>(a - mesh.columns.begin())].z();
+  return mesh.height(static_cast<size_t>(a - mesh.columns.begin()), static_cast<size_t>(b - mesh.rows.begin()));
 }
 
 }  // namespace sp
