@@ -231,21 +231,22 @@ void World::applyTerrainPatch(const TerrainPatchCmd& c) {
   Impl& m = *impl_;
   if (m.grid.use_count() > 1) m.grid = std::make_shared<HeightGrid>(*m.grid);  // a snapshot shares it
   // The bounds stay exact without reading the whole grid (0.3 ms for 512 x
-  // 512) unless the patch replaces a sample at the lowest or highest height.
-  bool rescan = false;
-  for (int r = 0; r < c.rows && !rescan; ++r)
+  // 512): only when the patch replaces the lowest (highest) sample with
+  // something higher (lower) may the extreme now lie elsewhere.
+  bool touchedMin = false, touchedMax = false;
+  for (int r = 0; r < c.rows; ++r)
     for (int k = 0; k < c.columns; ++k) {
       const double old = m.grid->at(c.column + k, c.row + r);
-      if (old == m.gridMin || old == m.gridMax) rescan = true;
+      touchedMin = touchedMin || old == m.gridMin;
+      touchedMax = touchedMax || old == m.gridMax;
     }
   applyPatch(*m.grid, c);
-  if (rescan) {
+  double patchLo = c.heights.front(), patchHi = c.heights.front();
+  for (double h : c.heights) patchLo = std::min(patchLo, h), patchHi = std::max(patchHi, h);
+  if ((touchedMin && patchLo > m.gridMin) || (touchedMax && patchHi < m.gridMax))
     m.setTerrainBounds(m.grid->minHeight(), m.grid->maxHeight());
-  } else {
-    double lo = m.gridMin, hi = m.gridMax;
-    for (double h : c.heights) lo = std::min(lo, h), hi = std::max(hi, h);
-    m.setTerrainBounds(lo, hi);
-  }
+  else
+    m.setTerrainBounds(std::min(m.gridMin, patchLo), std::max(m.gridMax, patchHi));
   // The bounds feed the geom's AABB, which ODE recomputes only for a moved
   // geom: setting the same position marks it dirty.
   const dReal* pos = dGeomGetPosition(m.terrainGeom);

@@ -102,6 +102,19 @@ class TestTerrainPanel : public QObject {
     QTRY_VERIFY_WITH_TIMEOUT(w.lastTelemetry()->pose.p.z - z0 > 0.03, 10000);
     qInfo("raised %.3f m under the brush; the robot rose %.3f m", edited.at(i, j) - loaded.at(i, j),
           w.lastTelemetry()->pose.p.z - z0);
+    // The ghost's twin has the edit too: its trail lies on the edited ground
+    // (the trail's points are its world's terrain heights), not the loaded.
+    const TerrainSpec& terrain = w.session()->world()->terrain;
+    const auto groundOf = [&](const HeightGrid& g, const Vec3& p) {
+      const Vec2 q = gridPoint(terrain, {p.x, p.y});
+      return g.heightAt(q.x, q.y) + terrain.pose.p.z;
+    };
+    QTRY_VERIFY_WITH_TIMEOUT(!w.session()->ghost()->view().trail.empty() &&
+                                 std::abs(w.session()->ghost()->view().trail.front().z -
+                                          groundOf(edited, w.session()->ghost()->view().trail.front())) < 1e-9,
+                             10000);
+    const Vec3 trailStart = w.session()->ghost()->view().trail.front();
+    QVERIFY(groundOf(edited, trailStart) - groundOf(loaded, trailStart) > 0.03);
 
     // Save: the terrain and a world using it load as edited.
     const QString csv = dir_.filePath(QStringLiteral("edited.csv")), world = dir_.filePath(QStringLiteral("edited.world.xml"));
