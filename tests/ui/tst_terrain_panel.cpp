@@ -5,10 +5,12 @@
 // terrain_edit) all follow; Undo restores the heights bit for bit and the
 // robot settles back; Save writes a terrain and a world that load as edited.
 
+#include <QFile>
 #include <QMouseEvent>
 #include <QTemporaryDir>
 #include <QtTest>
 
+#include <algorithm>
 #include <cmath>
 
 #include "app/console_session.h"
@@ -130,6 +132,35 @@ class TestTerrainPanel : public QObject {
     QTRY_VERIFY_WITH_TIMEOUT(std::abs(w.lastTelemetry()->pose.p.z - z0) < 0.01, 10000);
     t->setEditing(false);
     QVERIFY(!view->terrainEditing());
+  }
+
+  // New and Import write a terrain and a world that load: a flat 4 x 2 m
+  // terrain at 0.3 m is 41 x 21 samples all at 0.3; the test track's
+  // profile imported is the test track's grid; a file that is not there is
+  // named in the error and nothing is written.
+  void newAndImport() {
+    TerrainPanel* t = window_->terrainPanel();
+    Diagnostics diag;
+    const QString csv = dir_.filePath(QStringLiteral("new.asc")), world = dir_.filePath(QStringLiteral("new.world.xml"));
+    QCOMPARE(t->createNew(4, 2, 0.1, 0.3, csv, world), QString());
+    std::optional<WorldModel> made = loadWorld(world.toStdString(), diag);
+    QVERIFY2(made, diag.format().c_str());
+    QCOMPARE(made->terrain.grid.columns, 41);
+    QCOMPARE(made->terrain.grid.rows, 21);
+    QVERIFY(std::all_of(made->terrain.grid.heights.begin(), made->terrain.grid.heights.end(),
+                        [](double h) { return h == 0.3; }));
+    const QString track = dir_.filePath(QStringLiteral("track.csv")), trackWorld = dir_.filePath(QStringLiteral("track.world.xml"));
+    QCOMPARE(t->import(QStringLiteral(SP_SOURCE_DIR "/terrains/test_track.csv"), true, 0, 4, 0.05, track, trackWorld),
+             QString());
+    made = loadWorld(trackWorld.toStdString(), diag);
+    QVERIFY2(made, diag.format().c_str());
+    const std::optional<WorldModel> original = loadWorld(SP_SOURCE_DIR "/terrains/test_track.world.xml", diag);
+    QCOMPARE(made->terrain.grid.heights, original->terrain.grid.heights);
+    const QString missing = dir_.filePath(QStringLiteral("nothing.csv"));
+    const QString error = t->import(missing, false, 4, 4, 0.05, dir_.filePath(QStringLiteral("x.csv")),
+                                    dir_.filePath(QStringLiteral("x.world.xml")));
+    QVERIFY2(error.contains(QStringLiteral("nothing.csv")), qPrintable(error));
+    QVERIFY(!QFile::exists(dir_.filePath(QStringLiteral("x.world.xml"))));
   }
 
  private:
