@@ -16,7 +16,8 @@
 // on what was lost. Both times are CLOCK_REALTIME (the kernel stamps btime
 // with it; the script reads $EPOCHREALTIME), so they compare directly.
 //
-// Prints one line "ok|FAIL loss_ms=... last_time=... samples=..." and exits
+// Prints what is wrong (a log without samples is not ok), then one line
+// "ok|FAIL loss_ms=... last_time=... samples=..." and exits
 // 0 when all checks pass, 1 otherwise, 2 on bad usage, 3 when LOG is an
 // empty database (the writer was killed before its first commit).
 
@@ -101,15 +102,22 @@ int main(int argc, char** argv) {
     }
   }
   sqlite3_finalize(st);
+  // A log that cannot be asked for its samples (the table dropped) or has
+  // none holds nothing to replay: not ok, whatever its integrity.
+  std::string samplesProblem;
   if (sqlite3_prepare_v2(db, "SELECT max(time), count(*) FROM samples", -1, &st, nullptr) == SQLITE_OK &&
       sqlite3_step(st) == SQLITE_ROW) {
     if (sqlite3_column_type(st, 0) != SQLITE_NULL) lastTime = sqlite3_column_double(st, 0);
     samples = sqlite3_column_int64(st, 1);
+    if (samples == 0) samplesProblem = "no samples";
+  } else {
+    samplesProblem = std::string("samples unreadable: ") + sqlite3_errmsg(db);
   }
   sqlite3_finalize(st);
   sqlite3_close(db);
 
-  bool ok = integrity == "ok";
+  bool ok = integrity == "ok" && samplesProblem.empty();
+  if (!samplesProblem.empty()) std::printf("FAIL %s: %s\n", path.c_str(), samplesProblem.c_str());
   double lossMs = 0;
   if (killedAt >= 0) {
     if (birth < 0) {

@@ -122,7 +122,10 @@ std::optional<Replay> openReplay(const std::string& path, double from, std::stri
   for (int64_t s : snapshotSteps)
     if (static_cast<double>(s) * r.logged.params.step <= from + 1e-9) r.start = s;
   std::optional<std::pair<Snapshot, uint64_t>> snapshot = r.reader->snapshot(r.start, &error);
-  if (!snapshot) return std::nullopt;
+  if (!snapshot) {
+    error = path + ": the snapshot at step " + std::to_string(r.start) + ": " + error;
+    return std::nullopt;
+  }
   if (std::string why = r.world->restore(snapshot->first); !why.empty()) {
     error = path + ": cannot restore the snapshot at step " + std::to_string(r.start) + ": " + why;
     return std::nullopt;
@@ -192,8 +195,25 @@ std::optional<ResimReport> resimulate(const std::string& path, const ResimOption
   ResimReport report;
   report.startStep = start;
   const std::vector<std::pair<int64_t, uint64_t>> hashes = reader->hashes();
+  // Untrusted logs: nothing to compare is no verdict, and a hash far beyond
+  // the log's last snapshot (a writer logs one every sim second and at the
+  // end) would have the re-simulation run for ages.
+  const int64_t lastSnapshot = reader->snapshotSteps().back();
+  const int64_t slack = std::llround(2.0 / replay->logged.params.step);
   int64_t end = start;
-  for (const auto& h : hashes) end = std::max(end, h.first);
+  for (const auto& h : hashes) {
+    if (h.first > lastSnapshot + slack) {
+      error = path + ": a state hash at step " + std::to_string(h.first) + " lies beyond the log's last snapshot (step " +
+              std::to_string(lastSnapshot) + "): a damaged or altered log";
+      return std::nullopt;
+    }
+    end = std::max(end, h.first);
+  }
+  if (std::none_of(hashes.begin(), hashes.end(), [&](const auto& h) { return h.first >= start; })) {
+    error = path + ": the log holds no state hash at or after step " + std::to_string(start) +
+            ": there is nothing to compare the re-simulation with";
+    return std::nullopt;
+  }
 
   size_t nextHash = 0;
   while (nextHash < hashes.size() && hashes[nextHash].first < start) ++nextHash;

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <fstream>
@@ -222,8 +223,8 @@ int run(const std::vector<std::string>& args) {
       }
       char* end = nullptr;
       const double x = std::strtod(v->c_str(), &end);
-      if (end == v->c_str() || *end != '\0' || !(x > 0)) {
-        std::cerr << "<command line>: error: " << a << ": expected a positive number, got '" << *v << "'\n";
+      if (end == v->c_str() || *end != '\0' || !(x > 0) || !std::isfinite(x)) {
+        std::cerr << "<command line>: error: " << a << ": expected a finite positive number, got '" << *v << "'\n";
         return 2;
       }
       if (a == "--duration") o.duration = x;

@@ -22,14 +22,21 @@ const std::string* FileSet::find(const std::string& path) const {
 std::optional<std::string> readSourceFile(const std::string& path, const FileSet* files) {
   if (files)
     if (const std::string* held = files->find(path)) return *held;
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return std::nullopt;
+  if (!sourceFileProblem(path, nullptr).empty()) return std::nullopt;
   std::ifstream in(path, std::ios::binary);
   if (!in) return std::nullopt;
   std::ostringstream out;
   out << in.rdbuf();
   if (in.bad()) return std::nullopt;
   return out.str();
+}
+
+std::string sourceFileProblem(const std::string& path, const FileSet* files) {
+  if (files && files->find(path)) return {};
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return "is not a regular file (a folder, device or pipe)";
+  if (std::filesystem::file_size(path, ec) > kMaxSourceFileBytes) return "is larger than 64 MiB";
+  return {};
 }
 
 bool sourceFileExists(const std::string& path, const FileSet* files) {

@@ -4,6 +4,7 @@
 // world from the file contents stored in its session log this way, without
 // writing them anywhere.
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -33,5 +34,12 @@ std::optional<std::string> readSourceFile(const std::string& path, const FileSet
 
 /// Whether readSourceFile() would find `path`.
 bool sourceFileExists(const std::string& path, const FileSet* files);
+
+/// Robot, world, parameter and rules files are read whole: at most this many bytes.
+inline constexpr std::uintmax_t kMaxSourceFileBytes = 64u << 20;
+/// Why readSourceFile() would not read an existing `path`: "" when it
+/// would, else "is not a regular file (a folder, device or pipe)" or "is
+/// larger than 64 MiB". A device such as /dev/zero would never end.
+std::string sourceFileProblem(const std::string& path, const FileSet* files);
 
 }  // namespace sp

@@ -257,13 +257,21 @@ void noChildren(const XMLElement* e, std::string_view file, Diagnostics& diag) {
     unknownElement(c, e, file, diag);
 }
 
+/// Why a robot or world file was not read, for its error.
+std::string unreadable(const std::string& path, const FileSet* files, const char* kind) {
+  if (!sourceFileExists(path, files)) return std::string("cannot open ") + kind + " file: not found";
+  const std::string why = sourceFileProblem(path, files);
+  return std::string("cannot open ") + kind + " file: " + (why.empty() ? "cannot read it" : "it " + why);
+}
+
 /// Parses the document; reports a syntax error with its line.
 bool parseXml(XMLDocument& doc, std::string_view xml, std::string_view file, Diagnostics& diag) {
   if (doc.Parse(xml.data(), xml.size()) == tinyxml2::XML_SUCCESS) return true;
   std::string what = doc.ErrorName();
   if (what.rfind("XML_ERROR_", 0) == 0) what = what.substr(10);
   for (char& c : what) c = c == '_' ? ' ' : static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  diag.error(file, doc.ErrorLineNum(), "XML syntax: " + what);
+  // Line 1 at least (an empty file has none): editors jump to file:line.
+  diag.error(file, std::max(1, doc.ErrorLineNum()), "XML syntax: " + what);
   return false;
 }
 
@@ -271,7 +279,7 @@ const XMLElement* rootElement(const XMLDocument& doc, const char* expected, std:
                               Diagnostics& diag) {
   const XMLElement* root = doc.RootElement();
   if (!root) {
-    diag.error(file, 0, std::string("empty document, expected <") + expected + ">");
+    diag.error(file, 1, std::string("empty document, expected <") + expected + ">");
     return nullptr;
   }
   if (std::string_view(root->Name()) != expected) {
@@ -674,7 +682,7 @@ std::optional<RobotModel> parseRobot(std::string_view xml, std::string_view file
 std::optional<RobotModel> loadRobot(const std::string& path, Diagnostics& diag, const FileSet* files) {
   std::optional<std::string> text = readSourceFile(path, files);
   if (!text) {
-    diag.error(path, 0, "cannot open robot file");
+    diag.error(path, 0, unreadable(path, files, "robot"));
     return std::nullopt;
   }
   return parseRobot(*text, path, diag);
@@ -866,6 +874,8 @@ std::optional<WorldModel> parseWorld(std::string_view xml, std::string_view file
         const std::string path = resolvePath(baseDir, *f);
         if (!sourceFileExists(path, files)) {
           r.error("robot file '" + *f + "' not found (looked at " + path + ")");
+        } else if (const std::string why = sourceFileProblem(path, files); !why.empty()) {
+          r.error("robot file '" + *f + "' " + why);
         } else if (std::optional<RobotModel> model = loadRobot(path, diag, files)) {
           inst.model = std::move(*model);
           for (const LinkSpec& link : inst.model.links)
@@ -905,7 +915,7 @@ std::optional<WorldModel> parseWorld(std::string_view xml, std::string_view file
 std::optional<WorldModel> loadWorld(const std::string& path, Diagnostics& diag, const FileSet* files) {
   std::optional<std::string> text = readSourceFile(path, files);
   if (!text) {
-    diag.error(path, 0, "cannot open world file");
+    diag.error(path, 0, unreadable(path, files, "world"));
     return std::nullopt;
   }
   return parseWorld(*text, path, fs::path(path).parent_path().string(), diag, files);

@@ -163,8 +163,10 @@ Entry entry(const char* key, const char* description, Accessors a) {
 const std::vector<Entry>& table() {
   constexpr double kMaxRate = 10000;
   static const std::vector<Entry> entries = {
-      entry("physics.step", "fixed integration step [s], (0, 0.1]",
-            real(&SimParams::step, openClosed(0, 0.1))),
+      // At least 10 us: a finer step simulates nothing in any useful time
+      // (1e-300 ran "1 s" as zero steps and exited 0).
+      entry("physics.step", "fixed integration step [s], [1e-05, 0.1]",
+            real(&SimParams::step, closed(1e-5, 0.1))),
       entry("physics.solver", "quick (dWorldQuickStep, iterative) or exact (dWorldStep)", solver()),
       entry("physics.iterations", "quick solver iterations per step, 1..1000",
             integer(&SimParams::iterations, 1, 1000)),
@@ -204,8 +206,8 @@ const std::vector<Entry>& table() {
             real(&SimParams::linkHelloTimeout, closed(0.1, 600))),
       entry("console.stale_after", "console: no telemetry this long greys the robot and says 'no data' [s], [0.05, 60]",
             real(&SimParams::consoleStaleAfter, closed(0.05, 60))),
-      entry("ghost.step", "console's predictive ghost: physics step [s], (0, 0.02]",
-            real(&SimParams::ghostStep, openClosed(0, 0.02))),
+      entry("ghost.step", "console's predictive ghost: physics step [s], [1e-05, 0.02]",
+            real(&SimParams::ghostStep, closed(1e-5, 0.02))),
       entry("ghost.iterations", "ghost: quick solver iterations per step, 1..1000",
             integer(&SimParams::ghostIterations, 1, 1000)),
       entry("ghost.horizon", "ghost: seconds of predicted path drawn ahead of the ghost [s], [0, 60]",

@@ -62,7 +62,7 @@ class TestFileSet : public QObject {
     Diagnostics none;
     QVERIFY(!loadWorld("/nonexistent/sp/worlds/held.world.xml", none));
     QCOMPARE(QString::fromStdString(none.format()),
-             QString("/nonexistent/sp/worlds/held.world.xml: error: cannot open world file\n"));
+             QString("/nonexistent/sp/worlds/held.world.xml: error: cannot open world file: not found\n"));
   }
 
   // The set wins over the disk; what the set lacks comes from the disk.
@@ -92,7 +92,7 @@ class TestFileSet : public QObject {
     QVERIFY(!readSourceFile("/dev/zero", nullptr));
     Diagnostics diag;
     QVERIFY(!loadRobot("/dev/zero", diag));
-    QCOMPARE(QString::fromStdString(diag.format()), QString("/dev/zero: error: cannot open robot file\n"));
+    QCOMPARE(QString::fromStdString(diag.format()), QString("/dev/zero: error: cannot open robot file: it is not a regular file (a folder, device or pipe)\n"));
   }
 };
 

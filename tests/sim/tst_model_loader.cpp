@@ -898,7 +898,7 @@ void TestModelLoader::testMissingWorldFile() {
   const std::string path = dir_.filePath("absent.world.xml").toStdString();
   Diagnostics diag;
   QVERIFY(!loadWorld(path, diag));
-  QCOMPARE(diag.format(), path + ": error: cannot open world file\n");
+  QCOMPARE(diag.format(), path + ": error: cannot open world file: not found\n");
 }
 
 // The annotated robot and world of docs/formats.md load without a single

@@ -231,8 +231,9 @@ void TestParams::setParamRejects_data() {
   QTest::newRow("nan") << "physics.step" << "nan" << "physics.step: expected a number, got 'nan'";
   QTest::newRow("inf") << "health.max_linear_speed" << "inf"
                        << "health.max_linear_speed: expected a number, got 'inf'";
-  QTest::newRow("step negative") << "physics.step" << "-1" << "physics.step: must be > 0, got -1";
-  QTest::newRow("step zero") << "physics.step" << "0" << "physics.step: must be > 0, got 0";
+  QTest::newRow("step negative") << "physics.step" << "-1" << "physics.step: must be >= 1e-05, got -1";
+  QTest::newRow("step zero") << "physics.step" << "0" << "physics.step: must be >= 1e-05, got 0";
+  QTest::newRow("step vanishing") << "physics.step" << "1e-300" << "physics.step: must be >= 1e-05, got 1e-300";
   QTest::newRow("step too big") << "physics.step" << "0.2" << "physics.step: must be <= 0.1, got 0.2";
   QTest::newRow("solver") << "physics.solver" << "fast" << "physics.solver: expected 'quick' or 'exact', got 'fast'";
   QTest::newRow("solver case") << "physics.solver" << "Quick"
@@ -336,7 +337,7 @@ void TestParams::loadParamsErrors_data() {
                               << "{file}:1: error: physics.step: expected a number, got 'abc'\n";
   QTest::newRow("out of range after comments")
       << QByteArray("# comment\n\nphysics.step = -1   # negative\n")
-      << "{file}:3: error: physics.step: must be > 0, got -1\n";
+      << "{file}:3: error: physics.step: must be >= 1e-05, got -1\n";
   QTest::newRow("no equals sign") << QByteArray("physics.step 0.002\n") << "{file}:1: error: expected 'key = value'\n";
   QTest::newRow("no key") << QByteArray("  = 3\n") << "{file}:1: error: expected 'key = value'\n";
   QTest::newRow("no value") << QByteArray("physics.step =   # later\n")

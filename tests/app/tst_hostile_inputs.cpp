@@ -1,0 +1,179 @@
+// Hostile files and logs (issue 17): what a file or a log holds may not
+// crash, hang or write outside where it should; each case answers with an
+// error naming the file (and line) and a non-zero exit, through the real
+// command-line tools. Controls: the same files and logs unaltered pass.
+
+#include <sqlite3.h>
+#include <sys/stat.h>
+
+#include <QElapsedTimer>
+#include <QFile>
+#include <QProcess>
+#include <QTemporaryDir>
+#include <QtTest>
+
+namespace {
+
+struct Run {
+  int exit = -1;
+  QString out, err;
+  qint64 ms = 0;
+};
+
+// Runs a tool of the build with a 20 s limit (a hang fails the test).
+Run tool(const QString& name, const QStringList& args) {
+  QProcess p;
+  QElapsedTimer t;
+  t.start();
+  p.start(QStringLiteral(SP_BINARY_DIR "/app/") + name, args);
+  Run r;
+  if (!p.waitForFinished(20000)) {
+    p.kill();
+    p.waitForFinished();
+    r.err = QStringLiteral("timed out");
+    return r;
+  }
+  r.exit = p.exitStatus() == QProcess::NormalExit ? p.exitCode() : 128 + p.exitCode();
+  r.out = QString::fromUtf8(p.readAllStandardOutput());
+  r.err = QString::fromUtf8(p.readAllStandardError());
+  r.ms = t.elapsed();
+  return r;
+}
+
+bool sql(const QString& path, const char* statement) {
+  sqlite3* db = nullptr;
+  const bool ok = sqlite3_open(path.toUtf8().constData(), &db) == SQLITE_OK &&
+                  sqlite3_exec(db, statement, nullptr, nullptr, nullptr) == SQLITE_OK;
+  sqlite3_close(db);
+  return ok;
+}
+
+void write(const QString& path, const QByteArray& text) {
+  QFile f(path);
+  QVERIFY(f.open(QIODevice::WriteOnly | QIODevice::Truncate));
+  f.write(text);
+}
+
+}  // namespace
+
+class TestHostileInputs : public QObject {
+  Q_OBJECT
+
+ private slots:
+  void initTestCase() {
+    QVERIFY(dir_.isValid());
+    log_ = dir_.filePath(QStringLiteral("good.splog"));
+    const Run r = tool(QStringLiteral("simpartner-sim"), {"run", "--world", SP_SOURCE_DIR "/terrains/flat.world.xml",
+                                                         "--duration", "2", "--rtf", "max", "--log", log_});
+    QVERIFY2(r.exit == 0, qPrintable(r.err));
+  }
+
+  // A robot file that is a device, a folder or a pipe: read, /dev/zero
+  // never ends; each is an error at the world's line, at once.
+  void robotFileNotRegular_data() {
+    QTest::addColumn<QString>("file");
+    QTest::newRow("device") << QStringLiteral("/dev/zero");
+    QTest::newRow("folder") << QStringLiteral("/tmp");
+    QTest::newRow("pipe") << QStringLiteral("pipe.xml");
+  }
+  void robotFileNotRegular() {
+    QFETCH(QString, file);
+    QTemporaryDir dir;
+    QVERIFY(mkfifo(dir.filePath(QStringLiteral("pipe.xml")).toUtf8().constData(), 0600) == 0);
+    const QString world = dir.filePath(QStringLiteral("w.world.xml"));
+    write(world, "<world name=\"w\" version=\"1\">\n  <terrain type=\"plane\"/>\n  <robot name=\"r\" file=\"" +
+                     file.toUtf8() + "\"/>\n</world>\n");
+    for (const char* command : {"check", "run"}) {
+      const Run r = tool(QStringLiteral("simpartner-sim"),
+                         QString(command) == "check" ? QStringList{"check", world}
+                                                     : QStringList{"run", "--world", world, "--duration", "0.1"});
+      QVERIFY2(r.exit == 1, qPrintable(r.err));
+      QVERIFY2(r.err.contains(world + ":3: error: robot 'r': robot file '" + file + "' is not a regular file"),
+               qPrintable(r.err));
+    }
+  }
+
+  // An empty robot file's error has a line for editors to jump to.
+  void emptyFileHasALine() {
+    const QString empty = dir_.filePath(QStringLiteral("empty.xml"));
+    write(empty, "");
+    const Run r = tool(QStringLiteral("simpartner-sim"), {"check", empty});
+    QCOMPARE(r.exit, 1);
+    QVERIFY2(r.err.contains(empty + ":1: error: XML syntax: empty document"), qPrintable(r.err));
+  }
+
+  // Runs that would simulate nothing and say they succeeded are refused.
+  void nothingSimulatedIsRefused() {
+    const QString world = QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml");
+    Run r = tool(QStringLiteral("simpartner-sim"), {"run", "--world", world, "--duration", "inf"});
+    QCOMPARE(r.exit, 2);
+    QVERIFY2(r.err.contains("--duration: expected a finite positive number, got 'inf'"), qPrintable(r.err));
+    r = tool(QStringLiteral("simpartner-sim"), {"run", "--world", world, "--set", "physics.step=1e-300"});
+    QCOMPARE(r.exit, 1);
+    QVERIFY2(r.err.contains("physics.step: must be >= 1e-05, got 1e-300"), qPrintable(r.err));
+    r = tool(QStringLiteral("simpartner-sim"), {"run", "--world", world, "--duration", "0.05", "--rtf", "max"});
+    QVERIFY2(r.exit == 0, qPrintable(r.err));  // control
+  }
+
+  // resim on untrusted logs. Control: the log as written re-simulates (0).
+  void resimOfAlteredLogs() {
+    Run r = tool(QStringLiteral("simpartner-sim"), {"resim", log_});
+    QVERIFY2(r.exit == 0 && r.out.contains("no divergence"), qPrintable(r.err));
+
+    // No hashes: no verdict, not "no divergence".
+    const QString noHashes = dir_.filePath(QStringLiteral("nohashes.splog"));
+    QVERIFY(QFile::copy(log_, noHashes) && sql(noHashes, "DELETE FROM hashes"));
+    r = tool(QStringLiteral("simpartner-sim"), {"resim", noHashes});
+    QCOMPARE(r.exit, 1);
+    QVERIFY2(r.err.contains(noHashes + ": the log holds no state hash"), qPrintable(r.err));
+
+    // A hash at step 2^62 would run for ages: refused at once.
+    const QString far = dir_.filePath(QStringLiteral("far.splog"));
+    QVERIFY(QFile::copy(log_, far) && sql(far, "INSERT INTO hashes(step, hash) VALUES (4611686018427387904, 5)"));
+    r = tool(QStringLiteral("simpartner-sim"), {"resim", far});
+    QCOMPARE(r.exit, 1);
+    QVERIFY2(r.err.contains("step 4611686018427387904 lies beyond the log's last snapshot"), qPrintable(r.err));
+    QVERIFY(r.ms < 10000);
+
+    // A damaged snapshot: the file and the step named.
+    const QString bad = dir_.filePath(QStringLiteral("badsnap.splog"));
+    QVERIFY(QFile::copy(log_, bad) && sql(bad, "UPDATE snapshots SET data = X'00112233' WHERE step = 0"));
+    r = tool(QStringLiteral("simpartner-sim"), {"resim", bad});
+    QCOMPARE(r.exit, 1);
+    QVERIFY2(r.err.contains(bad + ": the snapshot at step 0: not a snapshot"), qPrintable(r.err));
+
+    // A logged file name that climbs out of any folder: re-simulation holds
+    // the logged files in memory and writes nothing, there or anywhere.
+    const QString outside = dir_.filePath(QStringLiteral("outside"));
+    const QString climbing = dir_.filePath(QStringLiteral("climb.splog"));
+    const QByteArray name = ("../../../../.." + outside + "/evil.world.xml").toUtf8();
+    QVERIFY(QFile::copy(log_, climbing) &&
+            sql(climbing, ("UPDATE meta SET value = '" + name + "' WHERE key = 'world_file'").constData()));
+    r = tool(QStringLiteral("simpartner-sim"), {"resim", climbing});
+    QVERIFY(!QFile::exists(outside));
+    QVERIFY(!QFile::exists(outside + QStringLiteral("/evil.world.xml")));
+    qInfo("climbing world_file: exit %d: %s", r.exit, qPrintable(r.err.left(200) + r.out.left(200)));
+  }
+
+  // logcheck: a log without its samples is not ok. Control: the log is.
+  void logcheckWantsSamples() {
+    Run r = tool(QStringLiteral("simpartner-logcheck"), {log_});
+    QVERIFY2(r.exit == 0 && r.out.startsWith("ok"), qPrintable(r.out));
+    const QString empty = dir_.filePath(QStringLiteral("nosamples.splog"));
+    QVERIFY(QFile::copy(log_, empty) && sql(empty, "DELETE FROM samples"));
+    r = tool(QStringLiteral("simpartner-logcheck"), {empty});
+    QCOMPARE(r.exit, 1);
+    QVERIFY2(r.out.contains(empty + ": no samples"), qPrintable(r.out));
+    const QString dropped = dir_.filePath(QStringLiteral("dropped.splog"));
+    QVERIFY(QFile::copy(log_, dropped) && sql(dropped, "DROP TABLE samples"));
+    r = tool(QStringLiteral("simpartner-logcheck"), {dropped});
+    QCOMPARE(r.exit, 1);
+  }
+
+ private:
+  QTemporaryDir dir_;
+  QString log_;
+};
+
+QTEST_GUILESS_MAIN(TestHostileInputs)
+#include "tst_hostile_inputs.moc"
