@@ -1,5 +1,7 @@
 #include "sim/diagnostics.h"
 
+#include "sim/text.h"
+
 namespace sp {
 
 std::string Diagnostic::format() const {
@@ -11,12 +13,12 @@ std::string Diagnostic::format() const {
 }
 
 void Diagnostics::error(std::string_view file, int line, std::string message) {
-  items_.push_back({std::string(file), line, Severity::Error, std::move(message)});
+  items_.push_back({std::string(file), line, Severity::Error, cutLongQuotes(std::move(message))});
   ++errorCount_;
 }
 
 void Diagnostics::warning(std::string_view file, int line, std::string message) {
-  items_.push_back({std::string(file), line, Severity::Warning, std::move(message)});
+  items_.push_back({std::string(file), line, Severity::Warning, cutLongQuotes(std::move(message))});
 }
 
 void Diagnostics::append(const Diagnostics& other) {

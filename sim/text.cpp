@@ -1,5 +1,6 @@
 #include "sim/text.h"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <system_error>
@@ -39,6 +40,40 @@ std::string shortestText(double value) {
   char buf[32];
   const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value);
   return ec == std::errc() ? std::string(buf, end) : std::string("?");
+}
+
+std::string cutLongQuotes(std::string message, size_t keep) {
+  const auto wordChar = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0; };
+  std::string out;
+  size_t i = 0;
+  while (i < message.size()) {
+    const size_t open = message.find('\'', i);
+    if (open == std::string::npos) break;
+    // An opening quote does not follow a letter; a closing one is not followed by one.
+    if (open > 0 && wordChar(message[open - 1])) {
+      out.append(message, i, open + 1 - i);
+      i = open + 1;
+      continue;
+    }
+    size_t close = open + 1;
+    while ((close = message.find('\'', close)) != std::string::npos && close + 1 < message.size() &&
+           wordChar(message[close + 1]))
+      ++close;
+    if (close == std::string::npos) break;
+    const size_t length = close - open - 1;
+    out.append(message, i, open + 1 - i);
+    if (length > keep) {
+      size_t cut = keep;  // not inside a UTF-8 character
+      while (cut > 0 && (static_cast<unsigned char>(message[open + 1 + cut]) & 0xC0) == 0x80) --cut;
+      out.append(message, open + 1, cut);
+      out += "\u2026' (" + std::to_string(length) + " characters)";
+    } else {
+      out.append(message, open + 1, length + 1);
+    }
+    i = close + 1;
+  }
+  out.append(message, std::min(i, message.size()), std::string::npos);
+  return out;
 }
 
 }  // namespace sp

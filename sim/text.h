@@ -22,4 +22,10 @@ std::optional<double> parseReal(std::string_view text);
 /// The shortest text that reads back to exactly `value`.
 std::string shortestText(double value);
 
+/// `message` with every quoted value ('...') longer than `keep` characters
+/// cut to its first `keep` and its length: `'aaaa…' (5000000 characters)`.
+/// An error must not echo a 5 MB value. An apostrophe inside a word
+/// ("robot's") is not a quote.
+std::string cutLongQuotes(std::string message, size_t keep = 80);
+
 }  // namespace sp

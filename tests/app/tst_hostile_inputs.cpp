@@ -12,6 +12,8 @@
 #include <QTemporaryDir>
 #include <QtTest>
 
+#include "sim/text.h"
+
 namespace {
 
 struct Run {
@@ -153,6 +155,24 @@ class TestHostileInputs : public QObject {
     QVERIFY(!QFile::exists(outside));
     QVERIFY(!QFile::exists(outside + QStringLiteral("/evil.world.xml")));
     qInfo("climbing world_file: exit %d: %s", r.exit, qPrintable(r.err.left(200) + r.out.left(200)));
+  }
+
+  // Errors cut a quoted value longer than 80 characters to 80 and its
+  // length: a 5 MB value is not echoed. Apostrophes are not quotes.
+  void longValuesAreCut() {
+    const QByteArray huge(5000000, 'x');
+    const QString params = dir_.filePath(QStringLiteral("big.params"));
+    write(params, "physics.solver = " + huge + "\n");
+    const QString seq = dir_.filePath(QStringLiteral("big.seq"));
+    write(seq, "0 drive " + QByteArray(5000000, '9') + " 0\n");
+    for (const QString& file : {params, seq}) {
+      const Run r = tool(QStringLiteral("simpartner-sim"), {"check", file});
+      QCOMPARE(r.exit, 1);
+      QVERIFY2(r.err.size() < 400 && r.err.contains(QStringLiteral("\u2026' (5000000 characters)")), qPrintable(r.err.left(400)));
+    }
+    QCOMPARE(sp::cutLongQuotes("the robot's file '" + std::string(100, 'a') + "' and 'b'"),
+             "the robot's file '" + std::string(80, 'a') + "\u2026' (100 characters) and 'b'");
+    QCOMPARE(sp::cutLongQuotes("got 'short' and 'don't'"), std::string("got 'short' and 'don't'"));
   }
 
   // logcheck: a log without its samples is not ok. Control: the log is.
