@@ -22,6 +22,8 @@ namespace sp {
 namespace {
 
 /// Arguments of one command; number() records the first bad one.
+constexpr double kMaxCommandValue = 1e6;
+
 struct ArgReader {
   std::string_view command;
   std::vector<std::string_view> args;
@@ -40,7 +42,11 @@ struct ArgReader {
   double number(size_t i) {
     const std::optional<double> v = parseReal(args[i]);
     if (!v && error.empty()) error = std::string(command) + ": bad number '" + std::string(args[i]) + "'";
-    return v.value_or(0);
+    // Checked without a robot too (a sequence file alone): no speed, angle,
+    // rate or torque of a command is a million of its units.
+    if (v && std::abs(*v) > kMaxCommandValue && error.empty())
+      error = std::string(command) + ": " + std::string(args[i]) + " is not a plausible value (beyond +-1e6)";
+    return v && std::abs(*v) <= kMaxCommandValue ? *v : 0;
   }
   std::string word(size_t i) const { return std::string(args[i]); }
   Gait gait(size_t i) {

@@ -175,6 +175,21 @@ class TestHostileInputs : public QObject {
     QCOMPARE(sp::cutLongQuotes("got 'short' and 'don't'"), std::string("got 'short' and 'don't'"));
   }
 
+  // Implausible command values are errors even without a robot to check
+  // limits against. Control: a plausible drive passes.
+  void implausibleCommandValues() {
+    const QString seq = dir_.filePath(QStringLiteral("huge.seq"));
+    write(seq, "0 drive 1e300 0\n1 turn 1e300 10\n");
+    Run r = tool(QStringLiteral("simpartner-sim"), {"check", seq});
+    QCOMPARE(r.exit, 1);
+    QVERIFY2(r.err.contains(seq + ":1: error: drive: 1e300 is not a plausible value") &&
+                 r.err.contains(seq + ":2: error: turn: 1e300 is not a plausible value"),
+             qPrintable(r.err));
+    write(seq, "0 drive 0.5 0\n1 turn 0.3 10\n");
+    r = tool(QStringLiteral("simpartner-sim"), {"check", seq});
+    QVERIFY2(r.exit == 0, qPrintable(r.err));
+  }
+
   // logcheck: a log without its samples is not ok. Control: the log is.
   void logcheckWantsSamples() {
     Run r = tool(QStringLiteral("simpartner-logcheck"), {log_});
