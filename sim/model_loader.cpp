@@ -32,6 +32,8 @@ std::string formatNumber(double v) {
 
 /// Reads the attributes of one element with type and range checks, records
 /// which it consumed, and reports the rest as unknown in finish().
+constexpr double kMaxFileValue = 1e6;
+
 class ElementReader {
  public:
   ElementReader(const XMLElement* element, std::string_view file, Diagnostics& diag)
@@ -80,9 +82,19 @@ class ElementReader {
       error(attrLine(attr), std::string(attr) + ": expected a number, got '" + *t + "'");
       return fallback;
     }
+    if (!plausible(attr, *v)) return fallback;
     last_ = *v;
     lastValid_ = true;
     return *v * scale;
+  }
+
+  /// Every number of a robot or world file lies within +-kMaxFileValue
+  /// (docs/formats.md): no mass, length, position, gain or limit of a robot
+  /// is a million of its units, and ODE aborts on values like 1e300.
+  bool plausible(const char* attr, double v) {
+    if (std::abs(v) <= kMaxFileValue) return true;
+    error(attrLine(attr), std::string(attr) + ": " + shortestText(v) + " is not a plausible value (beyond +-1e6)");
+    return false;
   }
 
   /// Whether the last number() or vec3() call found a valid value.
@@ -133,6 +145,8 @@ class ElementReader {
       error(attrLine(attr), std::string(attr) + ": expected 3 numbers, got '" + *t + "'");
       return fallback;
     }
+    for (const std::optional<double>& x : v)
+      if (!plausible(attr, *x)) return fallback;
     lastValid_ = true;
     return {*v[0] * scale, *v[1] * scale, *v[2] * scale};
   }

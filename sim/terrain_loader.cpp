@@ -623,19 +623,28 @@ std::optional<HeightGrid> loadHeightGrid(const TerrainSource& source, Diagnostic
   }
   if (r.failed()) return std::nullopt;
 
+  std::optional<HeightGrid> grid;
   switch (format) {
-    case TerrainFormat::Asc:
-      return loadAsc(source, content, r);
-    case TerrainFormat::Pgm:
-      return loadPgm(source, content, r);
-    case TerrainFormat::Csv:
-      return loadCsvGrid(source, content, r);
-    case TerrainFormat::Profile:
-      return loadProfile(source, content, r);
-    case TerrainFormat::Auto:
-      break;
+    case TerrainFormat::Asc: grid = loadAsc(source, content, r); break;
+    case TerrainFormat::Pgm: grid = loadPgm(source, content, r); break;
+    case TerrainFormat::Csv: grid = loadCsvGrid(source, content, r); break;
+    case TerrainFormat::Profile: grid = loadProfile(source, content, r); break;
+    case TerrainFormat::Auto: break;
   }
-  return std::nullopt;
+  if (!grid) return std::nullopt;
+  // Plausible extents and heights (docs/formats.md): values the physics
+  // engine cannot hold (a cellsize or height of 1e308) abort it.
+  if (!(grid->width <= kMaxTerrainExtent && grid->depth <= kMaxTerrainExtent)) {
+    r.error(0, "the terrain spans " + shortestText(grid->width) + " x " + shortestText(grid->depth) +
+                   " m: at most " + shortestText(kMaxTerrainExtent) + " m a side");
+    return std::nullopt;
+  }
+  for (double h : grid->heights)
+    if (!(std::abs(h) <= kMaxTerrainHeight)) {
+      r.error(0, "a height of " + shortestText(h) + " m: heights lie within +-" + shortestText(kMaxTerrainHeight) + " m");
+      return std::nullopt;
+    }
+  return grid;
 }
 
 }  // namespace sp

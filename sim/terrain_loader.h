@@ -25,6 +25,10 @@ struct TerrainSource {
   double resolution = 0.05;  ///< profile only: sample spacing along both axes [m]
 };
 
+/// Plausible bounds, checked at load: a side [m] and a height's magnitude [m].
+inline constexpr double kMaxTerrainExtent = 1e5;
+inline constexpr double kMaxTerrainHeight = 1e5;
+
 /// Reads a height grid. Problems in the file are reported as path:line
 /// (or row) errors, all of them, and nullopt is returned when there is any.
 /// File rows are stored north first (image order): the first row of the file

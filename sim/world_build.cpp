@@ -126,7 +126,10 @@ World::~World() {
   if (m.heightData) dGeomHeightfieldDataDestroy(m.heightData);
   dWorldSetStepThreadingImplementation(m.world, nullptr, nullptr);
   dWorldDestroy(m.world);
-  dThreadingFreeImplementation(m.threading);
+  // After an engine failure the exception left ODE's job list mid-step, and
+  // freeing it asserts (abort: exit 134 where the failure was reported as
+  // exit 3). It is left allocated: a few hundred bytes per failed world.
+  if (!m.broken) dThreadingFreeImplementation(m.threading);
 }
 
 bool World::build(Diagnostics& diag) {

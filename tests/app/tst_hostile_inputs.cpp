@@ -9,6 +9,7 @@
 #include <QElapsedTimer>
 #include <QFile>
 #include <QProcess>
+#include <QRegularExpression>
 #include <QTemporaryDir>
 #include <QtTest>
 
@@ -173,6 +174,57 @@ class TestHostileInputs : public QObject {
     QCOMPARE(sp::cutLongQuotes("the robot's file '" + std::string(100, 'a') + "' and 'b'"),
              "the robot's file '" + std::string(80, 'a') + "\u2026' (100 characters) and 'b'");
     QCOMPARE(sp::cutLongQuotes("got 'short' and 'don't'"), std::string("got 'short' and 'don't'"));
+  }
+
+  // Values check used to accept and run aborted on (SIGABRT, exit 134):
+  // each is an error at its line now, for check and for run. Control: the
+  // same files with plausible values run (exit 0).
+  void implausibleFileValues_data() {
+    QTest::addColumn<QByteArray>("link");     // the robot's link element
+    QTest::addColumn<QByteArray>("terrain");  // the world's terrain element
+    QTest::addColumn<QByteArray>("asc");      // the terrain file, if any
+    QTest::addColumn<QString>("message");
+    const QByteArray link = R"(<link name="base" mass="5" xyz="0 0 1"><geom type="sphere" radius="0.2"/></link>)";
+    const QByteArray plane = R"(<terrain type="plane"/>)";
+    const QByteArray asc = "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n0 0 0\n0 0 0\n0 0 0\n";
+    QTest::newRow("link mass") << QByteArray(link).replace("mass=\"5\"", "mass=\"1e300\"") << plane << QByteArray()
+                               << "mass: 1e+300 is not a plausible value";
+    QTest::newRow("geom radius") << QByteArray(link).replace("radius=\"0.2\"", "radius=\"1e300\"") << plane
+                                 << QByteArray() << "radius: 1e+300 is not a plausible value";
+    QTest::newRow("link xyz") << QByteArray(link).replace("xyz=\"0 0 1\"", "xyz=\"1e300 0 1\"") << plane
+                              << QByteArray() << "xyz: 1e+300 is not a plausible value";
+    QTest::newRow("asc cellsize") << link << QByteArray(R"(<terrain type="heightfield" file="t.asc"/>)")
+                                  << QByteArray(asc).replace("cellsize 1", "cellsize 1e308")
+                                  << "the terrain spans inf x inf m: at most 1e+05 m a side";
+    QTest::newRow("pgm heights") << link
+                                 << QByteArray(R"(<terrain type="heightfield" file="t.pgm" width="4" depth="4" min_height="-1e308" max_height="1e308"/>)")
+                                 << QByteArray() << "min_height: -1e+308 is not a plausible value";
+    QTest::newRow("heightfield width") << link
+                                       << QByteArray(R"(<terrain type="heightfield" file="t.asc" width="1e300"/>)") << asc
+                                       << "width: 1e+300 is not a plausible value";
+    QTest::newRow("control") << link << QByteArray(R"(<terrain type="heightfield" file="t.asc"/>)") << asc << QString();
+  }
+  void implausibleFileValues() {
+    QFETCH(QByteArray, link);
+    QFETCH(QByteArray, terrain);
+    QFETCH(QByteArray, asc);
+    QFETCH(QString, message);
+    QTemporaryDir dir;
+    write(dir.filePath(QStringLiteral("r.xml")), "<robot name=\"r\" version=\"1\">\n  " + link + "\n</robot>\n");
+    write(dir.filePath(QStringLiteral("t.asc")), asc);
+    write(dir.filePath(QStringLiteral("t.pgm")), QByteArray("P2\n2 2\n255\n0 1\n2 3\n"));
+    const QString world = dir.filePath(QStringLiteral("w.world.xml"));
+    write(world, "<world name=\"w\" version=\"1\">\n  " + terrain + "\n  <robot name=\"r\" file=\"r.xml\"/>\n</world>\n");
+    for (const QStringList& args : {QStringList{"check", world},
+                                    QStringList{"run", "--world", world, "--duration", "0.2", "--rtf", "max"}}) {
+      const Run r = tool(QStringLiteral("simpartner-sim"), args);
+      if (message.isEmpty()) {
+        QVERIFY2(r.exit == 0, qPrintable(r.err));
+      } else {
+        QVERIFY2(r.exit == 1 && r.err.contains(message), qPrintable(QString::number(r.exit) + " " + r.err));
+        QVERIFY2(r.err.contains(QRegularExpression(QStringLiteral("\\.(xml|asc):\\d+: error: |\\.asc: error: "))), qPrintable(r.err));
+      }
+    }
   }
 
   // Implausible command values are errors even without a robot to check
