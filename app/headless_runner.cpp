@@ -202,6 +202,15 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
     report.logError = log->writer().errorMessage();
   }
 
+  if (csv) {
+    // A full disk cuts the file mid-line; the stream only says so when asked.
+    csvFile.flush();
+    csvFile.close();
+    if (!csvFile) {
+      report.csvError = options.csvFile + ": error: writing the CSV failed (is the disk full?): the file is incomplete";
+      err << report.csvError << "\n";
+    }
+  }
   const Pose base = world->linkPose(0, 0);
   if (!report.health.healthy()) err << "error: the twin diverged: " << report.health.message() << "\n";
   out << std::setprecision(3)

@@ -51,6 +51,7 @@ struct RunReport {
   HealthReport health;       ///< why the run stopped early, if it diverged
   int64_t logDropped = 0;    ///< session log items dropped (full queue, failed disk)
   std::string logError;      ///< why the session log failed, "" if it did not
+  std::string csvError;      ///< why the CSV file is incomplete (a full disk), "" if it is whole
 };
 
 /// Loads files and runs. Writes the narrative to `out` and diagnostics to

@@ -45,7 +45,8 @@ constexpr const char* kUsage = R"(usage:
       --log FILE        write a session log (SQLite; samples at rate.log Hz)
       --quiet           no progress lines
       Exits 0 when the run completed, 1 on bad input, 3 if the twin diverged
-      (the report names what, where and when).
+      (the report names what, where and when), 4 if the CSV could not be
+      written whole (a full disk).
   simpartner-sim validate [--out DIR] [--quick] [--params FILE] [--set KEY=VALUE]...
       Runs the founding paper's five validation experiments headless and
       writes DIR/report.md (default DIR: validation), an SVG plot and the CSV
@@ -239,7 +240,8 @@ int run(const std::vector<std::string>& args) {
   std::signal(SIGTERM, [](int) { gStop = true; });
   const auto report = sp::runHeadless(o, std::cout, std::cerr, monotonicSeconds, sleepUntilSeconds, &gStop);
   if (!report) return 1;
-  return report->health.healthy() ? 0 : 3;
+  if (!report->health.healthy()) return 3;
+  return report->csvError.empty() ? 0 : 4;
 }
 
 int rehearseCommand(const std::vector<std::string>& args) {

@@ -227,6 +227,19 @@ class TestHostileInputs : public QObject {
     }
   }
 
+  // A CSV that cannot be written whole (a full disk: /dev/full) fails
+  // loudly. Control: the same run to a file exits 0.
+  void csvOnAFullDisk() {
+    const QString world = QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml");
+    Run r = tool(QStringLiteral("simpartner-sim"),
+                 {"run", "--world", world, "--duration", "0.5", "--rtf", "max", "--csv", "/dev/full"});
+    QCOMPARE(r.exit, 4);
+    QVERIFY2(r.err.contains("/dev/full: error: writing the CSV failed"), qPrintable(r.err));
+    r = tool(QStringLiteral("simpartner-sim"), {"run", "--world", world, "--duration", "0.5", "--rtf", "max", "--csv",
+                                                dir_.filePath(QStringLiteral("ok.csv"))});
+    QVERIFY2(r.exit == 0, qPrintable(r.err));
+  }
+
   // Implausible command values are errors even without a robot to check
   // limits against. Control: a plausible drive passes.
   void implausibleCommandValues() {
