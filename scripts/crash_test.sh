@@ -13,10 +13,15 @@
 # for why this over-estimates the loss, never under-estimates it).
 #
 # Environment: SP_BUILD_DIR (default build) holds app/simpartner-sim and
-# app/simpartner-logcheck. Prints one line per run and a summary; exits 1 if
-# any run failed.
+# app/simpartner-logcheck; SP_CRASH_MAX_LOSS_MS (default 100) is the limit.
+# The loss printed is an upper bound that also counts the run's start-up and
+# any lag of its pacer behind the wall clock, both of which grow when the
+# machine is loaded (up to 201 ms seen under load, against 25 ms batches);
+# ctest runs it with the bound stated for a loaded machine, 300 ms.
+# Prints one line per run and a summary; exits 1 if any run failed.
 set -u
 N=${1:-100}
+LIMIT=${SP_CRASH_MAX_LOSS_MS:-100}
 BUILD=${SP_BUILD_DIR:-build}
 SIM=$BUILD/app/simpartner-sim
 CHECK=$BUILD/app/simpartner-logcheck
@@ -45,7 +50,7 @@ for ((i = 1; i <= N; ++i)); do
     nolog=$((nolog + 1))
     continue
   fi
-  result=$("$CHECK" "$log" --killed-at "$killed_at" --rtf 1 --max-loss-ms 100)
+  result=$("$CHECK" "$log" --killed-at "$killed_at" --rtf 1 --max-loss-ms "$LIMIT")
   status=$?
   echo "run $i: delay ${delay_ms} ms: $result"
   if ((status == 3)); then
@@ -62,5 +67,5 @@ for ((i = 1; i <= N; ++i)); do
   fi
   rm -f "$log" "$log-wal" "$log-shm"
 done
-echo "crash_test: $N runs, $failures failures, $nolog killed before the log existed, worst loss ${worst} ms (limit 100 ms)"
+echo "crash_test: $N runs, $failures failures, $nolog killed before the log existed, worst loss ${worst} ms (limit ${LIMIT} ms)"
 ((failures == 0))

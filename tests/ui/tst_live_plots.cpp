@@ -284,9 +284,13 @@ class TestLivePlots : public QObject {
       feed(*plot, i, i + 1);
       if (i % 3 == 2) QTest::qWait(2);
     }
+    // Only the upper bound is timing-proof: a loaded machine delays the
+    // timer (fewer replots), never adds ticks. That it replots at all is
+    // waited for.
     const qint64 elapsed = clock.elapsed();
-    QVERIFY2(plot->replots() >= 3 && plot->replots() <= elapsed / 20 + 2,
+    QVERIFY2(plot->replots() <= elapsed / 20 + 2,
              qPrintable(QString("%1 replots in %2 ms").arg(plot->replots()).arg(elapsed)));
+    QTRY_VERIFY(plot->replots() >= 1);
   }
 
   // Without its own timer a plot replots only when its owner ticks it, and
