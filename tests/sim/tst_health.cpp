@@ -119,6 +119,27 @@ class TestHealth : public QObject {
     QVERIFY(caught);
   }
 
+  // An engine failure inside a step is reported, and the World that had it
+  // is destroyed without aborting (ODE's job list is left mid-step by the
+  // failure; freeing it asserted: exit 134 where the run reported exit 3).
+  // A 1e300 kg body fails ODE's quaternion normalisation at the first step;
+  // files refuse such a mass, a model built in code does not.
+  void engineFailureThenDestroy() {
+    WorldFixture f;
+    f.write("robot.xml", R"(<robot name="r"><link name="base" mass="5" xyz="0 0 1"><geom type="box" size="0.3 0.3 0.3"/></link></robot>)");
+    Diagnostics diag;
+    std::optional<WorldModel> model = loadWorld(f.write("test.world.xml", kArmWorld), diag);
+    QVERIFY2(model, diag.format().c_str());
+    model->robots[0].model.links[0].mass = 1e300;
+    auto world = World::create(*model, {}, diag);
+    QVERIFY(world);
+    for (int i = 0; i < 10 && world->step(); ++i) {
+    }
+    QCOMPARE(world->health().kind, HealthReport::Kind::EngineFailure);
+    qInfo("%s", world->health().message().c_str());
+    world.reset();  // aborted here before
+  }
+
   // A joint made soft by a huge CFM is pulled apart by the arm's weight.
   void jointSeparationIsReported() {
     WorldFixture f;
