@@ -61,10 +61,14 @@ dSurfaceParameters toSurface(const ContactSpec& c) {
     s.soft_cfm = c.softCfm;
   }
   if (c.rollingResistance > 0) {
-    s.mode |= dContactRolling;
+    // Without dContactAxisDep ODE applies rho about all three axes, the
+    // spinning one too, and ignores rho2 and rhoN. With it, mu2 is used for
+    // the second friction direction: the same mu keeps friction isotropic.
+    s.mode |= dContactRolling | dContactAxisDep;
+    s.mu2 = c.mu;
     s.rho = c.rollingResistance;
     s.rho2 = c.rollingResistance;
-    s.rhoN = 0;
+    s.rhoN = 0;  // rolling resistance resists rolling, not spinning in place
   }
   return s;
 }
