@@ -382,6 +382,9 @@ void MainWindow::buildDocks() {
     recent.prepend(path);
     QSettings().setValue(QStringLiteral("replay/recent"), recent.mid(0, kRecentLogs));
     if (!replaying_) ghostShownBeforeReplay_ = scene_->ghostVisible();
+    // The view shows the log's ground: no editing the live terrain meanwhile.
+    terrain_->setEditing(false);
+    terrain_->setEnabled(false);
     replaying_ = true;
     scene_->setWorld(world);
     scene_->setGhostVisible(false);
@@ -421,6 +424,7 @@ void MainWindow::buildDocks() {
           [this](bool, const QString& verdict) { statusBar()->showMessage(verdict, 15000); });
   connect(replay_, &ReplayPanel::closed, this, [this] {
     replaying_ = false;
+    terrain_->setEnabled(true);
     replayDock_->hide();
     showWorld(*session_->world());
     scene_->setGhostVisible(ghostShownBeforeReplay_);
