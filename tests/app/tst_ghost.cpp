@@ -62,7 +62,8 @@ struct RunResult {
   std::vector<GhostError> all;
   std::string logPath;
   GhostStats stats;
-  size_t trail = 0;  // points of the last trail
+  size_t trail = 0;     // points of the last trail
+  size_t maxTrail = 0;  // of the longest trail seen during the drive
 };
 
 }  // namespace
@@ -143,6 +144,7 @@ class TestGhost : public QObject {
           result.heading.push_back(e->heading);
         }
       });
+      result.maxTrail = std::max(result.maxTrail, session.ghost()->view().trail.size());
     }
     result.seconds = elapsed() - t0;
     result.anchors = session.ghost()->stats().anchors;
@@ -180,12 +182,18 @@ class TestGhost : public QObject {
           "%.1f re-anchorings/s",
           m * 1000, radToDeg(median(r.heading)), r.moving.size(),
           *std::max_element(r.moving.begin(), r.moving.end()) * 1000, rate);
-    qInfo("%lld trails, the last %.0f ms for %zu points; last re-anchoring %.0f ms over %.2f s",
-          static_cast<long long>(r.stats.trails), r.stats.trailMs, r.trail, r.stats.anchorMs, r.stats.anchorSpan);
+    qInfo("%lld trails, the last %.0f ms for %zu points (longest %zu); last re-anchoring %.0f ms over %.2f s",
+          static_cast<long long>(r.stats.trails), r.stats.trailMs, r.trail, r.maxTrail, r.stats.anchorMs,
+          r.stats.anchorSpan);
     QCOMPARE(m <= 0.05, pass);
     // The trail (the path ahead) keeps coming: 5 s ahead in 0.1 s steps.
+    // A trail whose world diverges ends there (Ghost: "up to where it
+    // diverged"); once in CI the last one on the test track, the robot
+    // stopped, ended after 26 points. So: whole trails during the drive,
+    // and the last one not empty.
     QVERIFY(r.stats.trails > 10);
-    QCOMPARE(r.trail, size_t{51});
+    QCOMPARE(r.maxTrail, size_t{51});
+    QVERIFY(r.trail >= 2);
     // Re-anchoring kept going (a stall would show as a handful).
     QVERIFY2(rate > 5, qPrintable(QString::number(rate)));
   }
