@@ -21,7 +21,6 @@
 
 #include <QApplication>
 #include <QElapsedTimer>
-#include <QSurfaceFormat>
 #include <QTemporaryDir>
 #include <QTimer>
 
@@ -54,11 +53,7 @@ double ms(const QElapsedTimer& t) { return static_cast<double>(t.nsecsElapsed())
 }  // namespace
 
 int main(int argc, char** argv) {
-  QSurfaceFormat format;  // OpenSceneGraph's GL 2.1 compatibility context (shared/STACK.md)
-  format.setVersion(2, 1);
-  format.setProfile(QSurfaceFormat::CompatibilityProfile);
-  format.setDepthBufferSize(24);
-  QSurfaceFormat::setDefaultFormat(format);
+  sp::setSceneSurfaceFormat();  // before the application
   QApplication app(argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // each figure as it comes
   if (argc != 2) {

@@ -20,7 +20,6 @@
 
 #include <QApplication>
 #include <QElapsedTimer>
-#include <QSurfaceFormat>
 #include <QTemporaryDir>
 #include <QTimer>
 
@@ -160,11 +159,7 @@ void benchView(QApplication& app, const sp::WorldModel& model, bool quick) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  QSurfaceFormat format;  // OpenSceneGraph's GL 2.1 compatibility context (shared/STACK.md)
-  format.setVersion(2, 1);
-  format.setProfile(QSurfaceFormat::CompatibilityProfile);
-  format.setDepthBufferSize(24);
-  QSurfaceFormat::setDefaultFormat(format);
+  sp::setSceneSurfaceFormat();  // before the application
   QApplication app(argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const bool quick = argc > 1 && std::string(argv[1]) == "--quick";

@@ -8,7 +8,6 @@
 #include <QElapsedTimer>
 #include <QFileInfo>
 #include <QRegularExpression>
-#include <QSurfaceFormat>
 #include <QTimer>
 
 #include <cstdio>
@@ -50,15 +49,7 @@ std::optional<double> numberOption(const QCommandLineParser& parser, const QComm
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Debian's OpenSceneGraph is a fixed-function GL 2 build: it needs a
-  // compatibility context, requested before the application exists.
-  QSurfaceFormat format;
-  format.setVersion(2, 1);
-  format.setProfile(QSurfaceFormat::CompatibilityProfile);
-  format.setDepthBufferSize(24);
-  format.setSamples(0);
-  format.setSwapInterval(0);  // the view paces itself with a timer
-  QSurfaceFormat::setDefaultFormat(format);
+  sp::setSceneSurfaceFormat();  // before the application exists
 
   // The command line is read before any window system is touched: --help,
   // --version and bad options work without a display (a GUI application

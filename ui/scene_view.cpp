@@ -3,6 +3,7 @@
 #include "sim/terrain_brush.h"
 
 #include <QElapsedTimer>
+#include <QSurfaceFormat>
 #include <QLabel>
 #include <QMouseEvent>
 #include <QOpenGLContext>
@@ -1177,6 +1178,20 @@ std::optional<double> SceneView::drawnTerrainHeight(int i, int j) const {
   const auto b = std::find(mesh.rows.begin(), mesh.rows.end(), j);
   if (a == mesh.columns.end() || b == mesh.rows.end()) return std::nullopt;
   return mesh.height(static_cast<size_t>(a - mesh.columns.begin()), static_cast<size_t>(b - mesh.rows.begin()));
+}
+
+}  // namespace sp
+
+namespace sp {
+
+void setSceneSurfaceFormat() {
+  QSurfaceFormat format;
+  format.setVersion(2, 1);
+  format.setProfile(QSurfaceFormat::CompatibilityProfile);
+  format.setDepthBufferSize(24);
+  format.setSamples(0);
+  format.setSwapInterval(0);  // the view paces itself with a timer
+  QSurfaceFormat::setDefaultFormat(format);
 }
 
 }  // namespace sp

@@ -41,6 +41,11 @@ struct NamedPose {
 /// Thread: GUI thread only, like every QWidget. The view must stay in its
 /// top-level window: moving it to another one recreates Qt's GL context,
 /// which this view does not rebuild its GL objects for.
+/// Debian's OpenSceneGraph is a fixed-function GL 2 build: it needs a GL 2.1
+/// compatibility context. Sets it as the default surface format; call
+/// before the QApplication exists (the console, the GUI tests, benchmarks).
+void setSceneSurfaceFormat();
+
 class SceneView : public QOpenGLWidget {
   Q_OBJECT
 

@@ -6,13 +6,13 @@
 
 #include <QApplication>
 #include <QSettings>
-#include <QSurfaceFormat>
 #include <QTemporaryDir>
 #include <QtTest>
 
 #include <memory>
 
 #include "ui/main_window.h"
+#include "ui/scene_view.h"
 
 namespace sp::test {
 
@@ -37,11 +37,7 @@ inline QString startConsole(const QTemporaryDir& dir, const QString& world, Cons
 /// main() of a GL test: the default surface format first, then the application.
 template <typename Test>
 int glTestMain(int argc, char** argv) {
-  QSurfaceFormat format;
-  format.setVersion(2, 1);
-  format.setProfile(QSurfaceFormat::CompatibilityProfile);
-  format.setDepthBufferSize(24);
-  QSurfaceFormat::setDefaultFormat(format);
+  setSceneSurfaceFormat();
   QApplication app(argc, argv);
   Test test;
   return QTest::qExec(&test, argc, argv);

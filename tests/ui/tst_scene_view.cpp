@@ -8,7 +8,6 @@
 #include <QApplication>
 #include <QImage>
 #include <QMouseEvent>
-#include <QSurfaceFormat>
 #include <QWheelEvent>
 
 #include <algorithm>
@@ -29,11 +28,7 @@ namespace {
 // Before QTEST_MAIN's QApplication: OSG draws fixed-function GL 2, which a
 // 3.x core profile refuses.
 const bool kGl21Format = [] {
-  QSurfaceFormat format;
-  format.setVersion(2, 1);
-  format.setProfile(QSurfaceFormat::CompatibilityProfile);
-  format.setDepthBufferSize(24);
-  QSurfaceFormat::setDefaultFormat(format);
+  sp::setSceneSurfaceFormat();
   return true;
 }();
 
