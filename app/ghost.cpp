@@ -39,6 +39,14 @@ constexpr double kShownWindow = 20;   // [s] of robot time remembered for compar
 constexpr double kErrorWindow = 10;   // [s] of robot time the median is over
 constexpr double kMatchWindow = 0.1;  // [s] a shown state this close in time counts
 constexpr double kTrailPeriod = 0.25; // [s] between trails while nothing changes
+// Held joints (ghost.hold) are held only while the robot keeps them still:
+// within kStillBand of their newest position over the last kStillWindow of
+// telemetry (legs flex by up to 0.018 rad over the test track's bumps, and
+// their rates spike to 2 rad/s there, so rates cannot tell). A hold whose
+// weld is kReweld off the reported positions is welded anew.
+constexpr double kStillWindow = 1.0;  // [s] of robot time
+constexpr double kStillBand = 0.03;   // [rad] or [m]
+constexpr double kReweld = 0.05;      // [rad] or [m]
 
 // Seconds as the steady clock's duration (Ghost::now() counts from its epoch).
 std::chrono::steady_clock::duration steady(double seconds) {
@@ -79,17 +87,31 @@ std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& p
   profile.iterations = params.ghostIterations;
   std::unique_ptr<Ghost> g(new Ghost(world, profile, options));
   const RobotModel& robot = world.robots[0].model;
+  std::vector<int> drive;  // the wheels and the articulation keep turning in a held subtree
+  if (robot.drive) {
+    drive.assign(robot.drive->wheels.begin(), robot.drive->wheels.end());
+    drive.push_back(robot.drive->articulation);
+  }
   for (const std::string& name : splitNames(params.ghostHold)) {
     const std::vector<int> subtree = subtreeJoints(robot, name);
     if (subtree.empty()) {
       error = "ghost.hold: the robot has no joint '" + name + "'";
       return nullptr;
     }
-    g->held_.insert(g->held_.end(), subtree.begin(), subtree.end());
+    if (std::find(drive.begin(), drive.end(), robot.findJoint(name)) != drive.end()) {
+      error = "ghost.hold: joint '" + name + "' drives the robot and cannot be held";
+      return nullptr;
+    }
+    for (int j : subtree)
+      if (std::find(drive.begin(), drive.end(), j) == drive.end() &&
+          std::find(g->held_.begin(), g->held_.end(), j) == g->held_.end())
+        g->held_.push_back(j);
   }
+  std::sort(g->held_.begin(), g->held_.end());
   // The worlds are built on the first telemetry (the pose to weld at);
   // what could fail is checked now, in the robot's initial pose.
-  const std::shared_ptr<const Twin> twin = g->makeTwin(std::vector<double>(robot.joints.size(), 0.0), error);
+  const std::shared_ptr<const Twin> twin =
+      g->makeTwin(std::vector<double>(robot.joints.size(), 0.0), !g->held_.empty(), error);
   if (!twin) return nullptr;
   if (!g->buildWorld(*twin, &error)) return nullptr;
   g->anchorThread_ = std::thread([raw = g.get()] { raw->anchorLoop(); });
@@ -110,10 +132,11 @@ Ghost::~Ghost() {
     if (t->joinable()) t->join();
 }
 
-std::shared_ptr<const Ghost::Twin> Ghost::makeTwin(const std::vector<double>& positions, std::string& error) const {
+std::shared_ptr<const Ghost::Twin> Ghost::makeTwin(const std::vector<double>& positions, bool hold,
+                                                   std::string& error) const {
   auto twin = std::make_shared<Twin>();
   twin->world = model_;
-  if (!held_.empty()) {
+  if (hold && !held_.empty()) {
     twin->rigid = holdRigid(model_.robots[0].model, positions, held_, error);
     if (!twin->rigid) {
       error = "ghost.hold: " + error;
@@ -132,6 +155,52 @@ std::unique_ptr<World> Ghost::buildWorld(const Twin& twin, std::string* error) c
   std::unique_ptr<World> world = World::create(twin.world, params_, diag, options);
   if (!world && error) *error = "the ghost's world: " + diag.format();
   return world;
+}
+
+bool Ghost::movesHeld(const Command& command) const {
+  const RobotModel& robot = model_.robots[0].model;
+  const auto held = [&](const std::string& joint) {
+    return std::binary_search(held_.begin(), held_.end(), robot.findJoint(joint));
+  };
+  return std::visit(
+      [&](const auto& c) {
+        using T = std::decay_t<decltype(c)>;
+        if constexpr (std::is_same_v<T, JointVelocityCmd> || std::is_same_v<T, JointTargetCmd> ||
+                      std::is_same_v<T, JointTorqueCmd> || std::is_same_v<T, JointModeCmd>)
+          return held(c.joint);
+        else if constexpr (std::is_same_v<T, GaitCmd>)
+          return c.gait != Gait::Off;  // a gait walks the legs
+        else
+          return false;
+      },
+      command);
+}
+
+void Ghost::carryControl(const World& from, const Twin& fromTwin, World& to, const Twin& toTwin,
+                         const std::vector<double>& positions) const {
+  const RobotModel& a = fromTwin.world.robots[0].model;
+  const RobotModel& b = toTwin.world.robots[0].model;
+  const RobotControlState& was = from.snapshot().robots[0];
+  Snapshot s = to.snapshot();
+  RobotControlState& now = s.robots[0];
+  const std::vector<ActuatorState> fresh = now.actuators;
+  now = was;
+  now.actuators = fresh;
+  for (size_t i = 0; i < b.actuators.size(); ++i) {
+    const ActuatorSpec& spec = b.actuators[i];
+    const auto same = std::find_if(a.actuators.begin(), a.actuators.end(),
+                                   [&](const ActuatorSpec& x) { return x.name == spec.name; });
+    if (same != a.actuators.end()) {
+      now.actuators[i] = was.actuators[static_cast<size_t>(same - a.actuators.begin())];
+    } else if (spec.hasPid && spec.kp > 0) {
+      // It was held, so the robot kept it still: it holds where it is.
+      const int full = toTwin.rigid ? toTwin.rigid->jointOf[static_cast<size_t>(spec.joint)] : spec.joint;
+      now.actuators[i].mode = JointMode::Position;
+      now.actuators[i].target = positions[static_cast<size_t>(full)];
+      now.actuators[i].integral = 0;
+    }
+  }
+  to.restore(s);
 }
 
 std::vector<double> Ghost::fullPositions(const Twin& twin, const std::vector<double>& joints,
@@ -279,6 +348,8 @@ void Ghost::anchorLoop() {
   std::unique_ptr<World> world;
   Snapshot anchored;  // the last anchored state, commands in effect included
   uint64_t seen = 0, applied = 0, epoch = 0;
+  bool gaitOn = false;  // a gait is in effect
+  std::deque<std::pair<double, std::vector<double>>> recent;  // (robot time, joint positions), last kStillWindow
   double lastStart = -1e9;
   for (;;) {
     RobotFrame frame;
@@ -297,24 +368,56 @@ void Ghost::anchorLoop() {
       if (epoch != epoch_) {  // the robot restarted: weld and build anew
         epoch = epoch_;
         world.reset();
+        recent.clear();
+        gaitOn = false;
         applied = nextSeq_;
       }
       for (SentCommand& c : commandsFrom(applied)) (c.time <= frame.time ? effective : pending).push_back(std::move(c));
       target = options_.runAhead ? ghostTimeLocked(now()) : frame.time;
     }
     lastStart = now();
-    if (!world) {
+    const bool latched = frame.estop || frame.failsafe;
+    // Hold the ghost.hold joints only while the robot keeps them still and
+    // nothing sent moves them (a gait, a joint command in flight).
+    for (const SentCommand& c : effective)
+      if (std::holds_alternative<GaitCmd>(c.command)) gaitOn = std::get<GaitCmd>(c.command).gait != Gait::Off;
+      else if (std::holds_alternative<DriveCmd>(c.command) || std::holds_alternative<TurnCmd>(c.command) ||
+               std::holds_alternative<WheelsCmd>(c.command) || std::holds_alternative<StopCmd>(c.command))
+        gaitOn = false;
+    if (latched) gaitOn = false;
+    while (!recent.empty() && recent.front().first < frame.time - kStillWindow) recent.pop_front();
+    recent.emplace_back(frame.time, frame.jointPositions);
+    // Holding starts after a still window (or on the first frame); it goes on while they stay still.
+    bool still = !world || twin->rigid || frame.time - recent.front().first >= kStillWindow - 0.05;
+    for (const auto& [time, q] : recent)
+      for (int j : held_)
+        still = still && std::abs(q[static_cast<size_t>(j)] - frame.jointPositions[static_cast<size_t>(j)]) <= kStillBand;
+    bool hold = !held_.empty() && still && !gaitOn;
+    for (const SentCommand& c : pending) hold = hold && (latched || !movesHeld(c.command));
+    for (const SentCommand& c : effective) hold = hold && (latched || !movesHeld(c.command));
+    bool rebuild = !world || hold != twin->rigid.has_value();
+    if (!rebuild && twin->rigid)
+      for (int j : held_)
+        rebuild = rebuild || std::abs(twin->rigid->heldPositions[static_cast<size_t>(j)] -
+                                      frame.jointPositions[static_cast<size_t>(j)]) > kReweld;
+    if (rebuild) {
       std::string error;
-      twin = makeTwin(frame.jointPositions, error);
-      world = twin ? buildWorld(*twin, &error) : nullptr;
-      if (!world) {
+      std::shared_ptr<const Twin> next = makeTwin(frame.jointPositions, hold, error);
+      std::unique_ptr<World> built = next ? buildWorld(*next, &error) : nullptr;
+      if (!built) {
         setProblem(error);
         continue;
       }
+      // The set-points of the commands in effect carry over.
+      if (world) carryControl(*world, *twin, *built, *next, frame.jointPositions);
+      twin = std::move(next);
+      world = std::move(built);
       anchored = world->snapshot();
+      std::lock_guard lock(mutex_);
+      ++stats_.twins;
+      stats_.held = hold;
     }
     World& w = *world;
-    const bool latched = frame.estop || frame.failsafe;
     if (!effective.empty()) applied = effective.back().seq + 1;
     if (latched) {
       // The robot holds still and refuses what it is sent meanwhile.

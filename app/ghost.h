@@ -14,10 +14,15 @@
 // run at real time.
 //
 // Three threads, each owning one World built from the same model with the
-// ghost's profile (ghost.step, ghost.iterations; sensors off) and the
-// ghost.hold joints (the upper body) welded at the pose of the first
-// telemetry (sim/rigid.h; their links are drawn as telemetry reports them,
-// and commands to them do not move the ghost):
+// ghost's profile (ghost.step, ghost.iterations; sensors off). The
+// ghost.hold joints (the upper body, the legs' hips and knees; the wheels
+// and the articulation keep turning) are welded where telemetry reports
+// them (sim/rigid.h: fewer bodies and rows, 2-3x faster, and a coarse step
+// stays accurate over bumps, docs/performance.md) while the robot keeps them
+// still and nothing sent moves them; a gait, a joint command in flight or
+// the joints moving switch the ghost to the full robot, and holding resumes
+// (welded anew) once they have been still for 1 s. Held links are drawn as
+// telemetry reports them.
 //   anchor   on the newest telemetry (at most ghost.anchor_rate per second):
 //            the commands in effect by then, the frame's state through
 //            linkMotions + World::setRobotMotion, then run to ghost(now)
@@ -98,6 +103,8 @@ struct GhostStats {
   int64_t trails = 0;         ///< trails completed
   double trailMs = 0;         ///< wall time of the last one
   int64_t views = 0;          ///< views published
+  int64_t twins = 0;          ///< worlds built for a new weld or a switch between held and full
+  bool held = false;          ///< the newest is held (ghost.hold joints welded)
 };
 
 class Ghost {
@@ -160,9 +167,16 @@ class Ghost {
 
   Ghost(const WorldModel& world, const SimParams& params, const Options& options)
       : model_(world), params_(params), options_(options) {}
-  /// The twin welded at `positions` (the full robot's joints). Null and `error`
-  /// when the hold cannot be made.
-  std::shared_ptr<const Twin> makeTwin(const std::vector<double>& positions, std::string& error) const;
+  /// The twin welded at `positions` (the full robot's joints), or the full
+  /// robot when not `hold`. Null and `error` when the hold cannot be made.
+  std::shared_ptr<const Twin> makeTwin(const std::vector<double>& positions, bool hold, std::string& error) const;
+  /// Whether `command` moves a ghost.hold joint (a gait moves the legs).
+  bool movesHeld(const Command& command) const;
+  /// Gives `to` (just built) the controller set-points of `from` (the twin
+  /// it replaces), actuator by name; a joint `from` held holds where
+  /// `positions` (the full robot's) has it.
+  void carryControl(const World& from, const Twin& fromTwin, World& to, const Twin& toTwin,
+                    const std::vector<double>& positions) const;
   std::unique_ptr<World> buildWorld(const Twin& twin, std::string* error = nullptr) const;
   /// A state of `twin`'s robot as the full robot's joint positions: held
   /// ones as `reported` has them (the newest telemetry), when it has them.
@@ -183,7 +197,7 @@ class Ghost {
   WorldModel model_;  // the full world
   SimParams params_;  // the ghost profile
   Options options_;
-  std::vector<int> held_;  // joints the ghost holds rigid (ghost.hold's subtrees)
+  std::vector<int> held_;  // joints the ghost may hold rigid (ghost.hold's subtrees but the drive's), sorted
 
   mutable std::mutex mutex_;  // guards everything below
   std::condition_variable anchorWake_, presentWake_, trailWake_;

@@ -214,7 +214,7 @@ const std::vector<Entry>& table() {
             real(&SimParams::ghostHorizon, closed(0, 60))),
       entry("ghost.anchor_rate", "ghost: re-anchorings on telemetry per second at most [Hz], [1, 1000]",
             real(&SimParams::ghostAnchorRate, closed(1, 1000))),
-      entry("ghost.hold", "ghost: joints whose subtrees it holds rigid, comma-separated, or none",
+      entry("ghost.hold", "ghost: joints whose subtrees it holds rigid while still (the drive's joints turn), comma-separated, or none",
             jointNames(&SimParams::ghostHold)),
       entry("gait.caterpillar.hip_swing", "caterpillar: hip swing about the stance pose [deg], (0, 45]",
             real(&SimParams::caterpillarHipSwing, openClosed(0, 45))),

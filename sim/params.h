@@ -47,9 +47,10 @@ struct SimParams {
   int ghostIterations = 20;       ///< ghost: quick solver iterations
   double ghostHorizon = 5;        ///< [s] ghost: how far the trail looks ahead of the ghost
   double ghostAnchorRate = 15;    ///< [Hz] ghost: re-anchorings per second at most
-  /// Ghost: joints whose subtrees it holds rigid (comma-separated names, or
-  /// "none"): fewer bodies, faster predictions (sim/rigid.h).
-  std::string ghostHold = "waist_yaw";
+  /// Ghost: joints whose subtrees it holds rigid while the robot keeps them
+  /// still (comma-separated names, or "none"; the wheels and articulation
+  /// keep turning): fewer bodies, faster predictions (sim/rigid.h).
+  std::string ghostHold = "waist_yaw,hip_fl,hip_fr,hip_rl,hip_rr";
   // Gaits (sim/gait.h); swings in degrees about the stance pose
   double caterpillarHipSwing = 12;   ///< [deg]
   double caterpillarPhaseTime = 1.0; ///< [s] per half cycle

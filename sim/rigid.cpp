@@ -54,15 +54,6 @@ std::optional<RigidRobot> holdRigid(const RobotModel& robot, std::span<const dou
     isHeld[static_cast<size_t>(j)] = true;
   }
   const std::vector<int> above = jointAbove(robot);
-  for (size_t j = 0; j < nj; ++j) {
-    const JointSpec& joint = robot.joints[j];
-    const int parentJoint = joint.parent >= 0 ? above[static_cast<size_t>(joint.parent)] : -1;
-    if (!isHeld[j] && parentJoint >= 0 && isHeld[static_cast<size_t>(parentJoint)]) {
-      error = "joint '" + joint.name + "' moves below held joint '" + robot.joints[static_cast<size_t>(parentJoint)].name +
-              "': hold its whole subtree";
-      return std::nullopt;
-    }
-  }
   if (robot.drive) {
     std::vector<int> driveJoints(robot.drive->wheels.begin(), robot.drive->wheels.end());
     driveJoints.push_back(robot.drive->articulation);
@@ -97,9 +88,20 @@ std::optional<RigidRobot> holdRigid(const RobotModel& robot, std::span<const dou
     }
   for (size_t l = 0; l < nl; ++l) r.ownerOf.push_back(newLink[static_cast<size_t>(owner[l])]);
 
+  // The rigid robot's zero pose is the full robot's with the held joints at
+  // their held positions (the others at zero), so a joint that still moves
+  // below held ones (a wheel below a held knee) keeps its meaning.
+  std::vector<double> reposed(nj, 0.0);
+  for (size_t j = 0; j < nj; ++j)
+    if (isHeld[j]) reposed[j] = jointPositions[j];
+  const std::vector<Pose> poses = linkPoses(robot, robot.links[0].pose, reposed);
+  for (size_t l = 0; l < nl; ++l)
+    if (newLink[l] >= 0) r.model.links[static_cast<size_t>(newLink[l])].pose = poses[l];
+  // How each link moved from its zero pose into the reposed one.
+  const auto moved = [&](int link) { return poses[static_cast<size_t>(link)] * inverse(robot.links[static_cast<size_t>(link)].pose); };
+
   // Gathered links: their geoms, each with its own mass, in the owner's
   // frame at the held pose. Owners' own geoms get their shares too.
-  const std::vector<Pose> poses = linkPoses(robot, robot.links[0].pose, jointPositions);
   const auto shares = [](const LinkSpec& link) {
     double volume = 0;
     for (const GeomSpec& g : link.geoms) volume += geomVolume(g);
@@ -139,7 +141,11 @@ std::optional<RigidRobot> holdRigid(const RobotModel& robot, std::span<const dou
   for (size_t j = 0; j < nj; ++j) {
     if (isHeld[j]) continue;
     JointSpec joint = robot.joints[j];
-    if (joint.parent >= 0) joint.parent = newLink[static_cast<size_t>(joint.parent)];
+    const Pose m = moved(joint.parent >= 0 ? joint.parent : joint.child);
+    joint.anchor = transformPoint(m, joint.anchor);
+    joint.axis = rotate(m.q, joint.axis);
+    joint.axis2 = rotate(m.q, joint.axis2);
+    if (joint.parent >= 0) joint.parent = newLink[static_cast<size_t>(owner[static_cast<size_t>(joint.parent)])];
     joint.child = newLink[static_cast<size_t>(joint.child)];
     newJoint[j] = static_cast<int>(r.model.joints.size());
     r.model.joints.push_back(joint);

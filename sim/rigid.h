@@ -34,9 +34,11 @@ struct RigidRobot {
 };
 
 /// `robot` with the joints `held` (indices) welded at `jointPositions`
-/// (one per joint, model order). Every joint below a held one must be held
-/// too, and neither the drive's articulation nor its wheels may be held;
-/// otherwise nullopt and `error` says which joint.
+/// (one per joint, model order). Joints below held ones may still move (a
+/// wheel below a held knee): the rigid robot's zero pose is the full one's
+/// with the held joints at their positions, and theirs are carried there.
+/// Neither the drive's articulation nor its wheels may be held; otherwise
+/// nullopt and `error` says which joint.
 std::optional<RigidRobot> holdRigid(const RobotModel& robot, std::span<const double> jointPositions,
                                     const std::vector<int>& held, std::string& error);
 

@@ -49,6 +49,20 @@ struct Seen : sp::test::SharedState {
   }
 };
 
+// What telemetry reports of the robot in `w`.
+RobotFrame frameOf(const World& w) {
+  const RobotReadout r = readRobot(w);
+  RobotFrame f;
+  f.time = r.time;
+  f.base = r.base;
+  f.hasBaseVelocity = true;
+  f.baseLinearVelocity = r.baseLinearVelocity;
+  f.baseAngularVelocity = r.baseAngularVelocity;
+  f.jointPositions = r.jointPositions;
+  f.jointRates = r.jointRates;
+  return f;
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? NAN : v[v.size() / 2];
@@ -207,18 +221,6 @@ class TestGhost : public QObject {
     QVERIFY2(world, diag.format().c_str());
     auto robot = World::create(*world, SimParams{}, diag);
     QVERIFY(robot);
-    const auto frameOf = [](const World& w) {
-      const RobotReadout r = readRobot(w);
-      RobotFrame f;
-      f.time = r.time;
-      f.base = r.base;
-      f.hasBaseVelocity = true;
-      f.baseLinearVelocity = r.baseLinearVelocity;
-      f.baseAngularVelocity = r.baseAngularVelocity;
-      f.jointPositions = r.jointPositions;
-      f.jointRates = r.jointRates;
-      return f;
-    };
     std::string error;
     auto ghost = Ghost::create(*world, SimParams{}, error);
     QVERIFY2(ghost, error.c_str());
@@ -240,11 +242,100 @@ class TestGhost : public QObject {
     QCOMPARE(v.jointPositions[elbow], bent.jointPositions[elbow]);
   }
 
+  // The legs are held (ghost.hold) only while the robot keeps them still:
+  // a crouch sent switches the ghost to the full robot, which bends its
+  // knees a round trip before the robot does (a held ghost draws the knees
+  // as reported: they would stay straight); once the robot has held the
+  // crouch still for 1 s the ghost holds again, welded crouched, and drives
+  // on from there.
+  void crouchSwitchesToTheFullRobot() {
+    Diagnostics diag;
+    const auto world = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
+    QVERIFY2(world, diag.format().c_str());
+    const RobotModel& model = world->robots[0].model;
+    auto robot = World::create(*world, SimParams{}, diag);
+    QVERIFY(robot);
+    std::string error;
+    auto ghost = Ghost::create(*world, SimParams{}, error);
+    QVERIFY2(ghost, error.c_str());
+    const double roundTrip = 0.4;
+    const size_t knee = static_cast<size_t>(model.findJoint("knee_fl"));
+    const double start = Ghost::now();
+    std::deque<std::pair<double, Command>> inFlight;  // (robot time it arrives, command)
+    std::vector<double> errors;
+    // Runs the robot in real time to robot time `until`, a frame every 20 ms.
+    const auto runTo = [&](double until, const std::function<void()>& each) {
+      while (robot->time() < until - 1e-9) {
+        for (int i = 0; i < 20; ++i) {
+          while (!inFlight.empty() && inFlight.front().first <= robot->time() + 1e-9) {
+            QCOMPARE(robot->submit(inFlight.front().second), std::string());
+            inFlight.pop_front();
+          }
+          QVERIFY(robot->step());
+        }
+        const RobotFrame f = frameOf(*robot);
+        // The frame arrives half a round trip after the robot sent it.
+        std::this_thread::sleep_until(std::chrono::steady_clock::time_point(
+            std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                std::chrono::duration<double>(start + f.time + roundTrip / 2))));
+        if (const auto e = ghost->anchor(f, roundTrip); e && std::hypot(f.baseLinearVelocity.x, f.baseLinearVelocity.y) > 0.1)
+          errors.push_back(e->position);
+        if (each) each();
+      }
+    };
+    const auto send = [&](const Command& c) {
+      ghost->commandSent(c);
+      inFlight.emplace_back(ghost->ghostTime(Ghost::now()), c);
+    };
+    runTo(1.5, {});
+    QTRY_VERIFY_WITH_TIMEOUT(ghost->stats().anchors > 5, 5000);
+    QVERIFY(ghost->stats().held);
+    const int64_t twins = ghost->stats().twins;
+    QCOMPARE(twins, int64_t{1});
+
+    for (const char* leg : {"fl", "fr"}) {
+      send(JointTargetCmd{std::string("hip_") + leg, degToRad(18.6)});
+      send(JointTargetCmd{std::string("knee_") + leg, degToRad(-37.2)});
+    }
+    for (const char* leg : {"rl", "rr"}) {
+      send(JointTargetCmd{std::string("hip_") + leg, degToRad(-18.6)});
+      send(JointTargetCmd{std::string("knee_") + leg, degToRad(37.2)});
+    }
+    // Before the crouch reaches the robot, the ghost bends its knee.
+    double lead = 0;
+    const double arrives = inFlight.front().first;
+    runTo(arrives - 0.05, [&] {
+      const GhostView v = ghost->view();
+      if (v.jointPositions.size() > knee)
+        lead = std::max(lead, std::abs(v.jointPositions[knee] - readRobot(*robot).jointPositions[knee]));
+    });
+    qInfo("before the crouch arrived: the ghost's knee led the robot's by %.1f deg; %lld twins built",
+          radToDeg(lead), static_cast<long long>(ghost->stats().twins));
+    QVERIFY(!ghost->stats().held);
+    QVERIFY(lead > degToRad(10));
+    // The crouch done (about 2 s) and held still for 1 s: held again, crouched.
+    runTo(arrives + 4.5, {});
+    QTRY_VERIFY_WITH_TIMEOUT(ghost->stats().held, 2000);
+    QVERIFY(ghost->stats().twins >= twins + 2);
+    QVERIFY(std::abs(readRobot(*robot).jointPositions[knee] - degToRad(-37.2)) < degToRad(2));
+    // Driving on crouched: the held ghost predicts it.
+    send(DriveCmd{0.5, degToRad(10)});
+    runTo(robot->time() + 3, {});
+    QVERIFY2(errors.size() > 50, qPrintable(QString::number(errors.size())));
+    qInfo("driving crouched: median position error %.1f mm over %zu frames; held %d", median(errors) * 1000,
+          errors.size(), ghost->stats().held);
+    QVERIFY(median(errors) < 0.05);
+    QVERIFY(ghost->stats().held);
+    QCOMPARE(ghost->view().problem, std::string());
+  }
+
   void badHoldRefused_data() {
     QTest::addColumn<QString>("hold");
     QTest::addColumn<QString>("error");
     QTest::newRow("unknown joint") << "waist_yaw,nope" << "ghost.hold: the robot has no joint 'nope'";
-    QTest::newRow("a wheel") << "knee_fl" << "ghost.hold: joint 'wheel_fl' drives the robot and cannot be held";
+    QTest::newRow("a wheel") << "wheel_fl" << "ghost.hold: joint 'wheel_fl' drives the robot and cannot be held";
+    QTest::newRow("the articulation") << "hip_fl,articulation"
+                                      << "ghost.hold: joint 'articulation' drives the robot and cannot be held";
   }
 
   void badHoldRefused() {

@@ -1,5 +1,6 @@
 // Holding joints rigid (sim/rigid.h): the welded robot has the full robot's
-// mass, centre of mass and link poses in the held pose, and drives like it;
+// mass, centre of mass and link poses in the held pose, and drives like it,
+// also with joints below held ones still moving (wheels below held legs);
 // what cannot be held is refused, naming the joint.
 
 #include <QtTest>
@@ -21,6 +22,17 @@ WorldModel flat() {
   auto model = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
   if (!model) qFatal("%s", diag.format().c_str());
   return *model;
+}
+
+// Worlds of the full robot and of the rigid one.
+std::pair<std::unique_ptr<World>, std::unique_ptr<World>> fullAndRigid(const WorldModel& world, const RigidRobot& rigid) {
+  WorldModel rigidWorld = world;
+  rigidWorld.robots[0].model = rigid.model;
+  Diagnostics diag;
+  auto a = World::create(world, SimParams{}, diag);
+  auto b = World::create(rigidWorld, SimParams{}, diag);
+  if (!a || !b) qWarning("%s", diag.format().c_str());
+  return {std::move(a), std::move(b)};
 }
 
 double distance(Vec3 a, Vec3 b) { return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z)); }
@@ -61,12 +73,8 @@ class TestRigid : public QObject {
     QCOMPARE(fullJoints(*rigid, rigidJoints(*rigid, q)), q);
 
     // Centre of mass of the two worlds, the full one put in the held pose.
-    WorldModel rigidWorld = world;
-    rigidWorld.robots[0].model = rigid->model;
-    Diagnostics diag;
-    auto a = World::create(world, SimParams{}, diag);
-    auto b = World::create(rigidWorld, SimParams{}, diag);
-    QVERIFY2(a && b, diag.format().c_str());
+    auto [a, b] = fullAndRigid(world, *rigid);
+    QVERIFY(a && b);
     const Pose start = world.robots[0].pose * base;
     QCOMPARE(a->setRobotMotion(0, linkMotions(robot, start, {}, {}, q, std::vector<double>(q.size(), 0.0))), std::string());
     const Vec3 ca = a->robotCentreOfMass(0), cb = b->robotCentreOfMass(0);
@@ -74,9 +82,12 @@ class TestRigid : public QObject {
     QVERIFY(distance(ca, cb) < 1e-9);
     // Control: the same merge with the gathered mass spread over the geoms
     // by volume (a naive merge) moves the centre of mass, and this sees it.
-    for (LinkSpec& link : rigidWorld.robots[0].model.links)
+    WorldModel naiveWorld = world;
+    naiveWorld.robots[0].model = rigid->model;
+    for (LinkSpec& link : naiveWorld.robots[0].model.links)
       for (GeomSpec& g : link.geoms) g.mass = -1;
-    auto naive = World::create(rigidWorld, SimParams{}, diag);
+    Diagnostics diag;
+    auto naive = World::create(naiveWorld, SimParams{}, diag);
     QVERIFY2(naive, diag.format().c_str());
     const Vec3 cn = naive->robotCentreOfMass(0);
     qInfo("naive merge: centre of mass %.1f mm off", distance(ca, cn) * 1000);
@@ -92,12 +103,8 @@ class TestRigid : public QObject {
     std::string error;
     const auto rigid = holdRigid(robot, q, subtreeJoints(robot, "waist_yaw"), error);
     QVERIFY2(rigid, error.c_str());
-    WorldModel rigidWorld = world;
-    rigidWorld.robots[0].model = rigid->model;
-    Diagnostics diag;
-    auto a = World::create(world, SimParams{}, diag);
-    auto b = World::create(rigidWorld, SimParams{}, diag);
-    QVERIFY2(a && b, diag.format().c_str());
+    auto [a, b] = fullAndRigid(world, *rigid);
+    QVERIFY(a && b);
     for (World* w : {a.get(), b.get()}) {
       QCOMPARE(w->submit(DriveCmd{0.5, degToRad(12)}), std::string());
       for (int i = 0; i < 5000; ++i) QVERIFY(w->step());
@@ -110,15 +117,97 @@ class TestRigid : public QObject {
     QVERIFY(yaw < 1);
   }
 
+  // The legs held too, crouched (hips and knees bent), the wheels still
+  // turning below them: every remaining link where the full robot's
+  // kinematics puts it for any wheel angle, and the held robot drives like
+  // the full one from that pose.
+  void legsHeldCrouchedWheelsTurn() {
+    const WorldModel world = flat();
+    const RobotModel& robot = world.robots[0].model;
+    std::vector<double> q(robot.joints.size(), 0.0);
+    std::vector<int> held = subtreeJoints(robot, "waist_yaw");
+    for (const char* leg : {"fl", "fr", "rl", "rr"}) {
+      const int hip = robot.findJoint(std::string("hip_") + leg), knee = robot.findJoint(std::string("knee_") + leg);
+      q[static_cast<size_t>(hip)] = degToRad(20);
+      q[static_cast<size_t>(knee)] = degToRad(-35);
+      held.push_back(hip);
+      held.push_back(knee);
+    }
+    std::string error;
+    const auto rigid = holdRigid(robot, q, held, error);
+    QVERIFY2(rigid, error.c_str());
+    QCOMPARE(rigid->model.links.size(), size_t{6});  // two bodies, four wheels
+    QCOMPARE(rigid->model.totalMass(), robot.totalMass());
+    // Wheels turned to 1 rad, the articulation to 0.2 rad.
+    std::vector<double> moved = q;
+    for (int w : robot.drive->wheels) moved[static_cast<size_t>(w)] = 1.0;
+    moved[static_cast<size_t>(robot.drive->articulation)] = 0.2;
+    const Pose base = robot.links[0].pose;
+    const std::vector<Pose> full = linkPoses(robot, base, moved);
+    const std::vector<Pose> welded = linkPoses(rigid->model, base, rigidJoints(*rigid, moved));
+    const std::vector<Pose> upright = linkPoses(robot, base, std::vector<double>(q.size(), 0.0));
+    double worst = 0, crouch = 0;
+    for (size_t l = 0; l < rigid->model.links.size(); ++l) {
+      const size_t f = static_cast<size_t>(rigid->linkOf[l]);
+      worst = std::max({worst, distance(welded[l].p, full[f].p),
+                        1 - std::abs(welded[l].q.w * full[f].q.w + welded[l].q.x * full[f].q.x +
+                                         welded[l].q.y * full[f].q.y + welded[l].q.z * full[f].q.z)});
+      crouch = std::max(crouch, distance(full[f].p, upright[f].p));
+    }
+    qInfo("links %.2e from the full robot's; the crouch moved them up to %.3f m", worst, crouch);
+    QVERIFY(worst < 1e-12);
+    QVERIFY(crouch > 0.05);  // control: the pose does differ from the zero pose
+
+    // In ODE: both start crouched at rest and drive 5 s turning.
+    auto [a, b] = fullAndRigid(world, *rigid);
+    QVERIFY(a && b);
+    // Lifted so that the lowest wheel, lowered by the crouch, stays on the ground.
+    Pose start = world.robots[0].pose * base;
+    const std::vector<Pose> crouched = linkPoses(robot, base, q);
+    double lift = 0;
+    for (int w : robot.drive->wheels) {
+      const size_t l = static_cast<size_t>(robot.joints[static_cast<size_t>(w)].child);
+      lift = std::max(lift, upright[l].p.z - crouched[l].p.z);
+    }
+    start.p.z += lift;
+    const std::vector<double> rest(q.size(), 0.0);
+    QCOMPARE(a->setRobotMotion(0, linkMotions(robot, start, {}, {}, q, rest)), std::string());
+    QCOMPARE(b->setRobotMotion(0, linkMotions(rigid->model, start, {}, {}, rigidJoints(*rigid, q),
+                                              rigidJoints(*rigid, rest))),
+             std::string());
+    for (size_t j = 0; j < robot.joints.size(); ++j)
+      if (robot.joints[j].name.rfind("hip_", 0) == 0 || robot.joints[j].name.rfind("knee_", 0) == 0)
+        QCOMPARE(a->submit(JointTargetCmd{robot.joints[j].name, q[j]}), std::string());
+    // Settled for 1 s, then 5 s of driving: each base's path from its settled pose.
+    Pose settled[2];
+    for (int k = 0; k < 2; ++k) {
+      World& w = k == 0 ? *a : *b;
+      for (int i = 0; i < 1000; ++i) QVERIFY2(w.step(), w.health().message().c_str());
+      settled[k] = w.linkPose(0, 0);
+      QCOMPARE(w.submit(DriveCmd{0.5, degToRad(12)}), std::string());
+      for (int i = 0; i < 5000; ++i) QVERIFY2(w.step(), w.health().message().c_str());
+    }
+    const Pose pa = a->linkPose(0, 0), pb = b->linkPose(0, 0);
+    const Vec3 da = pa.p - settled[0].p, db = pb.p - settled[1].p;
+    const double off = std::hypot(da.x - db.x, da.y - db.y);
+    const double yaw = radToDeg(std::abs(std::remainder(heading(pa.q) - heading(settled[0].q) - heading(pb.q) +
+                                                            heading(settled[1].q),
+                                                        2 * kPi)));
+    qInfo("crouched, 5 s: paths %.1f mm, %.3f deg apart; full robot moved %.2f m (settling: %.1f mm apart)",
+          off * 1000, yaw, std::hypot(da.x, da.y), distance(settled[0].p, settled[1].p) * 1000);
+    QVERIFY(off < 0.03);
+    QVERIFY(yaw < 1);
+  }
+
   void refusals() {
     const WorldModel world = flat();
     const RobotModel& robot = world.robots[0].model;
     const std::vector<double> q(robot.joints.size(), 0.0);
     std::string error;
-    QVERIFY(!holdRigid(robot, q, {robot.findJoint("elbow_l")}, error));
-    QCOMPARE(error, std::string("joint 'finger_l1' moves below held joint 'elbow_l': hold its whole subtree"));
     QVERIFY(!holdRigid(robot, q, subtreeJoints(robot, "knee_fl"), error));
     QCOMPARE(error, std::string("joint 'wheel_fl' drives the robot and cannot be held"));
+    QVERIFY(!holdRigid(robot, q, {robot.findJoint("articulation")}, error));
+    QCOMPARE(error, std::string("joint 'articulation' drives the robot and cannot be held"));
     QVERIFY(!holdRigid(robot, std::vector<double>(3, 0.0), {}, error));
     QCOMPARE(error, std::string("expected 27 joint positions, got 3"));
     QVERIFY(!holdRigid(robot, q, {99}, error));
