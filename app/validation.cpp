@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <ostream>
 #include <sstream>
@@ -108,6 +109,47 @@ double slope(const std::vector<double>& x, const std::vector<double>& y) {
   return sxx > 0 ? sxy / sxx : 0;
 }
 
+}  // namespace
+
+LinearFit linearFit(const std::vector<double>& x, const std::vector<double>& y) {
+  LinearFit f;
+  if (x.size() < 2 || x.size() != y.size()) return f;
+  f.slope = slope(x, y);
+  f.intercept = mean(y) - f.slope * mean(x);
+  const double my = mean(y);
+  double residual = 0, total = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    const double e = y[i] - (f.intercept + f.slope * x[i]);
+    residual += e * e;
+    total += (y[i] - my) * (y[i] - my);
+  }
+  f.r2 = total > 0 ? 1 - residual / total : 0;
+  return f;
+}
+
+double proportionalityMismatch(const ErrorSeries& a, const ErrorSeries& b, double floor) {
+  std::vector<double> mismatch;
+  // The instants both have (a beam out of range gives no sample).
+  for (size_t i = 0, j = 0; i < a.times.size() && j < b.times.size();) {
+    if (a.times[i] < b.times[j] - 1e-9) {
+      ++i;
+    } else if (b.times[j] < a.times[i] - 1e-9) {
+      ++j;
+    } else {
+      if (std::abs(b.errors[j]) >= floor && a.ranges[i] > 0 && b.ranges[j] > 0) {
+        const double perMetreA = a.errors[i] / a.ranges[i], perMetreB = b.errors[j] / b.ranges[j];
+        mismatch.push_back(std::abs(perMetreB - perMetreA) / std::abs(perMetreB));
+      }
+      ++i, ++j;
+    }
+  }
+  if (mismatch.empty()) return std::numeric_limits<double>::infinity();
+  std::sort(mismatch.begin(), mismatch.end());
+  return mismatch[mismatch.size() / 2];
+}
+
+namespace {
+
 std::string solverText(const SimParams& p) {
   return "step " + num(p.step * 1000, 1) + " ms, " +
          (p.solver == Solver::Quick ? "quick solver " + std::to_string(p.iterations) + " iterations"
@@ -118,7 +160,7 @@ std::string solverText(const SimParams& p) {
 }  // namespace
 
 bool ExperimentResult::pass() const {
-  return std::all_of(metrics.begin(), metrics.end(), [](const Metric& m) { return m.pass; });
+  return std::all_of(metrics.begin(), metrics.end(), [](const Metric& m) { return !m.judged || m.pass; });
 }
 
 // 1. Articulation hinge held at several angles, wheel speeds from the
@@ -133,7 +175,8 @@ ExperimentResult circularDrive(const ValidationOptions& o) {
                  " m/s at the hinge; " + num(settle, 0) + " s to settle, then the hinge point's path over " +
                  num(record, 0) + " s is fitted with a circle";
   PlotSpec paths{"Circular drive: path of the articulation hinge", "x [m]", "y [m]", {}, 900, 900, {}, {}};
-  std::vector<double> angles = o.quick ? std::vector<double>{20} : std::vector<double>{10, 20, 30};
+  // The quick suite checks every angle the full one does, over a shorter record.
+  const std::vector<double> angles = {10, 20, 30};
   double worst = 0;
   for (double gammaDeg : angles) {
     auto w = makeWorld(model, o.params);
@@ -153,14 +196,21 @@ ExperimentResult circularDrive(const ValidationOptions& o) {
     requireHealthy(*w, r.title);
     mean.frontLength /= n, mean.rearLength /= n, mean.articulation /= n;
     const auto [centre, radius] = fitCircle(points);
-    const double s = std::sin(mean.articulation), c = std::cos(mean.articulation);
-    const double rRear = (mean.frontLength + mean.rearLength * c) / s;
-    const double expected = std::hypot(mean.rearLength, rRear);
+    // The kinematic radius for a hinge angle (workpartner-facts.md §3).
+    const auto kinematic = [&](double gamma) {
+      const double rRear = (mean.frontLength + mean.rearLength * std::cos(gamma)) / std::sin(gamma);
+      return std::hypot(mean.rearLength, rRear);
+    };
+    const double expected = kinematic(mean.articulation), nominal = kinematic(degToRad(gammaDeg));
     const double error = 100 * (radius - expected) / expected;
+    const double nominalError = 100 * (radius - nominal) / nominal;
     worst = std::max(worst, std::abs(error));
-    r.metrics.push_back({"hinge path radius at " + num(gammaDeg, 0) + " deg: model " + num(expected, 3) +
+    r.metrics.push_back({"hinge path radius at " + num(gammaDeg, 0) + " deg, measured hinge angle " +
+                             num(radToDeg(mean.articulation), 3) + " deg: model " + num(expected, 3) +
                              " m, simulated " + num(radius, 3) + " m; error",
                          "about 0.5", error, "%", "|error| <= 0.5 %", std::abs(error) <= 0.5});
+    r.metrics.push_back({"the same against the commanded (nominal) hinge angle: model " + num(nominal, 3) + " m; error",
+                         "", nominalError, "%", "", false, false});
     PlotSeries path{"simulated, " + num(gammaDeg, 0) + " deg", {}, {}, PlotSeries::Style::Line};
     for (const Vec3& p : points) {
       path.x.push_back(p.x);
@@ -182,100 +232,198 @@ ExperimentResult circularDrive(const ValidationOptions& o) {
       "a circle of radius R_H = sqrt(L_r^2 + R_r^2), R_r = (L_f + L_r cos gamma) / sin gamma "
       "(workpartner-facts.md §3), with L_f, L_r and gamma measured on the twin during the run (they move "
       "slightly with the legs). The wheel speeds come from the same kinematics, recomputed every step. The "
-      "largest deviation is " + num(worst, 2) + " %; the remainder is the compliance of the contacts and "
-      "joints under the tyres' side forces (at ERP 0.2 it was about 0.5 %, see config/defaults.params).";
+      "criterion uses the measured hinge angle, as an experimenter with an encoder on the hinge would; the "
+      "largest deviation is " + num(worst, 2) + " %, the compliance of the contacts and joints under the "
+      "tyres' side forces (at ERP 0.2 it was about 0.5 %, see config/defaults.params). Against the commanded "
+      "angle (the info rows) the error is larger: the hinge's position controller holds the angle a little "
+      "short of its target under the steering load.";
   return r;
 }
 
-// 2. The torso turns at a constant rate in front of a wall 6 m from the
-// robot's centre; the laser's range error against time and distance.
+// 2. The torso turns at a constant rate in front of a wall; the laser's
+// range error against time and distance, with the wall at three distances.
 ExperimentResult laserSweep(const ValidationOptions& o) {
   ExperimentResult r;
   r.number = 2;
   r.title = "Laser scanner";
   WorldModel model = loadModel(o, "terrains/laser_wall.world.xml");
   for (SensorSpec& s : model.robots[0].model.sensors) s.noise = 0;  // the error of the model, not of noise
-  const double rateDeg = 15, from = -45, sweep = 90 / rateDeg;
-  r.conditions = "terrains/laser_wall.world.xml: a wall whose face is 6 m ahead of the hinge; laser noise off; "
-                 "the waist turns from " + num(from, 0) + " deg at " + num(rateDeg, 0) + " deg/s (velocity mode) "
-                 "for " + num(sweep, 0) + " s; the beam along the torso's heading is compared with the wall";
-  auto w = makeWorld(model, o.params);
-  const RobotModel& robot = w->robotModel(0);
-  const int laser = robot.findSensor("laser");
-  const int waist = robot.findJoint("waist_yaw");
-  w->submit(JointTargetCmd{"waist_yaw", degToRad(from)});
-  stepFor(*w, 4);
-  w->submit(JointVelocityCmd{"waist_yaw", degToRad(rateDeg)});
-  const double t0 = w->time(), angle0 = w->jointPosition(0, waist);
-  std::vector<double> times, distances, trueError, commandError, angleError;
-  int64_t lastStep = -1;
-  Runner runner(*w);
-  while (w->time() < t0 + sweep - 1e-9) {
-    runner.advanceBy(1);
-    const SensorSample& s = w->sensorSample(0, laser);
-    if (s.step == lastStep) continue;
-    lastStep = s.step;
-    const auto& scan = std::get<LaserReading>(s.value);
-    const size_t centre = scan.ranges.size() / 2;
-    const double measured = scan.ranges[centre];
-    const Vec3 dir = rotate(scan.sensorPose.q, {1, 0, 0});
-    const Vec3 p = scan.sensorPose.p;
-    const double truth = (6.0 - p.x) / dir.x;
-    // What the paper's experimenters compared with: the pose the commanded
-    // rate implies, integrated from the start of the sweep.
-    const double heading = std::atan2(dir.y, dir.x);
-    const double actualAngle = w->jointPosition(0, waist);
-    const double commanded = angle0 + degToRad(rateDeg) * (s.time - t0);
-    const double commandedHeading = heading + (commanded - actualAngle);
-    const double expectedFromCommand = (6.0 - p.x) / std::cos(commandedHeading);
-    if (!std::isfinite(measured)) continue;
-    times.push_back(s.time - t0);
-    distances.push_back(measured);
-    trueError.push_back(measured - truth);
-    commandError.push_back(measured - expectedFromCommand);
-    angleError.push_back(radToDeg(actualAngle - commanded));
+  int wall = -1;
+  for (size_t i = 0; i < model.objects.size(); ++i)
+    if (model.objects[i].name == "wall") wall = static_cast<int>(i);
+  if (wall < 0) throw std::runtime_error("laser_wall.world.xml has no object named 'wall'");
+  const double rateDeg = 15, from = -45, sweep = 90 / rateDeg, jitter = 0.5;
+  const double walls[] = {3, 6, 9};  // [m] the wall's face ahead of the hinge; 6 m is the paper's
+  r.conditions = "terrains/laser_wall.world.xml, the wall's face moved to 3, 6 and 9 m ahead of the hinge (6 m in "
+                 "the paper); laser noise off; the waist turns from " + num(from, 0) + " deg at " + num(rateDeg, 0) +
+                 " deg/s (velocity mode) for " + num(sweep, 0) + " s; the beam along the torso's heading is compared "
+                 "with the wall; fits start " + num(jitter, 1) + " s into the sweep (after the start-up jitter)";
+  struct Sweep {
+    std::vector<double> times, distances, trueError, commandError, angleError;
+  };
+  std::vector<Sweep> sweeps;
+  for (double face : walls) {
+    WorldModel m = model;
+    m.objects[static_cast<size_t>(wall)].pose.p.x += face - 6;
+    auto w = makeWorld(m, o.params);
+    const RobotModel& robot = w->robotModel(0);
+    const int laser = robot.findSensor("laser");
+    const int waist = robot.findJoint("waist_yaw");
+    w->submit(JointTargetCmd{"waist_yaw", degToRad(from)});
+    stepFor(*w, 4);
+    w->submit(JointVelocityCmd{"waist_yaw", degToRad(rateDeg)});
+    const double t0 = w->time(), angle0 = w->jointPosition(0, waist);
+    Sweep& sw = sweeps.emplace_back();
+    int64_t lastStep = -1;
+    Runner runner(*w);
+    while (w->time() < t0 + sweep - 1e-9) {
+      runner.advanceBy(1);
+      const SensorSample& s = w->sensorSample(0, laser);
+      if (s.step == lastStep) continue;
+      lastStep = s.step;
+      const auto& scan = std::get<LaserReading>(s.value);
+      const double measured = scan.ranges[scan.ranges.size() / 2];
+      const Vec3 dir = rotate(scan.sensorPose.q, {1, 0, 0});
+      const Vec3 p = scan.sensorPose.p;
+      const double truth = (face - p.x) / dir.x;
+      // What the paper's experimenters compared with: the pose the commanded
+      // rate implies, integrated from the start of the sweep.
+      const double heading = std::atan2(dir.y, dir.x);
+      const double actualAngle = w->jointPosition(0, waist);
+      const double commanded = angle0 + degToRad(rateDeg) * (s.time - t0);
+      const double expectedFromCommand = (face - p.x) / std::cos(heading + (commanded - actualAngle));
+      if (!std::isfinite(measured)) continue;
+      sw.times.push_back(s.time - t0);
+      sw.distances.push_back(measured);
+      sw.trueError.push_back(measured - truth);
+      sw.commandError.push_back(measured - expectedFromCommand);
+      sw.angleError.push_back(radToDeg(actualAngle - commanded));
+    }
+    requireHealthy(*w, r.title);
+    r.simSeconds += w->time();
   }
-  requireHealthy(*w, r.title);
-  r.simSeconds = w->time();
+  const Sweep& paper = sweeps[1];
   double worstTrue = 0;
-  for (double e : trueError) worstTrue = std::max(worstTrue, std::abs(e));
-  const double drift = slope(times, angleError);
-  r.metrics.push_back({"largest range error against the scanner's true pose", "", worstTrue * 1000, "mm",
-                       "< 0.001 mm (exact ray casting)", worstTrue < 1e-6});
-  r.metrics.push_back({"torso angle lag behind the commanded rate, growth", "error grew linearly with time",
-                       drift * 1000, "mdeg/s", "reported", true});
-  r.metrics.push_back({"range error against the commanded pose at the end of the sweep",
-                       "proportional to distance", commandError.empty() ? 0 : commandError.back() * 1000, "mm",
-                       "reported", true});
-  PlotSpec vsTime{"Laser: range error against time", "time since the sweep started [s]", "range error [mm]", {},
-                  960, 540, {}, {}};
-  PlotSeries a{"against the true scanner pose", times, {}, PlotSeries::Style::Line};
-  PlotSeries b{"against the pose the commanded rate implies", times, {}, PlotSeries::Style::Line};
-  for (size_t i = 0; i < times.size(); ++i) {
-    a.y.push_back(trueError[i] * 1000);
-    b.y.push_back(commandError[i] * 1000);
+  for (const Sweep& sw : sweeps)
+    for (double e : sw.trueError) worstTrue = std::max(worstTrue, std::abs(e));
+  // After the start-up jitter.
+  const auto after = [&](const std::vector<double>& v) {
+    std::vector<double> out;
+    for (size_t i = 0; i < v.size(); ++i)
+      if (paper.times[i] >= jitter) out.push_back(v[i]);
+    return out;
+  };
+  const std::vector<double> t = after(paper.times);
+  const LinearFit angleFit = linearFit(t, after(paper.angleError));
+  const LinearFit rangeFit = linearFit(t, after(paper.commandError));
+  const double proportional =
+      proportionalityMismatch({sweeps[0].times, sweeps[0].distances, sweeps[0].commandError},
+                              {sweeps[2].times, sweeps[2].distances, sweeps[2].commandError}, 0.5e-3);
+  r.metrics.push_back({"largest range error against the scanner's true pose, all three walls", "", worstTrue * 1000,
+                       "mm", "< 0.001 mm (exact ray casting: ours, not the paper's claim)", worstTrue < 1e-6});
+  r.metrics.push_back({"torso angle error against the commanded rate: linear fit over time, R^2 (slope " +
+                           num(angleFit.slope * 1000, 2) + " mdeg/s)",
+                       "the integrator error grew linearly", angleFit.r2, "", "R^2 >= 0.95", angleFit.r2 >= 0.95});
+  r.metrics.push_back({"range error against the commanded pose, 6 m wall: linear fit over time, R^2",
+                       "grew linearly with time", rangeFit.r2, "", "R^2 >= 0.9", rangeFit.r2 >= 0.9});
+  r.metrics.push_back({"range error per metre of range, 9 m wall against 3 m wall at the same instants: median "
+                       "relative difference",
+                       "proportional to the distance", proportional * 100, "%", "<= 10 %", proportional <= 0.1});
+  PlotSpec vsTime{"Laser: range error against time (6 m wall)", "time since the sweep started [s]",
+                  "range error [mm]", {}, 960, 540, {}, {}};
+  PlotSeries a{"against the true scanner pose", paper.times, {}, PlotSeries::Style::Line};
+  PlotSeries b{"against the pose the commanded rate implies", paper.times, {}, PlotSeries::Style::Line};
+  for (size_t i = 0; i < paper.times.size(); ++i) {
+    a.y.push_back(paper.trueError[i] * 1000);
+    b.y.push_back(paper.commandError[i] * 1000);
   }
   vsTime.series = {a, b};
-  PlotSpec vsDistance{"Laser: range error against distance", "measured range [m]", "range error [mm]", {}, 960,
-                      540, {}, {}};
-  PlotSeries c{"against the true scanner pose", distances, a.y, PlotSeries::Style::Points};
-  PlotSeries d{"against the pose the commanded rate implies", distances, b.y, PlotSeries::Style::Points};
-  vsDistance.series = {c, d};
+  PlotSpec vsDistance{"Laser: range error against the commanded pose, by distance", "measured range [m]",
+                      "range error [mm]", {}, 960, 540, {}, {}};
+  for (size_t k = 0; k < sweeps.size(); ++k) {
+    PlotSeries d{"wall at " + num(walls[k], 0) + " m", sweeps[k].distances, {}, PlotSeries::Style::Points};
+    for (double e : sweeps[k].commandError) d.y.push_back(e * 1000);
+    vsDistance.series.push_back(std::move(d));
+  }
+  PlotSpec angle{"Laser: torso angle error against the commanded rotation", "time since the sweep started [s]",
+                 "angle error [deg]", {}, 960, 400, {}, {}};
+  PlotSeries fitted{"linear fit from " + num(jitter, 1) + " s", {}, {}, PlotSeries::Style::Line};
+  for (double x : t) {
+    fitted.x.push_back(x);
+    fitted.y.push_back(angleFit.intercept + angleFit.slope * x);
+  }
+  angle.series = {{"torso (waist) angle - commanded", paper.times, paper.angleError, PlotSeries::Style::Line}, fitted};
   r.plots.push_back({"laser_error_time", vsTime});
   r.plots.push_back({"laser_error_distance", vsDistance});
+  r.plots.push_back({"laser_angle_error", angle});
+  const auto verdict = [](bool pass) { return std::string(pass ? "meets" : "misses"); };
   r.discussion =
       "Against the scanner's true pose the ranges are exact (largest error " + num(worstTrue * 1e9, 3) +
-      " nm): each beam is intersected with the wall analytically at the current state, so nothing "
-      "accumulates. The paper's shape appears when the ranges are compared with the pose the commanded "
-      "rotation implies, as an experimenter outside the simulator would: the torso's motor tracks the "
-      "commanded rate with a small constant error (" + num(drift * 1000, 2) + " mdeg/s here), the angle "
-      "error it integrates grows linearly with time, and a heading error turns into a range error "
-      "proportional to the distance to the wall (d tan(phi) dphi for a beam meeting the wall at angle phi).";
+      " nm over the three walls): each beam is intersected with the wall analytically at the current state, so "
+      "nothing accumulates; this is a property of our ray casting, not something the paper claimed. The paper's "
+      "claims are about the error an experimenter outside the simulator sees, against the pose the commanded "
+      "rotation implies. There the torso's angle error grows with time at " + num(angleFit.slope * 1000, 2) +
+      " mdeg/s (the motor tracks the commanded rate with a small constant error, which integrates, as the "
+      "paper's integrator error did), with a jitter of about a thousandth of a degree riding on it; a line "
+      "explains R^2 = " + num(angleFit.r2, 3) + " of it, which " + verdict(r.metrics[1].pass) +
+      " the criterion stated before the run (R^2 >= 0.95). The range error it causes is proportional to the "
+      "distance: per metre of range the 3 m and 9 m walls agree within " + num(proportional * 100, 3) +
+      " %, since a heading error dphi moves a beam meeting the wall at angle phi by d tan(phi) dphi. The range "
+      "error itself runs from " + num(paper.commandError.empty() ? 0 : paper.commandError.front() * 1000, 1) +
+      " mm to " + num(paper.commandError.empty() ? 0 : paper.commandError.back() * 1000, 1) +
+      " mm over the sweep, through zero as tan(phi) changes sign at the wall's normal; a line explains R^2 = " +
+      num(rangeFit.r2, 3) + " of it, which " + verdict(r.metrics[2].pass) +
+      " the criterion (R^2 >= 0.9). So the twin shows the paper's mechanism (a linearly growing angle error, "
+      "a range error proportional to distance) but not its clean linear growth of the range error in time; the "
+      "paper gives neither its sweep's angles nor its plot's axes, so we cannot tell whether its error was "
+      "measured on one side of the normal only.";
   return r;
 }
 
 // 3. Pick and place: drive to a pole across two cubes, lift it, carry it to
-// a second pair and lay it down; the wheel forces on the way.
+// a second pair and lay it down; the wheel forces on the way. The pole's
+// effect on the axles is measured in one pose: the same sequence run again
+// without the pole gives the robot's own loads in every pose.
+namespace {
+
+struct PickPlaceRun {
+  std::vector<double> t, fl, fr, rl, rr, poleZ;
+  Pose poleEnd;
+  double seconds = 0;
+  // Mean axle loads (front pair, rear pair) over a time window.
+  std::pair<double, double> axles(double from, double to) const {
+    std::vector<double> front, rear;
+    for (size_t i = 0; i < t.size(); ++i)
+      if (t[i] >= from && t[i] < to) {
+        front.push_back(fl[i] + fr[i]);
+        rear.push_back(rl[i] + rr[i]);
+      }
+    return {mean(front), mean(rear)};
+  }
+};
+
+PickPlaceRun runPickPlace(const WorldModel& model, const SimParams& params, const std::vector<TimedCommand>& seq,
+                          int pole, double end, const std::string& experiment) {
+  auto w = makeWorld(model, params);
+  PickPlaceRun run;
+  Runner runner(*w);
+  runner.schedule(seq);
+  const int64_t sampleSteps = std::llround(0.01 / w->params().step);
+  while (w->time() < end - 1e-9 && w->health().healthy()) {
+    runner.advanceBy(sampleSteps);
+    const std::array<double, 4> f = wheelNormals(*w);
+    run.t.push_back(w->time());
+    run.fl.push_back(f[0]), run.fr.push_back(f[1]), run.rl.push_back(f[2]), run.rr.push_back(f[3]);
+    run.poleZ.push_back(pole >= 0 ? w->objectPose(pole).p.z : 0);
+  }
+  requireHealthy(*w, experiment);
+  if (pole >= 0) run.poleEnd = w->objectPose(pole);
+  run.seconds = w->time();
+  return run;
+}
+
+}  // namespace
+
 ExperimentResult pickAndPlace(const ValidationOptions& o) {
   ExperimentResult r;
   r.number = 3;
@@ -291,73 +439,61 @@ ExperimentResult pickAndPlace(const ValidationOptions& o) {
   if (pole < 0) throw std::runtime_error("pick_place.world.xml has no dynamic object (the pole)");
   const double poleWeight = model.objects[static_cast<size_t>(pole)].mass * 9.81;
   const double end = seq->back().time + 4;
+  // The windows terrains/pick_place.seq names: standing in the stance pose
+  // before anything moves, and standing still holding the pole up.
+  const double standFrom = 1, standTo = 2, holdFrom = 11, holdTo = 12.5;
   r.conditions = "terrains/pick_place.world.xml and terrains/pick_place.seq (" + std::to_string(seq->size()) +
                  " commands, " + num(end, 0) + " s); pole " + num(poleWeight / 9.81, 1) +
-                 " kg; wheel forces from the 100 Hz wheel_force sensors";
-  auto w = makeWorld(model, o.params);
-  const double z0 = w->objectPose(pole).p.z;
-  std::vector<double> t, fl, fr, rl, rr, poleZ;
-  std::vector<std::array<double, 4>> before, holding;
-  double firstGrip = -1;
-  Runner runner(*w);
-  runner.schedule(*seq);
-  runner.setSubmitHook([&](const ScheduledCommand& c, const std::string&) {
-    if (firstGrip < 0)
-      if (const auto* target = std::get_if<JointTargetCmd>(&c.command); target && target->joint.rfind("finger", 0) == 0)
-        firstGrip = w->time();
-  });
-  const int64_t sampleSteps = std::llround(0.01 / w->params().step);
-  while (w->time() < end - 1e-9 && w->health().healthy()) {
-    runner.advanceBy(sampleSteps);
-    const std::array<double, 4> f = wheelNormals(*w);
-    const Pose pp = w->objectPose(pole);
-    t.push_back(w->time());
-    fl.push_back(f[0]), fr.push_back(f[1]), rl.push_back(f[2]), rr.push_back(f[3]);
-    poleZ.push_back(pp.p.z);
-    const double speed = norm(w->linkLinearVelocity(0, 0));
-    if (firstGrip < 0 && w->time() > 1.5 && speed < 0.01) before.push_back(f);
-    if (pp.p.z > z0 + 0.05 && speed < 0.01) holding.push_back(f);
-  }
-  requireHealthy(*w, r.title);
-  r.simSeconds = w->time();
-  auto avg = [](const std::vector<std::array<double, 4>>& v, int i) {
-    double s = 0;
-    for (const auto& f : v) s += f[static_cast<size_t>(i)];
-    return v.empty() ? 0.0 : s / static_cast<double>(v.size());
-  };
-  const double frontBefore = avg(before, 0) + avg(before, 1), rearBefore = avg(before, 2) + avg(before, 3);
-  const double frontHold = avg(holding, 0) + avg(holding, 1), rearHold = avg(holding, 2) + avg(holding, 3);
-  const Pose final = w->objectPose(pole);
-  const double finalSpeed = norm(w->linkLinearVelocity(0, 0));
-  (void)finalSpeed;
+                 " kg; wheel forces from the 100 Hz wheel_force sensors, averaged over " + num(standFrom, 0) + "-" +
+                 num(standTo, 0) + " s (standing) and " + num(holdFrom, 1) + "-" + num(holdTo, 1) +
+                 " s (holding the pole up, standing still); control run: the same sequence with the pole removed";
+  const PickPlaceRun with = runPickPlace(model, o.params, *seq, pole, end, r.title);
+  WorldModel bare = model;
+  bare.objects.erase(bare.objects.begin() + pole);
+  const PickPlaceRun without = runPickPlace(bare, o.params, *seq, -1, end, r.title);
+  r.simSeconds = with.seconds + without.seconds;
+  const double z0 = model.objects[static_cast<size_t>(pole)].pose.p.z;
+  const auto [frontStand, rearStand] = with.axles(standFrom, standTo);
+  const auto [frontHold, rearHold] = with.axles(holdFrom, holdTo);
+  const auto [frontBare, rearBare] = without.axles(holdFrom, holdTo);
+  const double dFront = frontHold - frontBare, dRear = rearHold - rearBare;
+  // Criteria, stated before the run.
   r.metrics.push_back({"front share of the wheel load, standing", "front clearly heavier",
-                       100 * frontBefore / (frontBefore + rearBefore), "%", "> 52 %",
-                       frontBefore / (frontBefore + rearBefore) > 0.52});
-  r.metrics.push_back({"front axle load change while holding the pole, share of its weight",
-                       "most of the pole's weight", 100 * (frontHold - frontBefore) / poleWeight, "%", "> 50 %",
-                       !holding.empty() && (frontHold - frontBefore) > 0.5 * poleWeight});
-  r.metrics.push_back({"rear axle load change while holding the pole", "falls slightly", rearHold - rearBefore, "N",
-                       "< 0", !holding.empty() && rearHold < rearBefore});
+                       100 * frontStand / (frontStand + rearStand), "%", "> 52 %",
+                       frontStand / (frontStand + rearStand) > 0.52});
+  r.metrics.push_back({"front axle load from the pole (same pose with and without it), share of its weight",
+                       "most of the pole's weight", 100 * dFront / poleWeight, "%", "> 50 %", dFront > 0.5 * poleWeight});
+  r.metrics.push_back({"rear axle load from the pole (same pose with and without it)", "falls slightly", dRear, "N",
+                       "< 0", dRear < 0});
+  r.metrics.push_back({"both axles together from the pole, share of its weight (statics: 100 %)", "",
+                       100 * (dFront + dRear) / poleWeight, "%", "within 10 % of 100 %",
+                       std::abs((dFront + dRear) / poleWeight - 1) <= 0.1});
   r.metrics.push_back({"pole height after release, against its start on the first cubes", "stays on the cubes",
-                       (final.p.z - z0) * 1000, "mm", "within 20 mm (cubes of equal height)",
-                       std::abs(final.p.z - z0) < 0.02});
+                       (with.poleEnd.p.z - z0) * 1000, "mm", "within 20 mm (cubes of equal height)",
+                       std::abs(with.poleEnd.p.z - z0) < 0.02});
+  r.metrics.push_back({"for the record: front axle load change from standing to holding (the poses differ)", "",
+                       frontHold - frontStand, "N", "", false, false});
   PlotSpec forces{"Pick and place: wheel normal forces (0.25 s moving average)", "time [s]", "normal force [N]", {},
                   960, 540, {}, {}};
-  forces.series = {{"front left", t, smooth(fl, 25), PlotSeries::Style::Line},
-                   {"front right", t, smooth(fr, 25), PlotSeries::Style::Line},
-                   {"rear left", t, smooth(rl, 25), PlotSeries::Style::Line},
-                   {"rear right", t, smooth(rr, 25), PlotSeries::Style::Line}};
+  forces.series = {{"front left", with.t, smooth(with.fl, 25), PlotSeries::Style::Line},
+                   {"front right", with.t, smooth(with.fr, 25), PlotSeries::Style::Line},
+                   {"rear left", with.t, smooth(with.rl, 25), PlotSeries::Style::Line},
+                   {"rear right", with.t, smooth(with.rr, 25), PlotSeries::Style::Line}};
   PlotSpec lift{"Pick and place: pole height", "time [s]", "pole centre height [m]", {}, 960, 400, {}, {}};
-  lift.series = {{"pole", t, poleZ, PlotSeries::Style::Line}};
+  lift.series = {{"pole", with.t, with.poleZ, PlotSeries::Style::Line}};
   r.plots.push_back({"pick_place_wheel_forces", forces});
   r.plots.push_back({"pick_place_pole_height", lift});
-  r.discussion = "Standing, the front axle carries " + num(frontBefore, 0) + " N and the rear " + num(rearBefore, 0) +
+  r.discussion = "Standing, the front axle carries " + num(frontStand, 0) + " N and the rear " + num(rearStand, 0) +
                  " N: the torso and arms sit on the front half, the engine and batteries at the rear only partly "
-                 "balance them. Holding the " + num(poleWeight, 0) + " N pole ahead of the front axle adds " +
-                 num(frontHold - frontBefore, 0) + " N to the front and changes the rear by " +
-                 num(rearHold - rearBefore, 0) + " N: the pole's moment about the front axle lifts weight off "
-                 "the rear, as the paper observed. (Our readings include the legs' and wheels' weight, about 200 N "
-                 "per axle pair, which the real robot's sensors did not measure.)";
+                 "balance them. The pole's own effect is measured in one pose, holding it up and standing still, "
+                 "against the same moment of the same sequence run without the pole (the robot's loads differ "
+                 "between its poses by as much as the pole's effect, so standing-before against holding would mix "
+                 "the two: " + num(frontHold - frontStand, 0) + " N at the front). The " + num(poleWeight, 0) +
+                 " N pole adds " + num(dFront, 0) + " N to the front and changes the rear by " + num(dRear, 0) +
+                 " N, together " + num(100 * (dFront + dRear) / poleWeight, 1) + " % of its weight, as statics "
+                 "requires: held ahead of the front axle, its moment lifts weight off the rear, as the paper "
+                 "observed. (Our readings include the legs' and wheels' weight, about 200 N per axle pair, which "
+                 "the real robot's sensors did not measure.)";
   return r;
 }
 
@@ -419,95 +555,216 @@ ExperimentResult slipperySurface(const ValidationOptions& o) {
   return r;
 }
 
-// 5. The test track: speed dips and wheel-force spikes at the bumps.
-ExperimentResult testTrack(const ValidationOptions& o) {
-  ExperimentResult r;
-  r.number = 5;
-  r.title = "Test track";
-  const WorldModel model = loadModel(o, "terrains/test_track.world.xml");
-  const double speed = 0.8;
-  r.conditions = "terrains/test_track.world.xml (profile terrains/test_track.csv, packed snow mu 0.3); drive " +
-                 num(speed, 1) + " m/s straight until the front axle reaches the end of the bumps";
-  auto w = makeWorld(model, o.params);
-  // Bumps: local maxima above 8 cm of the track's middle row.
-  const HeightGrid& grid = *w->terrainGrid();
-  const double x0 = model.terrain.pose.p.x - grid.width / 2;
-  std::vector<double> peaks;
-  const int row = grid.rows / 2;
+// 5. The test track: the robot slows on each bump's climb and speeds up on
+// its descent, and the front axle unloads on the climb (nose up); the same
+// tests at places without bumps must fail.
+namespace {
+
+// A bump of the track's profile, from the terrain alone: foot, crest and
+// end along x [m].
+struct Bump {
+  double foot, crest, end;
+};
+
+// Bumps: crests (local maxima above 8 cm); each bump runs from where the
+// profile last rose 2 cm above the lowest point since the previous crest to
+// where it falls back within 2 cm of the lowest point before the next one.
+std::vector<Bump> findBumps(const HeightGrid& grid, int row, double x0) {
+  std::vector<int> crests;
   for (int i = 1; i + 1 < grid.columns; ++i) {
     const double h = grid.at(i, row);
-    if (h > 0.08 && h >= grid.at(i - 1, row) && h > grid.at(i + 1, row)) peaks.push_back(x0 + i * grid.spacingX());
+    if (h > 0.08 && h >= grid.at(i - 1, row) && h > grid.at(i + 1, row)) crests.push_back(i);
   }
-  const double lastPeak = peaks.empty() ? 0 : peaks.back();
-  w->submit(DriveCmd{speed, 0});
+  const auto x = [&](int i) { return x0 + i * grid.spacingX(); };
+  std::vector<Bump> bumps;
+  for (size_t k = 0; k < crests.size(); ++k) {
+    const int c = crests[k];
+    const int before = k == 0 ? 0 : crests[k - 1], after = k + 1 < crests.size() ? crests[k + 1] : grid.columns - 1;
+    double low = 1e9;
+    for (int i = before; i <= c; ++i) low = std::min(low, grid.at(i, row));
+    int foot = c;
+    while (foot > before && grid.at(foot - 1, row) > low + 0.02) --foot;
+    low = 1e9;
+    for (int i = c; i <= after; ++i) low = std::min(low, grid.at(i, row));
+    int end = c;
+    while (end < after && grid.at(end + 1, row) > low + 0.02) ++end;
+    bumps.push_back({x(foot), x(c), x(end)});
+  }
+  return bumps;
+}
+
+// Mean of `v` over the samples whose position is in [a, b).
+double meanOver(const std::vector<double>& at, const std::vector<double>& v, double a, double b) {
+  std::vector<double> in;
+  for (size_t i = 0; i < at.size(); ++i)
+    if (at[i] >= a && at[i] < b) in.push_back(v[i]);
+  return in.empty() ? std::numeric_limits<double>::quiet_NaN() : mean(in);
+}
+
+struct TrackRun {
   std::vector<double> axle, v, front, rear;
+  double seconds = 0;
+};
+
+// Drives straight at `speed` until the front axle is `until` metres along x,
+// sampling the hinge speed and the axle loads every 20 ms.
+TrackRun driveStraight(const WorldModel& model, const SimParams& params, double speed, double until,
+                       const std::string& experiment) {
+  auto w = makeWorld(model, params);
+  w->submit(DriveCmd{speed, 0});
+  TrackRun run;
   Vec3 previous = hingePoint(*w);
   const RobotModel& robot = w->robotModel(0);
   auto frontAxleX = [&] {
     const DriveSpec& d = *robot.drive;
     return (w->linkPose(0, robot.joints[d.wheels[0]].child).p.x + w->linkPose(0, robot.joints[d.wheels[1]].child).p.x) / 2;
   };
-  while (frontAxleX() < lastPeak + 3 && w->time() < 80 && w->health().healthy()) {
+  while (frontAxleX() < until && w->time() < 80 && w->health().healthy()) {
     stepFor(*w, 0.02);
     const Vec3 p = hingePoint(*w);
     const std::array<double, 4> f = wheelNormals(*w);
-    axle.push_back(frontAxleX());
-    v.push_back(norm(p - previous) / 0.02);
-    front.push_back(f[0] + f[1]);
-    rear.push_back(f[2] + f[3]);
+    run.axle.push_back(frontAxleX());
+    run.v.push_back(norm(p - previous) / 0.02);
+    run.front.push_back(f[0] + f[1]);
+    run.rear.push_back(f[2] + f[3]);
     previous = p;
   }
-  requireHealthy(*w, r.title);
-  r.simSeconds = w->time();
-  // Baseline: everywhere between the bumps (undulation only), once moving.
-  std::vector<double> flatV, flatF;
-  for (size_t i = 50; i < axle.size(); ++i) {
-    bool nearBump = false;
-    for (double peak : peaks) nearBump = nearBump || std::abs(axle[i] - peak) < 2.0;
-    if (!nearBump) {
-      flatV.push_back(v[i]);
-      flatF.push_back(front[i]);
-    }
+  requireHealthy(*w, experiment);
+  run.seconds = w->time();
+  return run;
+}
+
+}  // namespace
+
+ExperimentResult testTrack(const ValidationOptions& o) {
+  ExperimentResult r;
+  r.number = 5;
+  r.title = "Test track";
+  const WorldModel model = loadModel(o, "terrains/test_track.world.xml");
+  const WorldModel flatModel = loadModel(o, "terrains/flat.world.xml");
+  const double speed = 0.8, speedUp = 1.10, unload = 0.95, settled = 1.5;
+  const HeightGrid& grid = model.terrain.grid;
+  const double x0 = model.terrain.pose.p.x - grid.width / 2;
+  const int row = grid.rows / 2;
+  const std::vector<Bump> bumps = findBumps(grid, row, x0);
+  if (bumps.empty()) throw std::runtime_error("test_track.world.xml: no bump found in the profile");
+  const double until = bumps.back().end + 1;
+  r.conditions = "terrains/test_track.world.xml (profile terrains/test_track.csv, packed snow mu 0.3); drive " +
+                 num(speed, 1) + " m/s straight until the front axle is 1 m past the last bump. Bumps from the "
+                 "profile alone: crests above 8 cm, each from its foot (2 cm above the lowest point before it) to "
+                 "its end. Control runs: the same drive on terrains/flat.world.xml, and the flat stretches of the "
+                 "track between bumps (the robot at speed, front axle past x = " + num(settled, 1) + " m)";
+  const TrackRun track = driveStraight(model, o.params, speed, until, r.title);
+  const TrackRun flat = driveStraight(flatModel, o.params, speed, until, r.title);
+  r.simSeconds = track.seconds + flat.seconds;
+
+  // Flat stretches between bumps (and after the last), at least 0.8 m long.
+  std::vector<std::pair<double, double>> flats;
+  double from = settled;
+  for (const Bump& b : bumps) {
+    if (b.foot - from >= 0.8) flats.emplace_back(from, b.foot);
+    from = std::max(from, b.end);
   }
-  const double vFlat = mean(flatV), fFlat = mean(flatF);
-  int aligned = 0;
-  for (size_t b = 0; b < peaks.size(); ++b) {
-    double vMin = 1e9, fMax = 0, atV = 0, atF = 0;
-    for (size_t i = 0; i < axle.size(); ++i)
-      if (std::abs(axle[i] - peaks[b]) < 1.5) {
-        if (v[i] < vMin) vMin = v[i], atV = axle[i];
-        if (front[i] > fMax) fMax = front[i], atF = axle[i];
-      }
-    const double dip = 100 * (vFlat - vMin) / vFlat, spike = 100 * (fMax - fFlat) / fFlat;
-    const bool ok = dip > 1 && spike > 5;
-    aligned += ok;
-    r.metrics.push_back({"bump " + std::to_string(b + 1) + " (peak at " + num(peaks[b], 2) +
-                             " m): speed dip at " + num(atV, 2) + " m, front force spike at " + num(atF, 2) + " m",
-                         "slowed at the same places", dip, "% dip, " + num(spike, 0) + " % spike",
-                         "dip > 1 % and spike > 5 % within 1.5 m of the peak", ok});
+  if (until - from >= 0.8) flats.emplace_back(from, until);
+  std::vector<double> flatLoads;
+  for (const auto& [a, b] : flats) flatLoads.push_back(meanOver(track.axle, track.front, a, b));
+  const double flatLoad = mean(flatLoads);
+
+  // Criteria, stated before the run: on each bump the hinge's mean speed
+  // on the descent is >= 1.10 x that on the climb, and the front pair's
+  // mean load on the climb is <= 0.95 x its mean on the flat stretches.
+  int both = 0;
+  double flatWorstSpeed = 0, flatWorstLoad = 1e9;
+  for (size_t k = 0; k < bumps.size(); ++k) {
+    const Bump& b = bumps[k];
+    const double climb = meanOver(track.axle, track.v, b.foot, b.crest);
+    const double descent = meanOver(track.axle, track.v, b.crest, b.end);
+    const double load = meanOver(track.axle, track.front, b.foot, b.crest) / flatLoad;
+    const bool fast = descent / climb >= speedUp, light = load <= unload;
+    both += fast && light;
+    const std::string where = "bump " + std::to_string(k + 1) + " (" + num(b.foot, 2) + "-" + num(b.crest, 2) + "-" +
+                              num(b.end, 2) + " m)";
+    r.metrics.push_back({where + ": speed on the descent / on the climb", "slowed at the same places",
+                         descent / climb, "", ">= " + num(speedUp, 2), fast});
+    r.metrics.push_back({where + ": front load on the climb / on the flat stretches", "force changes at the bumps",
+                         load, "", "<= " + num(unload, 2), light});
+    // Control: the same places on flat ground.
+    flatWorstSpeed = std::max(flatWorstSpeed, meanOver(flat.axle, flat.v, b.crest, b.end) /
+                                                  meanOver(flat.axle, flat.v, b.foot, b.crest));
+    const double flatGroundLoad = meanOver(flat.axle, flat.front, settled, until);
+    flatWorstLoad = std::min(flatWorstLoad, meanOver(flat.axle, flat.front, b.foot, b.crest) / flatGroundLoad);
   }
+  // Control: the track's flat stretches, the second half against the first
+  // (speed) and each against the others (load).
+  double stretchWorstSpeed = 0, stretchWorstLoad = 1e9;
+  for (size_t k = 0; k < flats.size(); ++k) {
+    const auto [a, b] = flats[k];
+    const double mid = (a + b) / 2;
+    stretchWorstSpeed = std::max(stretchWorstSpeed, meanOver(track.axle, track.v, mid, b) /
+                                                        meanOver(track.axle, track.v, a, mid));
+    std::vector<double> others;
+    for (size_t m = 0; m < flats.size(); ++m)
+      if (m != k) others.push_back(flatLoads[m]);
+    if (!others.empty()) stretchWorstLoad = std::min(stretchWorstLoad, flatLoads[k] / mean(others));
+  }
+  r.metrics.push_back({"control: the same places on flat ground, largest speed ratio (must fail the test)", "",
+                       flatWorstSpeed, "", "< " + num(speedUp, 2), flatWorstSpeed < speedUp});
+  r.metrics.push_back({"control: the same places on flat ground, smallest load ratio (must fail the test)", "",
+                       flatWorstLoad, "", "> " + num(unload, 2), flatWorstLoad > unload});
+  r.metrics.push_back({"control: the track's " + std::to_string(flats.size()) +
+                           " flat stretches, second half / first half speed, largest (must fail the test)",
+                       "", stretchWorstSpeed, "", "< " + num(speedUp, 2), stretchWorstSpeed < speedUp});
+  r.metrics.push_back({"control: the flat stretches' front load against the other stretches', smallest (must fail "
+                       "the test)",
+                       "", stretchWorstLoad, "", "> " + num(unload, 2), stretchWorstLoad > unload});
+  // Force spikes, for the record: the largest front load over each bump.
+  for (size_t k = 0; k < bumps.size(); ++k) {
+    double peak = 0;
+    for (size_t i = 0; i < track.axle.size(); ++i)
+      if (track.axle[i] >= bumps[k].foot && track.axle[i] < bumps[k].end + 1) peak = std::max(peak, track.front[i]);
+    r.metrics.push_back({"bump " + std::to_string(k + 1) + ": largest front load from its foot to 1 m past its end, "
+                         "against the flat stretches' mean",
+                         "spikes matched the real run's", 100 * (peak / flatLoad - 1), "%", "", false, false});
+  }
+
   PlotSpec speedPlot{"Test track: speed against distance", "front axle position [m]", "speed [m/s]", {}, 960, 400,
                      {}, {}};
-  speedPlot.series = {{"hinge speed", axle, v, PlotSeries::Style::Line}};
+  speedPlot.series = {{"hinge speed, test track", track.axle, track.v, PlotSeries::Style::Line},
+                      {"hinge speed, flat ground (control)", flat.axle, flat.v, PlotSeries::Style::Line}};
   PlotSpec forcePlot{"Test track: axle loads against distance (0.1 s moving average)", "front axle position [m]",
                      "normal force [N]", {}, 960, 400, {}, {}};
-  forcePlot.series = {{"front pair", axle, smooth(front, 5), PlotSeries::Style::Line},
-                      {"rear pair", axle, smooth(rear, 5), PlotSeries::Style::Line}};
-  PlotSpec profile{"Test track: profile", "distance [m]", "height [m]", {}, 960, 300, {}, {}};
+  forcePlot.series = {{"front pair", track.axle, smooth(track.front, 5), PlotSeries::Style::Line},
+                      {"rear pair", track.axle, smooth(track.rear, 5), PlotSeries::Style::Line}};
+  PlotSpec profile{"Test track: profile and the bumps found in it", "distance [m]", "height [m]", {}, 960, 300, {}, {}};
   PlotSeries h{"track middle row", {}, {}, PlotSeries::Style::Line};
   for (int i = 0; i < grid.columns; ++i) {
     h.x.push_back(x0 + i * grid.spacingX());
     h.y.push_back(grid.at(i, row));
   }
-  profile.series = {h};
+  PlotSeries marks{"foot, crest, end", {}, {}, PlotSeries::Style::Points};
+  for (const Bump& b : bumps)
+    for (double x : {b.foot, b.crest, b.end}) {
+      marks.x.push_back(x);
+      marks.y.push_back(grid.at(static_cast<int>(std::lround((x - x0) / grid.spacingX())), row));
+    }
+  profile.series = {h, marks};
   r.plots.push_back({"track_speed", speedPlot});
   r.plots.push_back({"track_forces", forcePlot});
   r.plots.push_back({"track_profile", profile});
-  r.discussion = "Between the bumps the robot rolls at " + num(vFlat, 3) + " m/s with " + num(fFlat, 0) +
-                 " N on the front pair. At each bump the front wheels climb first: the load on them rises as the "
-                 "track curves upwards under them and the hinge slows while the wheels turn at a constant "
-                 "rate along the longer, tilted path; " + std::to_string(aligned) + " of " +
-                 std::to_string(peaks.size()) + " bumps show both within 1.5 m of their peak.";
+  r.discussion =
+      "On the flat stretches the front pair carries " + num(flatLoad, 0) + " N on average. The criteria "
+      "follow from the slope, stated before the run: climbing, the wheels turning at a constant rate lift the "
+      "robot and gravity holds it back, so the hinge runs slower than on the descent (ratio >= 1.10), and the "
+      "nose-up pitch moves load from the front axle to the rear (front load on the climb <= 0.95 x the flat "
+      "stretches'). " + std::to_string(both) + " of " + std::to_string(bumps.size()) + " bumps show both. The "
+      "same tests where there are no bumps fail, as they must: on flat ground at the bumps' places the speed "
+      "ratio is at most " + num(flatWorstSpeed, 3) + " and the load ratio at least " + num(flatWorstLoad, 3) +
+      "; on the track's flat stretches, second half against first, at most " + num(stretchWorstSpeed, 3) +
+      ", and a stretch's load against the others' at least " + num(stretchWorstLoad, 3) + ". (The stretches "
+      "between bumps are 1.8-2 m, shorter than the robot is long, so the speed still swings there after each "
+      "bump: an earlier criterion, a dip and a spike anywhere within 1.5 m of a crest, also passed at 141 of "
+      "171 arbitrary places.) The front-load peaks are listed for the record: the paper compared them with the "
+      "real robot's readings, which we do not have.";
   return r;
 }
 
@@ -555,7 +812,7 @@ std::string validationReport(const std::vector<ExperimentResult>& results, const
     for (const Metric& m : r.metrics)
       md << "| " << r.number << " | " << r.title << " | " << cell(m.quantity) << " | " << cell(m.paper) << " | "
          << num(m.ours, std::abs(m.ours) < 0.1 ? 4 : 2) << " | " << cell(m.unit) << " | " << cell(m.target) << " | "
-         << (m.pass ? "pass" : "**fail**") << " |\n";
+         << (!m.judged ? "info" : m.pass ? "pass" : "**fail**") << " |\n";
   for (const ExperimentResult& r : results) {
     md << "\n## " << r.number << ". " << r.title << " — " << (r.pass() ? "pass" : "fail") << "\n\n"
        << "Conditions: " << r.conditions << ". Simulated " << num(r.simSeconds, 0) << " s in "

@@ -13,14 +13,18 @@
 
 namespace sp {
 
-/// One figure of an experiment: ours beside the paper's.
+/// One figure of an experiment: ours beside the paper's. A judged metric
+/// has a target stated before the run that the figure can miss; an
+/// unjudged one (judged = false) is reported for context and counts for
+/// neither pass nor fail.
 struct Metric {
   std::string quantity;
   std::string paper;   ///< the paper's figure as text ("" if it gives none)
   double ours = 0;
   std::string unit;
-  std::string target;  ///< what counts as a pass, in words
-  bool pass = true;
+  std::string target;  ///< what counts as a pass, in words ("" when not judged)
+  bool pass = false;
+  bool judged = true;
 };
 
 struct ExperimentPlot {
@@ -55,6 +59,23 @@ ExperimentResult laserSweep(const ValidationOptions& options);
 ExperimentResult pickAndPlace(const ValidationOptions& options);
 ExperimentResult slipperySurface(const ValidationOptions& options);
 ExperimentResult testTrack(const ValidationOptions& options);
+
+/// A least-squares line y = intercept + slope x and its coefficient of
+/// determination (1 = every point on the line; 0 = no better than the mean).
+struct LinearFit {
+  double slope = 0, intercept = 0, r2 = 0;
+};
+LinearFit linearFit(const std::vector<double>& x, const std::vector<double>& y);
+
+/// Range errors sampled over time: errors[i] at range ranges[i] at times[i] (ascending).
+struct ErrorSeries {
+  std::vector<double> times, ranges, errors;
+};
+/// How far two series of range errors are from proportional to the range:
+/// over the instants both have where |error of b| >= floor, the median of
+/// |eb/db - ea/da| / |eb/db|. 0 when the error per metre of range is the
+/// same in both; infinity without such instants.
+double proportionalityMismatch(const ErrorSeries& a, const ErrorSeries& b, double floor);
 
 /// The report in Markdown: a summary table of every metric beside the
 /// paper's with pass or fail, the conditions, then a section per experiment
