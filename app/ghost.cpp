@@ -183,9 +183,11 @@ void Ghost::carryControl(const World& from, const Twin& fromTwin, World& to, con
   const RobotControlState& was = from.snapshot().robots[0];
   Snapshot s = to.snapshot();
   RobotControlState& now = s.robots[0];
-  const std::vector<ActuatorState> fresh = now.actuators;
+  const RobotControlState fresh = now;
   now = was;
-  now.actuators = fresh;
+  now.actuators = fresh.actuators;
+  now.resistance = fresh.resistance;  // per link: the two twins' links differ
+  now.resistanceShare = fresh.resistanceShare;
   for (size_t i = 0; i < b.actuators.size(); ++i) {
     const ActuatorSpec& spec = b.actuators[i];
     const auto same = std::find_if(a.actuators.begin(), a.actuators.end(),

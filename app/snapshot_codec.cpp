@@ -274,6 +274,11 @@ std::vector<uint8_t> encodeSnapshot(const Snapshot& s) {
     w.u8(static_cast<uint8_t>(rc.gait.gait));
     w.i32(rc.gait.phase);
     w.i64(rc.gait.phaseStart);
+    w.u64(rc.resistance.size());
+    for (size_t l = 0; l < rc.resistance.size(); ++l) {
+      w.f64(rc.resistance[l]);
+      w.f64(l < rc.resistanceShare.size() ? rc.resistanceShare[l] : 1.0);
+    }
   }
   w.u64(s.sensors.size());
   for (const auto& robotSensors : s.sensors) {
@@ -321,7 +326,7 @@ std::optional<Snapshot> decodeSnapshot(const std::vector<uint8_t>& data, std::st
   try {
     for (int i = 0; i < 4; ++i) r.u8();
     uint32_t version = r.u32();
-    if (version != kSnapshotCodecVersion)
+    if (version != kSnapshotCodecVersion && version != 1)
       return fail("snapshot format version " + std::to_string(version) + " is not supported (expected " +
                   std::to_string(kSnapshotCodecVersion) + ")");
     Snapshot s;
@@ -355,6 +360,14 @@ std::optional<Snapshot> decodeSnapshot(const std::vector<uint8_t>& data, std::st
       rc.gait.gait = static_cast<Gait>(g);
       rc.gait.phase = r.i32();
       rc.gait.phaseStart = r.i64();
+      if (version >= 2) {
+        rc.resistance.resize(r.count(16));
+        rc.resistanceShare.resize(rc.resistance.size());
+        for (size_t l = 0; l < rc.resistance.size(); ++l) {
+          rc.resistance[l] = r.f64();
+          rc.resistanceShare[l] = r.f64();
+        }
+      }
     }
     s.sensors.resize(r.count(8));
     for (auto& robotSensors : s.sensors) {

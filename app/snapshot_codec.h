@@ -16,7 +16,7 @@
 
 namespace sp {
 
-inline constexpr uint32_t kSnapshotCodecVersion = 1;
+inline constexpr uint32_t kSnapshotCodecVersion = 2;  // 2: motion resistance per link (1 is still read)
 
 /// Serializes a snapshot. Thread: any; pure function.
 std::vector<uint8_t> encodeSnapshot(const Snapshot& snapshot);

@@ -734,6 +734,9 @@ void readContact(const XMLElement* e, WorldModel& world, std::string_view file, 
   r.nonNegative("soft_cfm");
   c.rollingResistance = r.number("rolling_resistance", 0);
   r.nonNegative("rolling_resistance");
+  c.motionResistance = r.number("motion_resistance", 0);
+  r.within("motion_resistance", 0, 1);
+  c.motionResistanceSliding = r.boolean("motion_resistance_sliding", true);
   r.finish();
   noChildren(e, file, diag);
   if (isDefault) {

@@ -137,6 +137,13 @@ struct ContactSpec {
   double softErp = -1;    ///< < 0: the world's ERP
   double softCfm = -1;    ///< < 0: the world's CFM
   double rollingResistance = 0;  ///< [m], resisting torque = this x normal force
+  /// Motion resistance of a wheel on the surface (snow, sand): a force C x
+  /// normal force against the wheel's travel. On a robot's cylinder or
+  /// sphere it resists rolling as a torque C x N x radius; with
+  /// `motionResistanceSliding` a sliding (braced) wheel meets it too, as
+  /// friction mu + C.
+  double motionResistance = 0;
+  bool motionResistanceSliding = true;
   int line = 0;
 };
 

@@ -104,6 +104,7 @@ bool World::step() {
   for (const auto& [robot, command] : m.queue) applyCommand(command, robot);
   m.queue.clear();
   if (options_.controllers) runActuators();
+  applyMotionResistance();
   collide();
   {
     std::unique_lock<std::mutex> fallback;
@@ -122,11 +123,13 @@ bool World::step() {
   if (!m.broken) checkHealth();
   if (health_.healthy()) canonicalizeQuaternions();
   // Contact feedback is valid until the contact joints go.
+  if (health_.healthy()) updateMotionResistance();
   if (options_.sensors && health_.healthy()) {
     accumulateWheelForces();
     sampleSensors();
   }
   dJointGroupEmpty(m.contacts);
+  dJointGroupEmpty(m.resistanceJoints);
   tOdeMessages = nullptr;
   return true;
 }

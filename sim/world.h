@@ -47,6 +47,11 @@ struct RobotControlState {
   double driveYawRate = 0;
   bool gaitActive = false;
   GaitState gait;
+  /// Motion resistance (a surface's motion_resistance) per link: the
+  /// force [N] the last step's contacts set for the next, C x normal force,
+  /// and the share of it a rolling-only surface leaves (1 when sliding
+  /// wheels meet it too). State: it carries a step's forces into the next.
+  std::vector<double> resistance, resistanceShare;
   friend bool operator==(const RobotControlState&, const RobotControlState&) = default;
 };
 
@@ -241,6 +246,11 @@ class World {
   void canonicalizeQuaternions();
   void checkHealth();
   void accumulateWheelForces();
+  /// Motion resistance: the force each wheel meets this step, from the last
+  /// step's normal forces (applyMotionResistance), and those of this step
+  /// (updateMotionResistance, while the contact feedback is valid).
+  void applyMotionResistance();
+  void updateMotionResistance();
   void sampleSensors();
   void prepareRayTargets(int excludeRobot, int excludeLink) const;
   double castPrepared(Vec3 origin, Vec3 direction, double maxRange) const;

@@ -125,6 +125,7 @@ World::~World() {
   if (!m.world) return;
   ensureOdeThread();
   dJointGroupDestroy(m.contacts);
+  if (m.resistanceJoints) dJointGroupDestroy(m.resistanceJoints);
   dSpaceDestroy(m.space);  // destroys the geoms too (cleanup mode on)
   dGeomDestroy(m.ray);
   if (m.heightData) dGeomHeightfieldDataDestroy(m.heightData);
@@ -147,6 +148,7 @@ bool World::build(Diagnostics& diag) {
   m.space = dHashSpaceCreate(nullptr);
   dSpaceSetCleanup(m.space, 1);
   m.contacts = dJointGroupCreate(0);
+  m.resistanceJoints = dJointGroupCreate(0);
   m.randState = static_cast<unsigned long>(params_.seed & 0xffffffffu);
   m.random.reseed(params_.seed);
   m.ray = dCreateRay(nullptr, 1.0);
@@ -166,11 +168,14 @@ bool World::build(Diagnostics& diag) {
   m.materialCount = static_cast<int>(model_.materials.size());
   const int n = m.materialCount + 1;
   m.surfaces.resize(static_cast<size_t>(n * n));
+  m.resistances.resize(static_cast<size_t>(n * n));
   for (int a = -1; a < m.materialCount; ++a)
     for (int b = -1; b < m.materialCount; ++b) {
       const std::string& na = a < 0 ? std::string() : model_.materials[a];
       const std::string& nb = b < 0 ? std::string() : model_.materials[b];
-      m.surfaces[static_cast<size_t>((a + 1) * n + (b + 1))] = toSurface(model_.contactFor(na, nb));
+      const ContactSpec& c = model_.contactFor(na, nb);
+      m.surfaces[static_cast<size_t>((a + 1) * n + (b + 1))] = toSurface(c);
+      m.resistances[static_cast<size_t>((a + 1) * n + (b + 1))] = {c.motionResistance, c.motionResistanceSliding};
     }
 
   // Terrain.
@@ -258,6 +263,7 @@ bool World::build(Diagnostics& diag) {
         GeomInfo& info =
             m.newInfo(materialIndex(model_, g.material), static_cast<int>(r), static_cast<int>(li));
         info.wheelSensor = wheelSensorOfLink[li];
+        if (g.type == GeomType::Cylinder || g.type == GeomType::Sphere) info.rollRadius = g.radius;
         dGeomSetData(geom, &info);
         dGeomSetBody(geom, body);
         setGeomOffset(geom, Pose{-com, {}} * g.pose);
@@ -321,6 +327,16 @@ bool World::build(Diagnostics& diag) {
       rt.joints.push_back(joint);
     }
     for (const ActuatorSpec& a : robot.actuators) rt.control.actuators.push_back(initialActuatorState(a));
+    rt.control.resistance.assign(robot.links.size(), 0.0);
+    rt.control.resistanceShare.assign(robot.links.size(), 1.0);
+    rt.jointAbove.assign(robot.links.size(), -1);
+    for (size_t ji = 0; ji < robot.joints.size(); ++ji)
+      rt.jointAbove[static_cast<size_t>(robot.joints[ji].child)] = static_cast<int>(ji);
+    rt.rollRadius.assign(robot.links.size(), 0.0);
+    for (size_t li = 0; li < robot.links.size(); ++li)
+      for (const GeomSpec& g : robot.links[li].geoms)
+        if (g.type == GeomType::Cylinder || g.type == GeomType::Sphere)
+          rt.rollRadius[li] = std::max(rt.rollRadius[li], g.radius);
     rt.legs = findLegs(robot);
     if (rt.legs) {
       const LegJoints& leg = (*rt.legs)[0];

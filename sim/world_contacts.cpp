@@ -41,6 +41,7 @@ void World::collide() {
   // Feedback buffers must not move once ODE holds their addresses.
   m.contactFeedback.resize(m.candidates.size());
   m.wheelContacts.clear();
+  m.resisting.clear();
   m.deepest = 0;
   m.deepestContact = nullptr;
   for (size_t k = 0; k < m.candidates.size(); ++k) {
@@ -58,14 +59,25 @@ void World::collide() {
     }
     // ODE's contact normal points into the first geom; a wheel sensor wants
     // the force from the ground into the wheel.
+    const Vec3 n{c.geom.normal[0], c.geom.normal[1], c.geom.normal[2]};
     const GeomInfo* wheel = i1->wheelSensor >= 0 ? i1 : (i2->wheelSensor >= 0 ? i2 : nullptr);
     if (wheel && options_.sensors) {
       dJointSetFeedback(j, &m.contactFeedback[k]);
       const bool first = wheel == i1;
-      const Vec3 n{c.geom.normal[0], c.geom.normal[1], c.geom.normal[2]};
       // ODE fills f1 for the first non-null body it was attached to.
       const bool inF1 = first || dGeomGetBody(c.g1) == nullptr;
       m.wheelContacts.push_back({wheel->robot, wheel->wheelSensor, k, inF1, first ? n : -n});
+    }
+    // A robot's wheel (cylinder or sphere) on a surface with motion
+    // resistance: its normal force sets the resistance of the next step.
+    const Impl::Resistance& resist = m.resistance(i1->material, i2->material);
+    const GeomInfo* roller = i1->robot >= 0 && i1->rollRadius > 0 ? i1 : (i2->robot >= 0 && i2->rollRadius > 0 ? i2 : nullptr);
+    if (roller && resist.c > 0) {
+      dJointSetFeedback(j, &m.contactFeedback[k]);
+      const bool first = roller == i1;
+      const bool inF1 = first || dGeomGetBody(c.g1) == nullptr;
+      m.resisting.push_back({roller->robot, roller->link, k, inF1, first ? n : -n, resist.c, resist.sliding,
+                             roller->rollRadius});
     }
   }
   lastContactCount_ = static_cast<int>(m.candidates.size());

@@ -268,4 +268,59 @@ void World::runActuators() {
   }
 }
 
+
+void World::applyMotionResistance() {
+  Impl& m = *impl_;
+  const Vec3 g = model_.gravity;
+  const double gn = norm(g);
+  const Vec3 up = gn > 0 ? (-1.0 / gn) * g : Vec3{0, 0, 1};
+  for (size_t r = 0; r < m.robots.size(); ++r) {
+    Impl::Robot& rt = m.robots[r];
+    for (size_t l = 0; l < rt.bodies.size(); ++l) {
+      double force = rt.control.resistance[l];
+      const int joint = rt.jointAbove[l];
+      if (force <= 0 || joint < 0 || dJointGetType(rt.joints[static_cast<size_t>(joint)]) != dJointTypeHinge) continue;
+      // The wheel's rolling direction, horizontal: across its axle.
+      dVector3 a;
+      dJointGetHingeAxis(rt.joints[static_cast<size_t>(joint)], a);
+      Vec3 along = cross(up, Vec3{a[0], a[1], a[2]});
+      along = along - dot(along, up) * up;
+      if (norm(along) < 1e-6) continue;  // axle upright: it does not roll on the ground
+      along = (1.0 / norm(along)) * along;
+      if (rt.control.resistanceShare[l] < 1) {
+        // Rolling wheels only: the share of its travel the wheel rolls.
+        const dReal* v = dBodyGetLinearVel(rt.bodies[l]);
+        const double travel = std::abs(dot(Vec3{v[0], v[1], v[2]}, along));
+        const double rolled = std::abs(jointRate(static_cast<int>(r), joint)) * rt.rollRadius[l];
+        force *= std::clamp(rolled / std::max(travel, 1e-3), 0.0, 1.0);
+      }
+      // A motor holding the wheel's travel at zero with at most the
+      // resistance: Coulomb-like, solved with the contacts (no chatter, no
+      // smoothing speed that would set how fast a stalled robot creeps).
+      dJointID motor = dJointCreateLMotor(m.world, m.resistanceJoints);
+      dJointAttach(motor, rt.bodies[l], nullptr);
+      dJointSetLMotorNumAxes(motor, 1);
+      dJointSetLMotorAxis(motor, 0, 0, along.x, along.y, along.z);
+      dJointSetLMotorParam(motor, dParamVel, 0);
+      dJointSetLMotorParam(motor, dParamFMax, force);
+    }
+  }
+}
+
+void World::updateMotionResistance() {
+  Impl& m = *impl_;
+  for (Impl::Robot& rt : m.robots) {
+    std::fill(rt.control.resistance.begin(), rt.control.resistance.end(), 0.0);
+    std::fill(rt.control.resistanceShare.begin(), rt.control.resistanceShare.end(), 1.0);
+  }
+  for (const Impl::ResistingContact& c : m.resisting) {
+    const dJointFeedback& f = m.contactFeedback[c.feedback];
+    const dReal* force = c.wheelInF1 ? f.f1 : f.f2;
+    const double normal = std::max(0.0, dot(Vec3{force[0], force[1], force[2]}, c.normal));
+    RobotControlState& rc = m.robots[static_cast<size_t>(c.robot)].control;
+    rc.resistance[static_cast<size_t>(c.link)] += c.c * normal;
+    if (!c.sliding) rc.resistanceShare[static_cast<size_t>(c.link)] = 0;
+  }
+}
+
 }  // namespace sp

@@ -55,6 +55,7 @@ struct GeomInfo {
   int link = -1;
   int object = -1;
   int wheelSensor = -1;  // a wheel_force sensor on this geom's link
+  double rollRadius = 0;  // a robot's cylinder or sphere: the radius it rolls on (motion resistance)
 };
 
 inline bool finite(const dReal* v, int n) {
@@ -88,6 +89,8 @@ struct World::Impl {
     std::vector<dJointFeedback> jointFeedback;  // per joint (joint_force sensors read it)
     std::optional<std::array<LegJoints, 4>> legs;  // for gaits
     double legLength = 0;  // hip to wheel centre [m], for gaits
+    std::vector<int> jointAbove;     // per link: the joint whose child it is, -1 for the base
+    std::vector<double> rollRadius;  // per link: its largest cylinder or sphere radius (0: none)
   };
   // A contact joint whose force a wheel_force sensor sums.
   struct WheelContact {
@@ -100,6 +103,7 @@ struct World::Impl {
   dWorldID world = nullptr;
   dSpaceID space = nullptr;
   dJointGroupID contacts = nullptr;
+  dJointGroupID resistanceJoints = nullptr;  // this step's motion resistance motors, emptied with the contacts
   dThreadingImplementationID threading = nullptr;
   unsigned long randState = 0;
   bool perThreadRandom = true;
@@ -138,6 +142,11 @@ struct World::Impl {
   int64_t penetrationCheckFrom = 0;  // step; later after a terrain edit
 
   std::vector<dSurfaceParameters> surfaces;  // (materials+1)^2 table
+  struct Resistance {
+    double c = 0;         // motion resistance coefficient
+    bool sliding = true;  // a sliding wheel meets it too
+  };
+  std::vector<Resistance> resistances;  // the same table: each pair's motion resistance
   int materialCount = 0;
 
   struct Candidate {
@@ -149,6 +158,17 @@ struct World::Impl {
   std::vector<dContactGeom> scratch;
   std::vector<dJointFeedback> contactFeedback;
   std::vector<WheelContact> wheelContacts;
+  // A contact of a robot's wheel with a surface that has motion resistance.
+  struct ResistingContact {
+    int robot, link;
+    size_t feedback;  // index into contactFeedback
+    bool wheelInF1;
+    Vec3 normal;      // from the ground into the wheel
+    double c;         // the surface's motion resistance coefficient
+    bool sliding;     // a sliding wheel meets it too
+    double radius;    // the wheel's rolling radius
+  };
+  std::vector<ResistingContact> resisting;
   // Deepest contact of the last collision, for the health check.
   double deepest = 0;
   const Candidate* deepestContact = nullptr;
@@ -157,6 +177,9 @@ struct World::Impl {
 
   const dSurfaceParameters& surface(int a, int b) const {
     return surfaces[static_cast<size_t>((a + 1) * (materialCount + 1) + (b + 1))];
+  }
+  const Resistance& resistance(int a, int b) const {
+    return resistances[static_cast<size_t>((a + 1) * (materialCount + 1) + (b + 1))];
   }
 
   GeomInfo& newInfo(int material, int robot, int link, int object = -1) {

@@ -3,6 +3,7 @@
 
 #include "sim/world_impl.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "sim/hash.h"
@@ -78,6 +79,13 @@ std::string World::restore(const Snapshot& s) {
   }
   for (size_t r = 0; r < m.robots.size(); ++r) {
     m.robots[r].control = s.robots[r];
+    // Snapshots from before motion resistance (or of a welded twin) carry
+    // none: the next step's contacts set it.
+    const size_t links = m.robots[r].bodies.size();
+    if (m.robots[r].control.resistance.size() != links || m.robots[r].control.resistanceShare.size() != links) {
+      m.robots[r].control.resistance.assign(links, 0.0);
+      m.robots[r].control.resistanceShare.assign(links, 1.0);
+    }
     m.robots[r].sensors = s.sensors[r];
     if (scale != 1.0)
       for (SensorState& st : m.robots[r].sensors)
@@ -163,6 +171,13 @@ uint64_t World::stateHash() const {
     h.value(rt.control.driveYawRate);
     h.value(rt.control.gaitActive);
     h.value(rt.control.gait);
+    // Motion resistance only where a surface has it: other runs keep the
+    // hashes they always had.
+    if (std::any_of(rt.control.resistance.begin(), rt.control.resistance.end(), [](double f) { return f != 0; }))
+      for (size_t l = 0; l < rt.control.resistance.size(); ++l) {
+        h.value(rt.control.resistance[l]);
+        h.value(rt.control.resistanceShare[l]);
+      }
     for (const SensorState& st : rt.sensors) {
       h.value(st.nextStep);
       h.value(st.forceSum);

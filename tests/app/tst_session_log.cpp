@@ -187,10 +187,10 @@ class TestSessionLog : public QObject {
     std::vector<uint8_t> cut(bytes.begin(), bytes.end() - 3);
     QVERIFY(!decodeSnapshot(cut, &error));
     QCOMPARE(error, std::string("truncated snapshot data"));
-    std::vector<uint8_t> v2 = bytes;
-    v2[4] = 2;
-    QVERIFY(!decodeSnapshot(v2, &error));
-    QCOMPARE(error, std::string("snapshot format version 2 is not supported (expected 1)"));
+    std::vector<uint8_t> v3 = bytes;
+    v3[4] = 3;
+    QVERIFY(!decodeSnapshot(v3, &error));
+    QCOMPARE(error, std::string("snapshot format version 3 is not supported (expected 2)"));
   }
 
   // The reader refuses another format version, a database without meta and

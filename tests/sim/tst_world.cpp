@@ -3,7 +3,12 @@
 
 #include <QtTest>
 
+#include <algorithm>
 #include <cmath>
+
+#include "sim/kinematics.h"
+#include "sim/model_loader.h"
+#include "sim/readout.h"
 
 #include "tests/sim/world_fixture.h"
 
@@ -16,6 +21,17 @@ namespace {
 const char* kPlaneWorld = R"(<world name="w">
   <terrain type="plane"/>
   %1
+</world>)";
+
+// WorkPartner on a plane of snow: %1 mu, %2 motion resistance, %3 whether
+// sliding wheels meet it, %4 the robot file.
+const char* kSnowWorld = R"(<world name="w">
+  <material name="snow"/>
+  <material name="rubber"/>
+  <contact default="true" mu="%1"/>
+  <contact a="rubber" b="snow" mu="%1" motion_resistance="%2" motion_resistance_sliding="%3"/>
+  <terrain type="plane" material="snow"/>
+  <robot name="wp" file="%4" xyz="0 0 0"/>
 </world>)";
 
 std::string worldWith(const std::string& body, const char* gravity = nullptr) {
@@ -90,6 +106,87 @@ class TestWorld : public QObject {
     qInfo("after 1 s: spin %.3f rad/s, roll %.3f rad/s (both from 10)", spin, roll);
     QVERIFY(spin > 9.9);
     QVERIFY(roll >= 0 && roll < 9.0);
+  }
+
+  // Motion resistance (a contact's motion_resistance C, snow): a force
+  // C x normal force against each wheel's horizontal travel. WorkPartner
+  // coasting on free wheels from 0.5 m/s stops after v0^2 M' / (2 C g M)
+  // (M' its mass plus the wheels' spin, m_w / 2 each) within 10 %; without
+  // the resistance (control) it rolls on. Braced wheels sliding meet
+  // friction mu plus C, or mu alone when the surface spares them
+  // (motion_resistance_sliding="false"): stopping distances in the ratio
+  // (mu + C) / mu within 10 %. A snapshot taken while coasting continues
+  // bit for bit; one with the resistance state cleared does not (control).
+  void motionResistance() {
+    const auto coast = [](double c, const char* sliding, bool braced, double mu, Snapshot* mid = nullptr,
+                          std::unique_ptr<World>* keep = nullptr) {
+      WorldFixture f;
+      auto world = f.build(QString(kSnowWorld)
+                               .arg(mu)
+                               .arg(c)
+                               .arg(sliding, QString::fromStdString(std::string(SP_SOURCE_DIR) + "/robots/workpartner.xml"))
+                               .toStdString());
+      if (!world) return -1.0;
+      stepFor(*world, 1.0);  // standing
+      const RobotModel& robot = world->robotModel(0);
+      const double v0 = 0.5, r = robot.drive->wheelRadius;
+      for (int w : robot.drive->wheels) {
+        const std::string name = robot.joints[static_cast<size_t>(w)].name;
+        if (braced) world->submit(JointVelocityCmd{name, 0});
+        else world->submit(JointModeCmd{name, JointMode::Free});
+      }
+      world->step();
+      const RobotReadout now = readRobot(*world);
+      std::vector<double> rates(now.jointRates.size(), 0.0);
+      if (!braced)
+        for (int w : robot.drive->wheels)  // rolling forward along +x: spin +v0/r about +y
+          rates[static_cast<size_t>(w)] = v0 / r * robot.joints[static_cast<size_t>(w)].axis.y;
+      if (!world->setRobotMotion(0, linkMotions(robot, now.base, {v0, 0, 0}, {}, now.jointPositions, rates)).empty())
+        return -1.0;
+      const double x0 = world->linkPose(0, 0).p.x;
+      for (int i = 0; i < 6000 && world->linkLinearVelocity(0, 0).x > 0.002; ++i) {
+        if (mid && i == 50) *mid = world->snapshot();
+        world->step();
+      }
+      const double d = world->linkPose(0, 0).p.x - x0;
+      if (keep) *keep = std::move(world);
+      return d;
+    };
+    Diagnostics diag;
+    const auto model = loadRobot(std::string(SP_SOURCE_DIR) + "/robots/workpartner.xml", diag);
+    QVERIFY2(model, diag.format().c_str());
+    const double mass = model->totalMass(), g = 9.81, v0 = 0.5, c = 0.2;
+    double spin = 0;
+    for (int w : model->drive->wheels) spin += model->links[static_cast<size_t>(model->joints[static_cast<size_t>(w)].child)].mass / 2;
+    const double expected = v0 * v0 * (mass + spin) / (2 * c * g * mass);
+    const double rolled = coast(c, "true", false, 1.0);
+    const double free = coast(0, "true", false, 1.0);
+    qInfo("coasting from %.1f m/s: %.4f m with C = %.1f (expected %.4f), %.3f m without", v0, rolled, c, expected, free);
+    QVERIFY(std::abs(rolled / expected - 1) <= 0.1);
+    QVERIFY(free > 3 * expected);  // control
+
+    const double mu = 0.1, cb = 0.1;
+    const double both = coast(cb, "true", true, mu), frictionOnly = coast(cb, "false", true, mu);
+    qInfo("braced, sliding from %.1f m/s: %.4f m with mu + C, %.4f m with mu alone (ratio %.3f, expected %.3f)", v0,
+          both, frictionOnly, frictionOnly / both, (mu + cb) / mu);
+    QVERIFY(both > 0 && frictionOnly > 0);
+    QVERIFY(std::abs((frictionOnly / both) / ((mu + cb) / mu) - 1) <= 0.1);
+
+    // Re-simulation: the state carries the resistance.
+    Snapshot mid;
+    std::unique_ptr<World> world;
+    QVERIFY(coast(c, "true", false, 1.0, &mid, &world) > 0);
+    QVERIFY(std::any_of(mid.robots[0].resistance.begin(), mid.robots[0].resistance.end(), [](double f) { return f > 0; }));
+    const auto runFrom = [&](const Snapshot& s) {
+      if (!world->restore(s).empty()) return uint64_t{0};
+      for (int i = 0; i < 200; ++i) world->step();
+      return world->stateHash();
+    };
+    const uint64_t a = runFrom(mid), b = runFrom(mid);
+    Snapshot cleared = mid;
+    std::fill(cleared.robots[0].resistance.begin(), cleared.robots[0].resistance.end(), 0.0);
+    QCOMPARE(a, b);
+    QVERIFY(runFrom(cleared) != a);  // control
   }
 
   // A box dropped on a heightfield comes to rest with its bottom on the
