@@ -378,6 +378,14 @@ void Ghost::anchorLoop() {
       target = options_.runAhead ? ghostTimeLocked(now()) : frame.time;
     }
     lastStart = now();
+    const size_t joints = model_.robots[0].model.joints.size();
+    if (frame.jointPositions.size() != joints || frame.jointRates.size() != joints) {
+      setProblem("telemetry at " + std::to_string(frame.time) + " s has " +
+                 std::to_string(frame.jointPositions.size()) + " joint positions and " +
+                 std::to_string(frame.jointRates.size()) + " rates; the robot has " + std::to_string(joints) +
+                 " joints");
+      continue;
+    }
     const bool latched = frame.estop || frame.failsafe;
     // Hold the ghost.hold joints only while the robot keeps them still and
     // nothing sent moves them (a gait, a joint command in flight).

@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <filesystem>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <string>
 #include <thread>
 #include <vector>
@@ -21,6 +23,7 @@
 #include "app/plot_svg.h"
 #include "app/rehearsal.h"
 #include "app/resimulation.h"
+#include "app/sweep.h"
 #include "app/validation.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
@@ -67,6 +70,25 @@ constexpr const char* kUsage = R"(usage:
       --params FILE, --set KEY=VALUE   as for run
       --robust N        also N perturbed rehearsals (ranges robust.* of the rules)
       Exits 0 when the sequence passed, 6 when a rule failed, 1 on bad input.
+  simpartner-sim sweep --world FILE --commands SEQ --samples N --out DIR [options]
+      Many rehearsals of one sequence, each with its own parameters and
+      seed: writes DIR/manifest.txt (a line of --set arguments and a seed per
+      sample) and runs it, on all cores or as a Slurm job array.
+      --vary KEY=LO:HI  draw KEY uniformly in [LO, HI] per sample (repeatable)
+      --seed S          the sweep's seed (default 1)
+      --no-perturb      do not perturb friction, masses, terrain and start
+      --rules FILE, --params FILE, --set KEY=VALUE   as for rehearse
+      --jobs J          local threads (default: every core)
+      --slurm           submit a job array with sbatch instead of running
+      --sbatch ARG      pass ARG to sbatch (repeatable), e.g. --partition=sim
+  simpartner-sim sweep --resume DIR [--jobs J] [--slurm] [--sbatch ARG]...
+      Runs (or submits) only the tasks of DIR that have not run or failed.
+  simpartner-sim sweep-task DIR [INDEX]
+      Runs one sample (INDEX, or $SLURM_ARRAY_TASK_ID): what a job array runs.
+  simpartner-sim collect DIR
+      Gathers DIR's results into results.csv and report.md (pass/fail, end
+      pose, minimum stability margin, health, end hash per sample), naming
+      failed and missing tasks. Exits 0 when every task ran, 4 otherwise.
   simpartner-sim export LOG --csv DIR
       Writes one CSV per stream of a session log into DIR (samples.csv,
       laser.csv, commands.csv, events.csv), headers naming columns and units.
@@ -244,20 +266,28 @@ int run(const std::vector<std::string>& args) {
   return report->csvError.empty() ? 0 : 4;
 }
 
+// Whether args[i] is one of `options` and has a value after it; says why
+// not on stderr.
+bool knownWithValue(const std::vector<std::string>& args, size_t i, std::initializer_list<std::string_view> options) {
+  const std::string& a = args[i];
+  if (std::find(options.begin(), options.end(), a) == options.end()) {
+    std::cerr << "<command line>: error: unknown option '" << a << "'\n" << kUsage;
+    return false;
+  }
+  if (i + 1 >= args.size()) {
+    std::cerr << "<command line>: error: " << a << " needs a value\n";
+    return false;
+  }
+  return true;
+}
+
 int rehearseCommand(const std::vector<std::string>& args) {
   std::string worldFile, commandsFile, rulesFile, paramsFile;
   std::vector<std::string> overrides;
   int robust = 0;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a != "--world" && a != "--commands" && a != "--rules" && a != "--params" && a != "--set" && a != "--robust") {
-      std::cerr << "<command line>: error: unknown option '" << a << "'\n" << kUsage;
-      return 2;
-    }
-    if (i + 1 >= args.size()) {
-      std::cerr << "<command line>: error: " << a << " needs a value\n";
-      return 2;
-    }
+    if (!knownWithValue(args, i, {"--world", "--commands", "--rules", "--params", "--set", "--robust"})) return 2;
     const std::string& v = args[++i];
     if (a == "--world") worldFile = v;
     else if (a == "--commands") commandsFile = v;
@@ -387,6 +417,139 @@ int exportLog(const std::vector<std::string>& args) {
   return 0;
 }
 
+int collectCommand(const std::vector<std::string>& args);
+
+int sweepCommand(const std::vector<std::string>& args, const char* argv0) {
+  sp::SweepSpec spec;
+  std::string out, resume;
+  std::vector<std::string> sbatchArgs;
+  bool slurm = false;
+  int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  bool haveSamples = false;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--no-perturb") {
+      spec.perturb = false;
+      continue;
+    }
+    if (a == "--slurm") {
+      slurm = true;
+      continue;
+    }
+    if (!knownWithValue(args, i,
+                        {"--world", "--commands", "--rules", "--params", "--set", "--vary", "--samples", "--seed",
+                         "--out", "--jobs", "--resume", "--sbatch"}))
+      return 2;
+    const std::string& v = args[++i];
+    const auto count = [&](long lo, long hi, long& n) {
+      char* end = nullptr;
+      n = std::strtol(v.c_str(), &end, 10);
+      if (end == v.c_str() || *end != '\0' || n < lo || n > hi) {
+        std::cerr << "<command line>: error: " << a << ": expected " << lo << ".." << hi << ", got '" << v << "'\n";
+        return false;
+      }
+      return true;
+    };
+    long n = 0;
+    if (a == "--world") spec.world = v;
+    else if (a == "--commands") spec.commands = v;
+    else if (a == "--rules") spec.rules = v;
+    else if (a == "--params") spec.params = v;
+    else if (a == "--set") spec.overrides.push_back(v);
+    else if (a == "--out") out = v;
+    else if (a == "--resume") resume = v;
+    else if (a == "--sbatch") sbatchArgs.push_back(v);
+    else if (a == "--vary") {
+      sp::SweepVary vary;
+      if (const std::string why = sp::parseVary(v, vary); !why.empty()) {
+        std::cerr << "<command line>: error: " << why << "\n";
+        return 2;
+      }
+      spec.vary.push_back(vary);
+    } else if (a == "--samples") {
+      if (!count(1, 100000, n)) return 2;
+      spec.samples = static_cast<int>(n);
+      haveSamples = true;
+    } else if (a == "--seed") {
+      if (!count(0, std::numeric_limits<long>::max(), n)) return 2;
+      spec.seed = static_cast<uint64_t>(n);
+    } else if (a == "--jobs") {
+      if (!count(1, 256, n)) return 2;
+      jobs = static_cast<int>(n);
+    }
+  }
+  std::string error;
+  std::string dir = resume;
+  if (resume.empty()) {
+    if (spec.world.empty() || spec.commands.empty() || !haveSamples || out.empty()) {
+      std::cerr << "<command line>: error: sweep needs --world FILE, --commands SEQ, --samples N and --out DIR "
+                   "(or --resume DIR)\n";
+      return 2;
+    }
+    if (!sp::createSweep(out, spec, error)) {
+      std::cerr << error << "\n";
+      return 1;
+    }
+    dir = out;
+  }
+  if (slurm) {
+    // The tasks run this very binary: its full path, however it was started.
+    std::error_code ec;
+    const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+    const std::string job = sp::submitSlurm(dir, {}, ec ? std::string(argv0) : self.string(), sbatchArgs, error);
+    if (job.empty()) {
+      std::cerr << error << "\n";
+      return 1;
+    }
+    std::cout << "submitted job array " << job << " for " << dir << "; when it is done: simpartner-sim collect " << dir
+              << "\n";
+    return 0;
+  }
+  if (!sp::runSweepLocal(dir, {}, jobs, error)) {
+    std::cerr << error << "\n";
+    return 1;
+  }
+  return collectCommand({dir});
+}
+
+int sweepTaskCommand(const std::vector<std::string>& args) {
+  if (args.empty() || args.size() > 2) {
+    std::cerr << "<command line>: error: sweep-task needs DIR [INDEX]\n";
+    return 2;
+  }
+  const char* env = std::getenv("SLURM_ARRAY_TASK_ID");
+  const std::string text = args.size() == 2 ? args[1] : (env ? env : "");
+  char* end = nullptr;
+  const long index = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || index < 0 || index >= 100000) {
+    std::cerr << "<command line>: error: sweep-task: expected INDEX 0..99999 or SLURM_ARRAY_TASK_ID, got '" << text
+              << "'\n";
+    return 2;
+  }
+  std::string error;
+  if (!sp::runSweepTask(args[0], static_cast<int>(index), error)) {
+    std::cerr << "task " << index << ": " << error << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+int collectCommand(const std::vector<std::string>& args) {
+  if (args.size() != 1) {
+    std::cerr << "<command line>: error: collect needs DIR\n";
+    return 2;
+  }
+  std::string error;
+  const sp::SweepSummary s = sp::collectSweep(args[0], error);
+  if (!error.empty()) {
+    std::cerr << error << "\n";
+    return 1;
+  }
+  std::cout << args[0] << ": " << s.passed << " of " << s.done << " samples passed every rule; " << s.missing.size()
+            << " missing, " << s.failed.size() << " failed to run; " << args[0] << "/report.md\n";
+  return s.done == s.samples ? 0 : 4;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -410,6 +573,9 @@ int main(int argc, char** argv) {
   if (cmd == "resim") return resim(args);
   if (cmd == "rehearse") return rehearseCommand(args);
   if (cmd == "export") return exportLog(args);
+  if (cmd == "sweep") return sweepCommand(args, argv[0]);
+  if (cmd == "sweep-task") return sweepTaskCommand(args);
+  if (cmd == "collect") return collectCommand(args);
   std::cerr << "<command line>: error: unknown command '" << cmd << "'\n" << kUsage;
   return 2;
 }
