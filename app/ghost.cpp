@@ -180,7 +180,8 @@ void Ghost::carryControl(const World& from, const Twin& fromTwin, World& to, con
                          const std::vector<double>& positions) const {
   const RobotModel& a = fromTwin.world.robots[0].model;
   const RobotModel& b = toTwin.world.robots[0].model;
-  const RobotControlState& was = from.snapshot().robots[0];
+  const Snapshot before = from.snapshot();  // kept: `was` refers into it
+  const RobotControlState& was = before.robots[0];
   Snapshot s = to.snapshot();
   RobotControlState& now = s.robots[0];
   const RobotControlState fresh = now;

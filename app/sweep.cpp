@@ -17,6 +17,7 @@
 #include "app/rehearsal.h"
 #include "sim/command_check.h"
 #include "sim/command_file.h"
+#include "sim/flight_rules.h"
 #include "sim/model_loader.h"
 #include "sim/random.h"
 #include "sim/terrain_file.h"
@@ -85,7 +86,7 @@ bool samplePlan(const SweepSpec& spec, const std::vector<std::string>& sets, uin
     if (!error.empty() && error.back() == '\n') error.pop_back();
     return false;
   }
-  plan = RehearsalPlan{*world, params, rules, *commands, std::nullopt};
+  plan = RehearsalPlan{*world, params, rules, *commands, spec.start};
   if (spec.perturb) plan = perturbed(plan, seed);
   return true;
 }
@@ -185,8 +186,27 @@ bool createSweep(const std::string& dir, const SweepSpec& given, std::string& er
   m << "samples " << spec.samples << "\n"
     << "seed " << spec.seed << "\n"
     << "perturb " << (spec.perturb ? "true" : "false") << "\n";
+  if (spec.start) {
+    const RehearsalStart& s = *spec.start;
+    const auto numbers = [&](const char* key, std::initializer_list<double> values) {
+      m << key;
+      for (double v : values) m << " " << exact(v);
+      m << "\n";
+    };
+    numbers("start_base", {s.base.p.x, s.base.p.y, s.base.p.z, s.base.q.w, s.base.q.x, s.base.q.y, s.base.q.z});
+    numbers("start_twist", {s.baseLinear.x, s.baseLinear.y, s.baseLinear.z, s.baseAngular.x, s.baseAngular.y,
+                            s.baseAngular.z});
+    m << "start_joints";
+    for (double v : s.jointPositions) m << " " << exact(v);
+    m << "\nstart_rates";
+    for (double v : s.jointRates) m << " " << exact(v);
+    m << "\n";
+    for (const auto& [name, pose] : s.objects)
+      m << "start_object " << name << " " << exact(pose.p.x) << " " << exact(pose.p.y) << " " << exact(pose.p.z) << " "
+        << exact(pose.q.w) << " " << exact(pose.q.x) << " " << exact(pose.q.y) << " " << exact(pose.q.z) << "\n";
+  }
   for (int i = 0; i < spec.samples; ++i) {
-    const uint64_t seed = sampleSeed(spec.seed, i);
+    const uint64_t seed = spec.consecutiveSeeds ? spec.seed + static_cast<uint64_t>(i) : sampleSeed(spec.seed, i);
     Random draw(seed);
     m << "sample " << i << " " << seed;
     for (const SweepVary& v : spec.vary) {
@@ -198,6 +218,48 @@ bool createSweep(const std::string& dir, const SweepSpec& given, std::string& er
     m << "\n";
   }
   return writeFileAtomically(manifestPath(dir), m.str(), error);
+}
+
+bool createSweepFromPlan(const std::string& dir, const RehearsalPlan& plan, uint64_t seed, std::string& error) {
+  if (plan.world.robots.empty()) {
+    error = "the plan's world has no robot";
+    return false;
+  }
+  if (fs::exists(manifestPath(dir))) {
+    error = manifestPath(dir) + ": a sweep is there already (choose another folder)";
+    return false;
+  }
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) {
+    error = dir + ": cannot create: " + ec.message();
+    return false;
+  }
+  SweepSpec spec;
+  spec.world = plan.world.file;
+  spec.commands = dir + "/sequence.seq";
+  spec.rules = dir + "/flight.rules";
+  spec.params = dir + "/sweep.params";
+  spec.samples = plan.rules.robustSamples;
+  spec.seed = seed;
+  spec.start = plan.start;
+  spec.consecutiveSeeds = true;
+  std::string params = "# The console's parameters when the sweep was made\n";
+  for (const ParamInfo& p : paramTable()) params += p.key + " = " + paramValue(plan.params, p.key) + "\n";
+  const std::string sequence = "# The rehearsed sequence, as the console relays it\n" +
+                               sequenceText(plan.commands, &plan.world.robots[0].model);
+  if (!writeFileAtomically(spec.commands, sequence, error) ||
+      !writeFileAtomically(spec.rules, flightRulesText(plan.rules), error) ||
+      !writeFileAtomically(spec.params, params, error))
+    return false;
+  // The console's ground, edits included: a heightfield is saved exactly.
+  if (plan.world.terrain.kind == TerrainSpec::Kind::Heightfield) {
+    spec.world = dir + "/world.world.xml";
+    if (!saveHeightGrid(dir + "/terrain.asc", plan.world.terrain.grid, error) ||
+        !saveWorldWithTerrain(plan.world.file, spec.world, dir + "/terrain.asc", plan.world.terrain.grid, error))
+      return false;
+  }
+  return createSweep(dir, spec, error);
 }
 
 bool readSweep(const std::string& dir, SweepSpec& spec, std::vector<SweepSample>& samples, std::string& error) {
@@ -243,6 +305,21 @@ bool readSweep(const std::string& dir, SweepSpec& spec, std::vector<SweepSample>
     } else if (word == "perturb") {
       if (rest != "true" && rest != "false") return fail("perturb: expected true or false");
       spec.perturb = rest == "true";
+    } else if (word.rfind("start_", 0) == 0) {
+      if (!spec.start) spec.start = RehearsalStart{};
+      RehearsalStart& st = *spec.start;
+      std::istringstream r(rest);
+      std::vector<double> v;
+      std::string name;
+      if (word == "start_object" && !(r >> name)) return fail("expected: start_object NAME x y z qw qx qy qz");
+      for (double x; r >> x;) v.push_back(x);
+      if (!r.eof()) return fail(word + ": expected numbers");
+      if (word == "start_base" && v.size() == 7) st.base = {{v[0], v[1], v[2]}, {v[3], v[4], v[5], v[6]}};
+      else if (word == "start_twist" && v.size() == 6) st.baseLinear = {v[0], v[1], v[2]}, st.baseAngular = {v[3], v[4], v[5]};
+      else if (word == "start_joints") st.jointPositions = v;
+      else if (word == "start_rates") st.jointRates = v;
+      else if (word == "start_object" && v.size() == 7) st.objects.emplace_back(name, Pose{{v[0], v[1], v[2]}, {v[3], v[4], v[5], v[6]}});
+      else return fail(word + ": unknown, or the wrong count of numbers");
     } else if (word == "sample") {
       SweepSample sample;
       std::istringstream r(rest);

@@ -26,8 +26,11 @@
 // tasks on `threads` threads of its own; runSweepTask on any thread.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "app/rehearsal.h"
 
 namespace sp {
 
@@ -47,6 +50,13 @@ struct SweepSpec {
   /// Each sample also perturbs friction, masses, terrain and the start
   /// within the rules' robustness ranges, seeded by its own seed.
   bool perturb = true;
+  /// The robot's state to start from (the console's: where the robot is
+  /// now); nullopt = the world's own start.
+  std::optional<RehearsalStart> start;
+  /// Sample i's seed is seed + i, as robustness() numbers them (the
+  /// console's cluster robustness equals its local one sample for sample);
+  /// otherwise drawn from the seed and i (splitmix64).
+  bool consecutiveSeeds = false;
 };
 
 /// One sample of the manifest.
@@ -64,6 +74,13 @@ std::string parseVary(const std::string& text, SweepVary& out);
 /// (creating `dir`; an existing manifest is not overwritten). False and
 /// `error` (naming the file or option) otherwise.
 bool createSweep(const std::string& dir, const SweepSpec& spec, std::string& error);
+
+/// The console's "Robustness on cluster": writes the plan's sequence,
+/// rules, parameters and (for a heightfield, with any edits) world and
+/// terrain into `dir`, then a sweep of plan.rules.robustSamples samples
+/// from the plan's start with robustness()'s seeds (seed + i): sample i
+/// equals robustness(plan, seed)'s sample i.
+bool createSweepFromPlan(const std::string& dir, const RehearsalPlan& plan, uint64_t seed, std::string& error);
 
 /// Reads `dir`/manifest.txt; false and `error` naming its line otherwise.
 bool readSweep(const std::string& dir, SweepSpec& spec, std::vector<SweepSample>& samples, std::string& error);

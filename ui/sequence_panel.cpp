@@ -1,6 +1,8 @@
 #include "ui/sequence_panel.h"
 
 #include <QBoxLayout>
+#include <QCoreApplication>
+#include <QDateTime>
 #include <QFile>
 #include <QFileDialog>
 #include <QFontDatabase>
@@ -10,6 +12,7 @@
 #include <QMessageBox>
 #include <QPlainTextEdit>
 #include <QProgressBar>
+#include <QStandardPaths>
 #include <QPushButton>
 #include <QSlider>
 #include <QTextBlock>
@@ -23,6 +26,7 @@
 
 #include <cmath>
 
+#include "app/sweep.h"
 #include "sim/command_file.h"
 #include "sim/terrain_brush.h"
 
@@ -111,17 +115,26 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   rehearseButton_->setToolTip(tr("Run the sequence on the console's twin from the robot's state now"));
   robustButton_ = new QPushButton(tr("Robustness"), this);
   robustButton_->setToolTip(tr("Rehearse it again with friction, masses, terrain and start perturbed"));
+  clusterButton_ = new QPushButton(tr("On cluster…"), this);
+  clusterButton_->setToolTip(tr("The same robustness rehearsals as a sweep folder, submitted to a Slurm cluster "
+                                "that shares it (docs/sweeps.md)"));
   cancelButton_ = new QPushButton(tr("Cancel"), this);
   progress_ = new QProgressBar(this);
   progress_->setRange(0, 1000);
   progress_->setTextVisible(false);
   runRow->addWidget(rehearseButton_);
   runRow->addWidget(robustButton_);
+  runRow->addWidget(clusterButton_);
   runRow->addWidget(progress_, 1);
   runRow->addWidget(cancelButton_);
   layout->addLayout(runRow);
   connect(rehearseButton_, &QPushButton::clicked, this, &SequencePanel::rehearse);
   connect(robustButton_, &QPushButton::clicked, this, &SequencePanel::checkRobustness);
+  connect(clusterButton_, &QPushButton::clicked, this, [this] {
+    const QString folder = QFileDialog::getExistingDirectory(this, tr("Folder for the sweep (shared with the cluster)"));
+    if (!folder.isEmpty())
+      robustnessOnCluster(folder + "/robustness-" + QDateTime::currentDateTime().toString("yyyyMMdd-hhmmss"));
+  });
   connect(cancelButton_, &QPushButton::clicked, this, [this] { cancel_ = true; });
 
   verdicts_ = new QTreeWidget(this);
@@ -404,6 +417,51 @@ bool SequencePanel::checkRobustness() {
   return true;
 }
 
+bool SequencePanel::robustnessOnCluster(const QString& dir) {
+  if (busy_ || !plan_ || !rehearsalCurrent()) {
+    setStatus(tr("Rehearse the sequence first."));
+    return false;
+  }
+  std::string error;
+  if (!createSweepFromPlan(dir.toStdString(), *plan_, 1, error)) {
+    setStatus(tr("Robustness on cluster: %1").arg(QString::fromStdString(error)));
+    return false;
+  }
+  const int samples = plan_->rules.robustSamples;
+  const QString later = QStringLiteral("simpartner-sim collect %1").arg(dir);
+  if (QStandardPaths::findExecutable("sbatch").isEmpty()) {
+    setStatus(tr("Robustness on cluster: %1 samples written to %2 (no sbatch here); on a machine of the cluster that "
+                 "shares it: simpartner-sim sweep --resume %2 --slurm, then %3")
+                  .arg(samples)
+                  .arg(dir, later));
+  } else {
+    // sbatch may wait for a slow controller: on the worker, never the GUI.
+    setStatus(tr("Robustness on cluster: %1 samples written to %2; submitting…").arg(samples).arg(dir));
+    startWorker([this, dir, samples, later, sim = simBinary_.toStdString()] {
+      std::string why;
+      const std::string job = submitSlurm(dir.toStdString(), {}, sim, {}, why);
+      QMetaObject::invokeMethod(
+          this,
+          [this, dir, samples, later, job, why] {
+            busy_ = false;
+            updateButtons();
+            if (job.empty())
+              setStatus(tr("Robustness on cluster: %1 samples written to %2; %3")
+                            .arg(samples)
+                            .arg(dir, QString::fromStdString(why)));
+            else
+              setStatus(tr("Robustness on cluster: job array %1, %2 samples in %3; when it is done: %4")
+                            .arg(QString::fromStdString(job))
+                            .arg(samples)
+                            .arg(dir, later));
+          },
+          Qt::QueuedConnection);
+    });
+  }
+  emit logEvent("rehearsal", QStringLiteral("robustness on cluster: %1 samples in %2").arg(samples).arg(dir));
+  return true;
+}
+
 void SequencePanel::robustnessFinished(RobustnessResult r) {
   busy_ = false;
   progress_->setValue(1000);
@@ -579,6 +637,7 @@ void SequencePanel::updateButtons() {
   const bool running = phase == SequenceRelay::Phase::Running || phase == SequenceRelay::Phase::Sent;
   rehearseButton_->setEnabled(!busy_);
   robustButton_->setEnabled(!busy_ && rehearsalCurrent());
+  clusterButton_->setEnabled(!busy_ && rehearsalCurrent());
   cancelButton_->setEnabled(busy_);
   sendButton_->setEnabled(!busy_ && linkReady_ && rehearsalCurrent() && result_->passed && !running && !planPinned_);
   startLabel_->setText(pinned_ ? tr("Start: %1 (a what-if: it cannot be sent)").arg(pinned_->label)

@@ -15,7 +15,9 @@
 //               margin, roll and pitch with the scrubber's time marked;
 //   robustness  rules' robust.samples perturbed rehearsals on both cores:
 //               success probability and the spread of the end positions
-//               (their hull drawn with the path);
+//               (their hull drawn with the path); "On cluster…" writes the
+//               same rehearsals as a sweep folder and submits it to Slurm
+//               (app/sweep.h, docs/sweeps.md);
 //   relay       Send (only after a pass, with the text unchanged since),
 //               the robot's progress, Abort.
 //
@@ -26,6 +28,7 @@
 // Thread: GUI thread. Rehearsals run on a std::thread of the panel's,
 // cancelled and joined by the destructor.
 
+#include <QCoreApplication>
 #include <QString>
 #include <QStringList>
 #include <QWidget>
@@ -100,6 +103,12 @@ class SequencePanel : public QWidget {
   bool rehearse();
   /// Starts the robustness rehearsals (needs a passed rehearsal).
   bool checkRobustness();
+  /// The same robustness rehearsals as a sweep in `dir` (app/sweep.h:
+  /// sample i equals the local robustness's sample i), submitted with
+  /// sbatch when this machine has it; status() says where and what next.
+  bool robustnessOnCluster(const QString& dir);
+  /// The simpartner-sim a cluster's tasks run (default: beside this program).
+  void setSimBinary(const QString& path) { simBinary_ = path; }
   bool busy() const { return busy_; }
   /// The last rehearsal, if any (and whether the text is still what it rehearsed).
   const std::optional<RehearsalResult>& result() const { return result_; }
@@ -173,6 +182,8 @@ class SequencePanel : public QWidget {
   QList<int> marked_;
   QPushButton* rehearseButton_ = nullptr;
   QPushButton* robustButton_ = nullptr;
+  QPushButton* clusterButton_ = nullptr;
+  QString simBinary_ = QCoreApplication::applicationDirPath() + "/simpartner-sim";
   QPushButton* cancelButton_ = nullptr;
   QProgressBar* progress_ = nullptr;
   QTreeWidget* verdicts_ = nullptr;

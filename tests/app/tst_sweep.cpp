@@ -11,30 +11,17 @@
 #include <sstream>
 
 #include "app/sweep.h"
+#include "tests/app/sweep_results.h"
+#include "sim/command_file.h"
+#include "sim/model_loader.h"
+#include "sim/readout.h"
+#include "sim/world.h"
 
 using namespace sp;
+using sp::test::readText;
+using sp::test::sweepHashes;
 
 namespace {
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-// The sweep's end hashes by index, from results.csv (the hash column).
-std::vector<std::string> hashes(const std::string& dir) {
-  std::vector<std::string> out;
-  std::istringstream in(readText(dir + "/results.csv"));
-  std::string line;
-  std::getline(in, line);
-  for (; std::getline(in, line);) {
-    const size_t last = line.rfind(','), before = line.rfind(',', last - 1);
-    out.push_back(line.substr(before + 1, last - before - 1));
-  }
-  return out;
-}
 
 int runSim(const QStringList& args, QString* output = nullptr) {
   QProcess p;
@@ -131,7 +118,7 @@ class TestSweep : public QObject {
       QCOMPARE(runSim({"sweep-task", QString::fromStdString(tasks), QString::number(i)}, &out), 0);
     }
     QCOMPARE(runSim({"collect", QString::fromStdString(tasks)}), 0);
-    const std::vector<std::string> a = hashes(local), b = hashes(tasks);
+    const std::vector<std::string> a = sweepHashes(local), b = sweepHashes(tasks);
     qInfo("end hashes: %s %s %s %s", a[0].c_str(), a[1].c_str(), a[2].c_str(), a[3].c_str());
     QCOMPARE(a.size(), size_t{4});
     QCOMPARE(a, b);
@@ -140,7 +127,7 @@ class TestSweep : public QObject {
     QVERIFY2(createSweep(other, spec(4), error), error.c_str());
     QVERIFY(runSweepLocal(other, {}, 2, error));
     collectSweep(other, error);
-    const std::vector<std::string> c = hashes(other);
+    const std::vector<std::string> c = sweepHashes(other);
     QCOMPARE(c.size(), size_t{4});
     for (size_t i = 0; i < 4; ++i) QVERIFY(c[i] != a[i]);
   }
@@ -179,6 +166,62 @@ class TestSweep : public QObject {
     QCOMPARE(readText(dir + "/results/3.tsv"), result3);
     QVERIFY(pendingTasks(dir, error).empty());
     QCOMPARE(collectSweep(dir, error).done, 4);
+  }
+
+  // The console's "Robustness on cluster": the plan (its world with an
+  // edited heightfield, parameters, rules, a start in motion) written as a
+  // sweep equals the console's local robustness() sample for sample: the
+  // same verdicts and end positions, bit for bit.
+  void consoleRobustnessAsSweep() {
+    Diagnostics diag;
+    std::optional<WorldModel> world = loadWorld(SP_SOURCE_DIR "/terrains/test_track.world.xml", diag);
+    QVERIFY2(world, diag.format().c_str());
+    // An edit in the console: a 3 cm hump across the track 1.6-2.2 m along, where the robot drives.
+    HeightGrid& grid = world->terrain.grid;
+    for (int j = 0; j < grid.rows; ++j)
+      for (int i = 0; i < grid.columns; ++i)
+        if (const double x = i * grid.spacingX(); x >= 1.6 && x <= 2.2) grid.at(i, j) += 0.03;
+    std::optional<std::vector<TimedCommand>> commands = loadCommandSequence(seq_, diag, &world->robots[0].model);
+    QVERIFY2(commands, diag.format().c_str());
+    SimParams params;
+    params.erp = 0.45;
+    FlightRules rules;
+    rules.robustSamples = 3;
+    // The start: the robot after 0.5 s of driving.
+    auto robot = World::create(*world, params, diag);
+    QVERIFY(robot);
+    QCOMPARE(robot->submit(DriveCmd{0.4, 0}), std::string());
+    for (int i = 0; i < 500; ++i) QVERIFY(robot->step());
+    const RobotReadout r = readRobot(*robot);
+    RehearsalStart start{r.base, r.baseLinearVelocity, r.baseAngularVelocity, r.jointPositions, r.jointRates, {}};
+    const RehearsalPlan plan{*world, params, rules, *commands, start};
+
+    const RobustnessResult local = robustness(plan, 1, 2);
+    const std::string dir = tmp_.filePath("console").toStdString();
+    std::string error;
+    QVERIFY2(createSweepFromPlan(dir, plan, 1, error), error.c_str());
+    QVERIFY(readText(dir + "/manifest.txt").find("start_base ") != std::string::npos);
+    QVERIFY(runSweepLocal(dir, {}, 2, error));
+    const SweepSummary s = collectSweep(dir, error);
+    QCOMPARE(s.done, 3);
+    QCOMPARE(s.passed, local.passed);
+    std::istringstream csv(readText(dir + "/results.csv"));
+    std::string line;
+    std::getline(csv, line);
+    for (int i = 0; i < 3 && std::getline(csv, line); ++i) {
+      std::vector<std::string> f;
+      std::istringstream row(line);
+      for (std::string cell; std::getline(row, cell, ',');) f.push_back(cell);
+      QCOMPARE(f[2], std::string(local.samplePassed[static_cast<size_t>(i)] ? "true" : "false"));
+      QCOMPARE(std::stod(f[4]), local.endPoses[static_cast<size_t>(i)].p.x);
+      QCOMPARE(std::stod(f[5]), local.endPoses[static_cast<size_t>(i)].p.y);
+    }
+    // Control: the same sweep without the terrain edit ends elsewhere.
+    RehearsalPlan unedited = plan;
+    std::optional<WorldModel> original = loadWorld(SP_SOURCE_DIR "/terrains/test_track.world.xml", diag);
+    unedited.world = *original;
+    const RobustnessResult other = robustness(unedited, 1, 2);
+    QVERIFY(other.endPoses[0].p.x != local.endPoses[0].p.x || other.endPoses[0].p.y != local.endPoses[0].p.y);
   }
 
   // The job array script and its index list.

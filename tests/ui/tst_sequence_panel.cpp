@@ -197,6 +197,20 @@ class TestSequencePanel : public QObject {
     QTRY_VERIFY(std::hypot(scene->drawnRehearsalBasePose().p.x - at->base.p.x,
                            scene->drawnRehearsalBasePose().p.y - at->base.p.y) < 1e-3);
 
+    // Robustness on cluster: the same perturbed rehearsals written as a sweep
+    // (app/sweep.h), from the robot's state; no cluster answers here, so the
+    // status names the folder and what sbatch said, or the command to run.
+    const QString sweep = dir_.filePath("cluster-sweep");
+    QVERIFY(p->robustnessOnCluster(sweep));
+    QTRY_VERIFY_WITH_TIMEOUT(!p->busy(), 120000);
+    QVERIFY2(p->status().contains(sweep), qPrintable(p->status()));
+    QFile manifest(sweep + "/manifest.txt");
+    QVERIFY(manifest.open(QIODevice::ReadOnly));
+    const QString text = QString::fromUtf8(manifest.readAll());
+    QVERIFY(text.contains(QStringLiteral("\nsamples %1\n").arg(FlightRules{}.robustSamples)));
+    QVERIFY(text.contains("\nstart_base ") && text.contains("\nsample 0 1\n"));
+    QVERIFY(QFile::exists(sweep + "/sequence.seq") && QFile::exists(sweep + "/flight.rules"));
+
     QTRY_VERIFY(p->sendButton()->isEnabled());
     p->setText(QStringLiteral("0.2 drive 0.5 11\n3.0 stop\n"));
     QVERIFY(!p->sendButton()->isEnabled());
