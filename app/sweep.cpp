@@ -514,6 +514,7 @@ SweepSummary collectSweep(const std::string& dir, std::string& error) {
   for (const SweepVary& v : spec.vary) csv << "," << v.key;
   csv << ",passed,summary,end_x,end_y,end_heading_deg,min_margin,health,hash,wall_s\n";
   PlotSeries ok{"passed", {}, {}, PlotSeries::Style::Points}, bad{"failed a rule", {}, {}, PlotSeries::Style::Points};
+  PlotSeries margins{"least stability margin", {}, {}, PlotSeries::Style::Points};
   std::vector<std::string> failures;
   for (const SweepSample& s : samples) {
     const std::string status = readText(statusPath(dir, s.index));
@@ -535,6 +536,8 @@ SweepSummary collectSweep(const std::string& dir, std::string& error) {
     csv << "," << r["passed"] << "," << csvField(r["summary"]) << "," << r["end_x"] << "," << r["end_y"] << ","
         << r["end_heading_deg"] << "," << r["min_margin"] << "," << csvField(r["health"]) << "," << r["hash"] << ","
         << r["wall_s"] << "\n";
+    margins.x.push_back(s.index);
+    margins.y.push_back(std::strtod(r["min_margin"].c_str(), nullptr));
     PlotSeries& series = passed ? ok : bad;
     series.x.push_back(std::strtod(r["end_x"].c_str(), nullptr));
     series.y.push_back(std::strtod(r["end_y"].c_str(), nullptr));
@@ -545,6 +548,10 @@ SweepSummary collectSweep(const std::string& dir, std::string& error) {
     if (!series.x.empty()) plot.series.push_back(series);
   if (plot.series.empty()) plot.series.push_back({"no sample has run", {0}, {0}, PlotSeries::Style::Points});
   if (!writePlotSvg(plot, dir + "/end_positions.svg", error)) return sum;
+  PlotSpec marginPlot{"Sweep: least stability margin of each sample", "sample", "margin [m]", {}, 960, 400, {}, {}};
+  marginPlot.series.push_back(margins.x.empty() ? PlotSeries{"no sample has run", {0}, {0}, PlotSeries::Style::Points}
+                                                 : margins);
+  if (!writePlotSvg(marginPlot, dir + "/margins.svg", error)) return sum;
   std::ostringstream md;
   md << "# Sweep " << fs::path(dir).filename().string() << "\n\n"
      << "`" << spec.commands << "` on `" << spec.world << "`, " << spec.samples << " samples, seed " << spec.seed
@@ -557,7 +564,8 @@ SweepSummary collectSweep(const std::string& dir, std::string& error) {
   for (const std::string& f : failures) md << "- " << f << "\n";
   if (!sum.missing.empty() || !sum.failed.empty())
     md << "\nRun only those again: `simpartner-sim sweep --resume " << dir << "` (add `--slurm` on a cluster).\n";
-  md << "\n![End positions](end_positions.svg) (data: [results.csv](results.csv))\n";
+  md << "\n![End positions](end_positions.svg)\n\n![Least stability margins](margins.svg) (data: "
+        "[results.csv](results.csv))\n";
   writeFileAtomically(dir + "/report.md", md.str(), error);
   return sum;
 }

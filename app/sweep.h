@@ -9,7 +9,7 @@
 //                  line per sample: INDEX SEED --set KEY=VALUE ...
 //   results/N.tsv  one task's outcome (key<TAB>value lines), written whole
 //   status/N       "ok", or "error: why" when the task could not run
-//   results.csv, report.md, end_positions.svg   written by collectSweep()
+//   results.csv, report.md, end_positions.svg, margins.svg   by collectSweep()
 // A task reads only the manifest and writes only its own two files, so a
 // task is the same on any machine that sees the folder (a shared
 // filesystem on a cluster) and a rerun of some tasks touches nothing else.
@@ -119,8 +119,8 @@ struct SweepSummary {
 
 /// Gathers the results into `dir`/results.csv (one row per sample: index,
 /// seed, the varied values, passed, summary, end pose, minimum stability
-/// margin, health, end hash, wall time) and `dir`/report.md with a plot of
-/// the end positions, naming failed and missing tasks.
+/// margin, health, end hash, wall time) and `dir`/report.md with plots of
+/// the end positions and the margins, naming failed and missing tasks.
 SweepSummary collectSweep(const std::string& dir, std::string& error);
 
 }  // namespace sp

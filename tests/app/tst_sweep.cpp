@@ -111,6 +111,10 @@ class TestSweep : public QObject {
     QVERIFY2(error.empty(), error.c_str());
     QCOMPARE(s.done, 4);
     QVERIFY(s.missing.empty() && s.failed.empty());
+    for (const char* plot : {"end_positions.svg", "margins.svg"}) {
+      QVERIFY(readText(local + "/" + plot).find("<svg") != std::string::npos);
+      QVERIFY(readText(local + "/report.md").find(plot) != std::string::npos);
+    }
 
     QVERIFY2(createSweep(tasks, spec(3), error), error.c_str());
     for (int i = 0; i < 4; ++i) {
