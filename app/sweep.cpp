@@ -314,12 +314,20 @@ bool readSweep(const std::string& dir, SweepSpec& spec, std::vector<SweepSample>
       if (word == "start_object" && !(r >> name)) return fail("expected: start_object NAME x y z qw qx qy qz");
       for (double x; r >> x;) v.push_back(x);
       if (!r.eof()) return fail(word + ": expected numbers");
-      if (word == "start_base" && v.size() == 7) st.base = {{v[0], v[1], v[2]}, {v[3], v[4], v[5], v[6]}};
-      else if (word == "start_twist" && v.size() == 6) st.baseLinear = {v[0], v[1], v[2]}, st.baseAngular = {v[3], v[4], v[5]};
-      else if (word == "start_joints") st.jointPositions = v;
-      else if (word == "start_rates") st.jointRates = v;
-      else if (word == "start_object" && v.size() == 7) st.objects.emplace_back(name, Pose{{v[0], v[1], v[2]}, {v[3], v[4], v[5], v[6]}});
-      else return fail(word + ": unknown, or the wrong count of numbers");
+      if (word == "start_base" && v.size() == 7) {
+        st.base = {{v[0], v[1], v[2]}, {v[3], v[4], v[5], v[6]}};
+      } else if (word == "start_twist" && v.size() == 6) {
+        st.baseLinear = {v[0], v[1], v[2]};
+        st.baseAngular = {v[3], v[4], v[5]};
+      } else if (word == "start_joints") {
+        st.jointPositions = v;
+      } else if (word == "start_rates") {
+        st.jointRates = v;
+      } else if (word == "start_object" && v.size() == 7) {
+        st.objects.emplace_back(name, Pose{{v[0], v[1], v[2]}, {v[3], v[4], v[5], v[6]}});
+      } else {
+        return fail(word + ": unknown, or the wrong count of numbers");
+      }
     } else if (word == "sample") {
       SweepSample sample;
       std::istringstream r(rest);
