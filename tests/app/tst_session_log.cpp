@@ -7,6 +7,7 @@
 #include <QTemporaryDir>
 #include <QtTest>
 
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -44,6 +45,20 @@ void setFormatVersion(const std::string& path, const std::string& version) {
   std::string sql = "UPDATE meta SET value='" + version + "' WHERE key='format_version'";
   QCOMPARE(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
   sqlite3_close(db);
+}
+
+// `decoded` restored into a fresh world of `worldFile` has `world`'s state
+// hash, now and after 100 more steps of both.
+void verifyRestoresLike(World& world, const Snapshot& decoded, const std::string& worldFile) {
+  std::unique_ptr<World> fresh = makeWorld(worldFile);
+  QVERIFY(fresh);
+  QCOMPARE(fresh->restore(decoded), std::string());
+  QCOMPARE(fresh->stateHash(), world.stateHash());
+  for (int i = 0; i < 100; ++i) {
+    QVERIFY(world.step());
+    QVERIFY(fresh->step());
+  }
+  QCOMPARE(fresh->stateHash(), world.stateHash());
 }
 
 }  // namespace
@@ -174,14 +189,8 @@ class TestSessionLog : public QObject {
     QCOMPARE(decoded->terrain != nullptr, original.terrain != nullptr);
     if (original.terrain) QCOMPARE(decoded->terrain->heights, original.terrain->heights);
 
-    std::unique_ptr<World> fresh = makeWorld(worldFile.toStdString());
-    QCOMPARE(fresh->restore(*decoded), std::string());
-    QCOMPARE(fresh->stateHash(), world->stateHash());
-    for (int i = 0; i < 100; ++i) {
-      QVERIFY(world->step());
-      QVERIFY(fresh->step());
-    }
-    QCOMPARE(fresh->stateHash(), world->stateHash());
+    verifyRestoresLike(*world, *decoded, worldFile.toStdString());
+    if (QTest::currentTestFailed()) return;
 
     // Truncated data and another version are refused.
     std::vector<uint8_t> cut(bytes.begin(), bytes.end() - 3);
@@ -191,6 +200,36 @@ class TestSessionLog : public QObject {
     v3[4] = 3;
     QVERIFY(!decodeSnapshot(v3, &error));
     QCOMPARE(error, std::string("snapshot format version 3 is not supported (expected 2)"));
+  }
+
+  // Logs written before motion resistance (snapshot format version 1: no
+  // resistance per link) still restore and re-simulate exactly: the v1
+  // bytes are the v2 ones without that block.
+  void version1StillRead() {
+    std::unique_ptr<World> world = makeWorld("terrains/flat.world.xml");
+    QVERIFY(world);
+    QCOMPARE(world->submit(DriveCmd{0.3, 0}), std::string());
+    for (int i = 0; i < 300; ++i) QVERIFY(world->step());
+    const Snapshot original = world->snapshot();
+    QCOMPARE(original.robots.size(), size_t{1});
+    std::vector<uint8_t> bytes = encodeSnapshot(original);
+    // magic, version, modelKey, step, stepSize, bodies; robots: count, then
+    // actuators (count, 33 bytes each) and the drive and gait fields (44).
+    const size_t robot = 4 + 4 + 8 + 8 + 8 + 8 + original.bodies.size() * 13 * 8 + 8;
+    const size_t block = robot + 8 + original.robots[0].actuators.size() * 33 + 44;
+    const size_t links = original.robots[0].resistance.size();
+    QCOMPARE(links, world->robotModel(0).links.size());
+    uint64_t count = 0;
+    std::memcpy(&count, bytes.data() + block, 8);
+    QCOMPARE(count, uint64_t{links});  // found the block
+    bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(block),
+                bytes.begin() + static_cast<std::ptrdiff_t>(block + 8 + links * 16));
+    bytes[4] = 1;
+    std::string error;
+    std::optional<Snapshot> decoded = decodeSnapshot(bytes, &error);
+    QVERIFY2(decoded, error.c_str());
+    QVERIFY(decoded->robots[0].resistance.empty());
+    verifyRestoresLike(*world, *decoded, "terrains/flat.world.xml");
   }
 
   // The reader refuses another format version, a database without meta and
