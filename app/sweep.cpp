@@ -1,9 +1,7 @@
 #include "app/sweep.h"
 
 #include <algorithm>
-#include <charconv>
 #include <atomic>
-#include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -15,12 +13,15 @@
 
 #include "app/plot_svg.h"
 #include "app/rehearsal.h"
+#include "app/resimulation.h"
+#include "app/session_recorder.h"
 #include "sim/command_check.h"
 #include "sim/command_file.h"
 #include "sim/flight_rules.h"
 #include "sim/model_loader.h"
 #include "sim/random.h"
 #include "sim/terrain_file.h"
+#include "sim/text.h"
 
 namespace sp {
 namespace fs = std::filesystem;
@@ -34,25 +35,11 @@ std::string manifestPath(const std::string& dir) { return dir + "/manifest.txt";
 std::string resultPath(const std::string& dir, int i) { return dir + "/results/" + std::to_string(i) + ".tsv"; }
 std::string statusPath(const std::string& dir, int i) { return dir + "/status/" + std::to_string(i); }
 
-// Shortest text that reads back to the same double.
-std::string exact(double v) {
-  char buffer[32];
-  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, v);
-  return ec == std::errc() ? std::string(buffer, end) : std::string("nan");
-}
-
 // Whether `key` takes only whole numbers (a fractional value is refused).
 bool integerKey(const std::string& key) {
   SimParams probe;
   Diagnostics diag;
   return !applyOverride(probe, key + "=0.5", diag) && applyOverride(probe, key + "=1", diag);
-}
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 // Sample i's seed: the sweep's seed and i alone (splitmix64 of their sum).
@@ -94,7 +81,7 @@ bool samplePlan(const SweepSpec& spec, const std::vector<std::string>& sets, uin
 // Parses "key<TAB>value" lines.
 std::map<std::string, std::string> readTsv(const std::string& path) {
   std::map<std::string, std::string> out;
-  std::istringstream in(readText(path));
+  std::istringstream in(readWholeFile(path));
   for (std::string line; std::getline(in, line);) {
     const size_t tab = line.find('\t');
     if (tab != std::string::npos) out[line.substr(0, tab)] = line.substr(tab + 1);
@@ -149,7 +136,7 @@ bool createSweep(const std::string& dir, const SweepSpec& given, std::string& er
     for (double x : {v.lo, v.hi}) {
       SimParams probe;
       Diagnostics diag;
-      if (!applyOverride(probe, v.key + "=" + exact(x), diag)) {
+      if (!applyOverride(probe, v.key + "=" + shortestText(x), diag)) {
         error = "--vary " + v.key + ": " + diag.format();
         if (error.back() == '\n') error.pop_back();
         return false;
@@ -182,7 +169,7 @@ bool createSweep(const std::string& dir, const SweepSpec& given, std::string& er
     << "rules " << (spec.rules.empty() ? "-" : spec.rules) << "\n"
     << "params " << (spec.params.empty() ? "-" : spec.params) << "\n";
   for (const std::string& o : spec.overrides) m << "set " << o << "\n";
-  for (const SweepVary& v : spec.vary) m << "vary " << v.key << " " << exact(v.lo) << " " << exact(v.hi) << "\n";
+  for (const SweepVary& v : spec.vary) m << "vary " << v.key << " " << shortestText(v.lo) << " " << shortestText(v.hi) << "\n";
   m << "samples " << spec.samples << "\n"
     << "seed " << spec.seed << "\n"
     << "perturb " << (spec.perturb ? "true" : "false") << "\n";
@@ -190,20 +177,20 @@ bool createSweep(const std::string& dir, const SweepSpec& given, std::string& er
     const RehearsalStart& s = *spec.start;
     const auto numbers = [&](const char* key, std::initializer_list<double> values) {
       m << key;
-      for (double v : values) m << " " << exact(v);
+      for (double v : values) m << " " << shortestText(v);
       m << "\n";
     };
     numbers("start_base", {s.base.p.x, s.base.p.y, s.base.p.z, s.base.q.w, s.base.q.x, s.base.q.y, s.base.q.z});
     numbers("start_twist", {s.baseLinear.x, s.baseLinear.y, s.baseLinear.z, s.baseAngular.x, s.baseAngular.y,
                             s.baseAngular.z});
     m << "start_joints";
-    for (double v : s.jointPositions) m << " " << exact(v);
+    for (double v : s.jointPositions) m << " " << shortestText(v);
     m << "\nstart_rates";
-    for (double v : s.jointRates) m << " " << exact(v);
+    for (double v : s.jointRates) m << " " << shortestText(v);
     m << "\n";
     for (const auto& [name, pose] : s.objects)
-      m << "start_object " << name << " " << exact(pose.p.x) << " " << exact(pose.p.y) << " " << exact(pose.p.z) << " "
-        << exact(pose.q.w) << " " << exact(pose.q.x) << " " << exact(pose.q.y) << " " << exact(pose.q.z) << "\n";
+      m << "start_object " << name << " " << shortestText(pose.p.x) << " " << shortestText(pose.p.y) << " " << shortestText(pose.p.z) << " "
+        << shortestText(pose.q.w) << " " << shortestText(pose.q.x) << " " << shortestText(pose.q.y) << " " << shortestText(pose.q.z) << "\n";
   }
   for (int i = 0; i < spec.samples; ++i) {
     const uint64_t seed = spec.consecutiveSeeds ? spec.seed + static_cast<uint64_t>(i) : sampleSeed(spec.seed, i);
@@ -213,7 +200,7 @@ bool createSweep(const std::string& dir, const SweepSpec& given, std::string& er
       const double u = draw.uniform();
       // Integer keys (physics.iterations) draw each whole number alike.
       const double x = integers[&v - spec.vary.data()] ? std::floor(v.lo + (v.hi - v.lo + 1) * u) : v.lo + (v.hi - v.lo) * u;
-      m << " --set " << v.key << "=" << exact(std::min(x, v.hi));
+      m << " --set " << v.key << "=" << shortestText(std::min(x, v.hi));
     }
     m << "\n";
   }
@@ -378,8 +365,6 @@ bool runSweepTask(const std::string& dir, int index, std::string& error) {
   std::string health = "healthy";
   for (const RuleVerdict& v : r.verdicts)
     if (v.rule == Rule::Health && !v.passed) health = v.message();
-  char hash[24];
-  std::snprintf(hash, sizeof hash, "%016" PRIx64, r.endHash);
   std::ostringstream t;
   t << "index\t" << index << "\n"
     << "seed\t" << sample.seed << "\n";
@@ -389,14 +374,14 @@ bool runSweepTask(const std::string& dir, int index, std::string& error) {
   }
   t << "passed\t" << (r.passed ? "true" : "false") << "\n"
     << "summary\t" << r.summary() << "\n"
-    << "end_x\t" << exact(end.base.p.x) << "\n"
-    << "end_y\t" << exact(end.base.p.y) << "\n"
-    << "end_heading_deg\t" << exact(radToDeg(heading(end.base.q))) << "\n"
-    << "min_margin\t" << exact(minMargin) << "\n"
+    << "end_x\t" << shortestText(end.base.p.x) << "\n"
+    << "end_y\t" << shortestText(end.base.p.y) << "\n"
+    << "end_heading_deg\t" << shortestText(radToDeg(heading(end.base.q))) << "\n"
+    << "min_margin\t" << shortestText(minMargin) << "\n"
     << "health\t" << health << "\n"
-    << "hash\t" << hash << "\n"
-    << "simulated_s\t" << exact(r.duration) << "\n"
-    << "wall_s\t" << exact(r.wallSeconds) << "\n";
+    << "hash\t" << hashHex(r.endHash) << "\n"
+    << "simulated_s\t" << shortestText(r.duration) << "\n"
+    << "wall_s\t" << shortestText(r.wallSeconds) << "\n";
   if (!writeFileAtomically(resultPath(dir, index), t.str(), error)) return finish(false);
   return finish(true);
 }
@@ -407,7 +392,7 @@ std::vector<int> pendingTasks(const std::string& dir, std::string& error) {
   std::vector<int> out;
   if (!readSweep(dir, spec, samples, error)) return out;
   for (const SweepSample& s : samples)
-    if (readText(statusPath(dir, s.index)) != "ok\n") out.push_back(s.index);
+    if (readWholeFile(statusPath(dir, s.index)) != "ok\n") out.push_back(s.index);
   return out;
 }
 
@@ -525,7 +510,7 @@ SweepSummary collectSweep(const std::string& dir, std::string& error) {
   PlotSeries margins{"least stability margin", {}, {}, PlotSeries::Style::Points};
   std::vector<std::string> failures;
   for (const SweepSample& s : samples) {
-    const std::string status = readText(statusPath(dir, s.index));
+    const std::string status = readWholeFile(statusPath(dir, s.index));
     if (status.empty()) {
       sum.missing.push_back(s.index);
       continue;
@@ -564,9 +549,9 @@ SweepSummary collectSweep(const std::string& dir, std::string& error) {
   md << "# Sweep " << fs::path(dir).filename().string() << "\n\n"
      << "`" << spec.commands << "` on `" << spec.world << "`, " << spec.samples << " samples, seed " << spec.seed
      << (spec.perturb ? ", each perturbed within the rules' robustness ranges" : "") << ".\n";
-  for (const SweepVary& v : spec.vary) md << "- `" << v.key << "` drawn in [" << exact(v.lo) << ", " << exact(v.hi) << "]\n";
+  for (const SweepVary& v : spec.vary) md << "- `" << v.key << "` drawn in [" << shortestText(v.lo) << ", " << shortestText(v.hi) << "]\n";
   md << "\n**" << sum.passed << " of " << sum.done << " samples that ran passed every rule**";
-  if (sum.done) md << " (" << exact(std::round(1000.0 * sum.passed / sum.done) / 10) << " %)";
+  if (sum.done) md << " (" << shortestText(std::round(1000.0 * sum.passed / sum.done) / 10) << " %)";
   md << ". Missing (never ran): " << (sum.missing.empty() ? "none" : joinIndices(sum.missing))
      << ". Failed to run: " << (sum.failed.empty() ? "none" : joinIndices(sum.failed)) << ".\n\n";
   for (const std::string& f : failures) md << "- " << f << "\n";
