@@ -98,7 +98,7 @@ Outcome predict(const WorldModel& model, const Command& drive, const Profile& p,
     rates = rigidJoints(*rigid, r.jointRates);
   }
   WorldOptions options;
-  options.sensors = false;  // as the console's ghost (app/ghost.cpp): it draws, it does not scan
+  options.sensors = false;  // as the console's ghost (app/ghost/ghost.cpp): it draws, it does not scan
   auto ghost = build(ghostModel, params, options);
   ghost->submit(drive);
   ghost->step();  // the command takes effect; then the state is the robot's

@@ -28,7 +28,7 @@
 #include <thread>
 #include <vector>
 
-#include "app/twin_host.h"
+#include "app/robot/twin_host.h"
 #include "net/auth.h"
 #include "net/robot_server.h"
 #include "sim/model_loader.h"

@@ -5,7 +5,7 @@
 // 1. Logging's cost to the twin (issue 6 goal: at most 5 % slower).
 // Two WorkPartner twins on flat ground, built alike, driving alike, step at
 // the model's 1 kHz. One feeds a SessionLogWriter as runHeadless does
-// (app/headless_runner.cpp RunLog) with the logging rate raised to 1 kHz: a
+// (app/tools/headless_runner.cpp RunLog) with the logging rate raised to 1 kHz: a
 // full-state sample every step, every laser scan (20 Hz), a snapshot and a
 // state hash every sim second. The other logs nothing. Rounds alternate
 // between the two so that machine load hits them alike; the figures are
@@ -40,8 +40,8 @@
 #include <thread>
 #include <vector>
 
-#include "app/session_log.h"
-#include "app/session_recorder.h"
+#include "app/log/session_log.h"
+#include "app/log/session_recorder.h"
 #include "sim/model_loader.h"
 #include "sim/world.h"
 
@@ -305,7 +305,7 @@ int benchSeeks(const std::string& path) {
       a = Clock::now();
       f.scans += reader->laserBetween(t, t + 0.1).size();
       f.laser.push_back(seconds(a, Clock::now()) * 1e3);
-      // The console's replay seek (app/log_player.h: frameAt, laserAt).
+      // The console's replay seek (app/log/log_player.h: frameAt, laserAt).
       if (cold) coldStart();
       a = Clock::now();
       const bool found = reader->sampleAt(t).has_value() && reader->laserAt(t).has_value();

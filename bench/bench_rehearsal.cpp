@@ -16,7 +16,7 @@
 #include <tuple>
 #include <vector>
 
-#include "app/rehearsal.h"
+#include "app/rehearse/rehearsal.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/runner.h"

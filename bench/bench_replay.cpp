@@ -29,9 +29,9 @@
 #include <random>
 #include <vector>
 
-#include "app/log_player.h"
+#include "app/log/log_player.h"
 #include "ui/main_window.h"
-#include "ui/replay_panel.h"
+#include "ui/jobs/replay/replay_panel.h"
 #include "ui/scene_view.h"
 
 namespace {

@@ -9,7 +9,7 @@
 # sample must be at most 100 ms behind the sim time the run can have reached
 # at the kill. That bound is (kill time - FILE's birth time) x rtf, both on
 # CLOCK_REALTIME: the kill time is $EPOCHREALTIME read right after kill(2)
-# returns, the birth time is the kernel's btime of FILE (see app/log_check.cpp
+# returns, the birth time is the kernel's btime of FILE (see app/tools/log_check.cpp
 # for why this over-estimates the loss, never under-estimates it).
 #
 # Environment: SP_BUILD_DIR (default build) holds app/simpartner-sim and

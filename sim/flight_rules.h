@@ -1,6 +1,6 @@
 #pragma once
 // Flight rules: what a rehearsed command sequence must not do to the robot,
-// checked on the twin every step (app/rehearsal.h), with their limits, the
+// checked on the twin every step (app/rehearse/rehearsal.h), with their limits, the
 // guard's thresholds for the relayed run, and the ranges of the robustness
 // rehearsals, all from a rules file (`key = value`, config/flight.rules lists
 // every key with its default and where the default comes from; the format in
@@ -46,7 +46,7 @@ struct FlightRules {
   double maxYawRate = 60;            ///< [deg/s] base yaw rate
   // The rehearsal
   double settle = 2;                 ///< [s] simulated after the last command's time
-  // The relay (app/sequence_relay.h): when the robot refuses to start, when the guard aborts
+  // The relay (app/rehearse/sequence_relay.h): when the robot refuses to start, when the guard aborts
   double startPosition = 0.10;       ///< [m] robot's base from the rehearsal's start
   double startHeading = 5;           ///< [deg]
   double guardPosition = 0.30;       ///< [m] telemetry's base from the rehearsed one at the same time

@@ -15,8 +15,8 @@
 #include <memory>
 #include <optional>
 
-#include "app/console_session.h"
-#include "ui/control_panel.h"
+#include "app/console/console_session.h"
+#include "ui/jobs/drive/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/live_plots.h"
 #include "ui/main_window.h"

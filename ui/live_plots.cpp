@@ -25,7 +25,7 @@
 #include <cmath>
 #include <limits>
 
-#include "app/plot.h"  // plotSeriesColor: the report plots' palette
+#include "app/validation/plot.h"  // plotSeriesColor: the report plots' palette
 #include "sim/math.h"
 
 namespace sp {

@@ -263,7 +263,7 @@ class LaserPlot : public LivePlot {
   QValueAxis* forwardAxis_ = nullptr;  ///< vertical: sensor x
 };
 
-/// The predictive ghost's error (app/ghost.h): for each telemetry frame,
+/// The predictive ghost's error (app/ghost/ghost.h): for each telemetry frame,
 /// how far the robot was from where the ghost had shown it for that time,
 /// in position [cm] (left axis) and heading [deg] (right axis), over the
 /// last 30 s of robot time (the status bar gives the median of 10 s).

@@ -33,19 +33,19 @@
 
 #include <cmath>
 
-#include "app/console_session.h"
-#include "app/session_recorder.h"
+#include "app/console/console_session.h"
+#include "app/log/session_recorder.h"
 #include "ui/connect_dialog.h"
-#include "ui/control_panel.h"
+#include "ui/jobs/drive/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/limit_spin_box.h"
 #include "ui/live_plots.h"
 #include "ui/robot_connection.h"
 #include "ui/robot_feed.h"
-#include "ui/replay_panel.h"
+#include "ui/jobs/replay/replay_panel.h"
 #include "ui/scene_view.h"
-#include "ui/sequence_panel.h"
-#include "ui/terrain_panel.h"
+#include "ui/jobs/sequence/sequence_panel.h"
+#include "ui/jobs/terrain/terrain_panel.h"
 
 namespace sp {
 

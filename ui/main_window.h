@@ -6,7 +6,7 @@
 //
 // The session itself (the stand-in robot it runs on loopback or the robot
 // elsewhere it connects to, the world, the log) is a Qt-free ConsoleSession
-// (app/console_session.h); the views draw what a RobotFeed gives them (today
+// (app/console/console_session.h); the views draw what a RobotFeed gives them (today
 // the live link, ui/robot_feed.h).
 //
 // Thread: GUI thread only. The stand-in's physics and network threads and
@@ -23,7 +23,7 @@
 #include <utility>
 #include <vector>
 
-#include "app/robot_frame.h"
+#include "app/console/robot_frame.h"
 #include "net/message.h"
 #include "net/robot_client.h"
 #include "sim/robot_model.h"

@@ -12,7 +12,7 @@
 #include <atomic>
 #include <memory>
 
-#include "app/sequence_guard.h"
+#include "app/rehearse/sequence_guard.h"
 #include "net/robot_client.h"
 
 namespace sp {

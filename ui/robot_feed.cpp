@@ -2,7 +2,8 @@
 
 #include <chrono>
 
-#include "app/console_session.h"
+#include "app/console/console_session.h"
+#include "ui/jobs/replay/replay_panel.h"
 #include "ui/robot_connection.h"
 
 namespace sp {
@@ -57,6 +58,68 @@ LiveLinkFeed::LiveLinkFeed(RobotConnection* connection, ConsoleSession* session,
 void LiveLinkFeed::linkEvent(const QString& kind, const QString& text, const char* logKind) {
   if (logKind) session_->event(logKind, text.toStdString());
   emit event(kind, text);
+}
+
+const WorldModel* LiveLinkFeed::shownWorld() const { return session_->world(); }
+
+void LiveLinkFeed::announceWorld() {
+  if (const WorldModel* w = session_->world()) emit worldChanged(*w);
+}
+
+ReplayFeed::ReplayFeed(ReplayPanel* panel, QObject* parent) : RobotFeed(parent), panel_(panel) {
+  connect(panel, &ReplayPanel::frame, this, &RobotFeed::frame);
+  connect(panel, &ReplayPanel::laser, this, &RobotFeed::laser);
+  connect(panel, &ReplayPanel::terrain, this, &RobotFeed::terrain);
+  connect(panel, &ReplayPanel::opened, this, &RobotFeed::worldChanged);
+}
+
+const WorldModel* ReplayFeed::shownWorld() const {
+  const LogPlayer* player = panel_->player();
+  return player ? &player->world() : nullptr;
+}
+
+void ReplayFeed::seek(double time) { panel_->seek(time); }
+
+GhostFeed::GhostFeed(ConsoleSession* session, QObject* parent) : RobotFeed(parent), session_(session) {}
+
+const WorldModel* GhostFeed::shownWorld() const { return session_->world(); }
+
+void GhostFeed::reset() {
+  version_ = -1;
+  trailTime_ = -1;
+}
+
+void GhostFeed::poll() {
+  const Ghost* ghost = session_->ghost();
+  if (!ghost || ghost->viewVersion() == version_) return;
+  const GhostView v = ghost->view();
+  version_ = v.version;
+  if (v.version == 0) return;  // nothing predicted yet: the ghost stays where it is
+  RobotFrame f;
+  f.time = v.time;
+  f.base = v.base;
+  f.jointPositions = v.jointPositions;
+  emit frame(f);
+  if (v.trailTime != trailTime_) {
+    trailTime_ = v.trailTime;
+    emit trail(v.trail);
+  }
+}
+
+FeedSwitch::FeedSwitch(RobotFeed* live, QObject* parent) : QObject(parent), live_(live), current_(nullptr) {
+  show(live);
+}
+
+void FeedSwitch::show(RobotFeed* feed) {
+  if (!feed) feed = live_;
+  if (feed == current_) return;
+  for (const QMetaObject::Connection& c : links_) disconnect(c);
+  links_ = {connect(feed, &RobotFeed::frame, this, &FeedSwitch::frame),
+            connect(feed, &RobotFeed::laser, this, &FeedSwitch::laser),
+            connect(feed, &RobotFeed::terrain, this, &FeedSwitch::terrain),
+            connect(feed, &RobotFeed::worldChanged, this, &FeedSwitch::worldChanged)};
+  current_ = feed;
+  emit switched(feed);
 }
 
 }  // namespace sp

@@ -82,7 +82,7 @@ class SceneView : public QOpenGLWidget {
   /// while it is hidden.
   Pose drawnGhostBasePose() const;
 
-  /// The rehearsal (ui/sequence_panel.h): a second translucent robot, amber,
+  /// The rehearsal (ui/jobs/sequence/sequence_panel.h): a second translucent robot, amber,
   /// at the rehearsal scrubber's time, and the rehearsed path on the ground;
   /// hidden until setRehearsalVisible(true).
   void setRehearsalState(const Pose& base, const std::vector<double>& jointPositions);

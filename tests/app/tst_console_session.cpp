@@ -1,4 +1,4 @@
-// Tests of sp::ConsoleSession (app/console_session.h): the console's session
+// Tests of sp::ConsoleSession (app/console/console_session.h): the console's session
 // without its window. A real stand-in robot on loopback, real session logs.
 
 #include <QFileInfo>
@@ -11,10 +11,10 @@
 #include <memory>
 #include <mutex>
 
-#include "app/console_session.h"
-#include "app/session_log.h"
-#include "app/session_recorder.h"
-#include "app/stand_in.h"
+#include "app/console/console_session.h"
+#include "app/log/session_log.h"
+#include "app/log/session_recorder.h"
+#include "app/robot/stand_in.h"
 #include "net/robot_client.h"
 #include "sim/command_file.h"
 

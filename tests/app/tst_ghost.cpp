@@ -1,4 +1,4 @@
-// The predictive ghost (app/ghost.h) against a real stand-in over emulated
+// The predictive ghost (app/ghost/ghost.h) against a real stand-in over emulated
 // slow links: the console session (stand-in on loopback with the delay each
 // way, the ghost on its own threads) and a RobotClient driving as the
 // console does. Each telemetry frame is compared with what the ghost had
@@ -21,8 +21,8 @@
 #include <mutex>
 #include <thread>
 
-#include "app/console_session.h"
-#include "app/session_log.h"
+#include "app/console/console_session.h"
+#include "app/log/session_log.h"
 #include "net/robot_client.h"
 #include "sim/model_loader.h"
 #include "sim/readout.h"

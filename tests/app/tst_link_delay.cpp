@@ -14,7 +14,7 @@
 #include <optional>
 #include <thread>
 
-#include "app/stand_in.h"
+#include "app/robot/stand_in.h"
 #include "net/robot_client.h"
 #include "tests/app/shared_state.h"
 

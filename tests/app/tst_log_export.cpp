@@ -8,8 +8,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "app/headless_runner.h"
-#include "app/log_export.h"
+#include "app/tools/headless_runner.h"
+#include "app/log/log_export.h"
 #include "tests/app/demo_log.h"
 
 using namespace sp;

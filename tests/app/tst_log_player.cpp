@@ -1,4 +1,4 @@
-// Replaying a session log (app/log_player.h): a log written by a scripted
+// Replaying a session log (app/log/log_player.h): a log written by a scripted
 // headless run is opened, the logged world rebuilt from the files it stores,
 // and the state at any time read from the log: bit for bit what a fresh twin
 // running the same commands has at that sample's step (the twin is
@@ -15,13 +15,13 @@
 #include <filesystem>
 #include <sstream>
 
-#include "app/headless_runner.h"
-#include "app/console_session.h"
-#include "app/log_player.h"
-#include "app/session_recorder.h"
-#include "app/resimulation.h"
-#include "app/stand_in.h"
-#include "app/telemetry_recorder.h"
+#include "app/tools/headless_runner.h"
+#include "app/console/console_session.h"
+#include "app/log/log_player.h"
+#include "app/log/session_recorder.h"
+#include "app/log/resimulation.h"
+#include "app/robot/stand_in.h"
+#include "app/log/telemetry_recorder.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/runner.h"

@@ -1,5 +1,5 @@
-// Tests of sp::renderPlotSvg / writePlotSvg (app/plot_svg.h) and sp::toCsv
-// (app/plot.h): the report plots of `simpartner-sim validate`, without Qt.
+// Tests of sp::renderPlotSvg / writePlotSvg (app/validation/plot_svg.h) and sp::toCsv
+// (app/validation/plot.h): the report plots of `simpartner-sim validate`, without Qt.
 // The SVG is parsed back with Qt's XML reader to check what it draws.
 
 #include <QtTest>
@@ -11,8 +11,8 @@
 #include <limits>
 #include <string>
 
-#include "app/plot.h"
-#include "app/plot_svg.h"
+#include "app/validation/plot.h"
+#include "app/validation/plot_svg.h"
 
 using sp::PlotSeries;
 using sp::PlotSpec;

@@ -1,5 +1,5 @@
 // Rehearsal of command sequences on the twin with the flight rules
-// (app/rehearsal.h, sim/flight_rules.h): a typo is caught with its line, a
+// (app/rehearse/rehearsal.h, sim/flight_rules.h): a typo is caught with its line, a
 // sequence that tips the robot over the test track's bumps fails the
 // stability rule after its cause and before the fall, the same drive without
 // the cause passes, and the rules file reports its errors by line.
@@ -10,7 +10,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "app/rehearsal.h"
+#include "app/rehearse/rehearsal.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/rigid.h"

@@ -11,9 +11,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "app/headless_runner.h"
-#include "app/resimulation.h"
-#include "app/session_log.h"
+#include "app/tools/headless_runner.h"
+#include "app/log/resimulation.h"
+#include "app/log/session_log.h"
 #include "tests/app/demo_log.h"
 
 using namespace sp;

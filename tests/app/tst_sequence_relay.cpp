@@ -1,5 +1,5 @@
 // Relaying a rehearsed sequence to a real stand-in over loopback
-// (app/sequence_relay.h, SEQUENCE / SEQUENCE_STATE / ABORT): a sequence that
+// (app/rehearse/sequence_relay.h, SEQUENCE / SEQUENCE_STATE / ABORT): a sequence that
 // passed is run on board and its hash matches there; a stale start is
 // refused; with the stand-in's friction changed behind the console's back
 // the guard trips and the robot stops; the robot refuses a sequence whose
@@ -16,9 +16,9 @@
 #include <cmath>
 #include <deque>
 
-#include "app/sequence_relay.h"
-#include "app/session_log.h"
-#include "app/stand_in.h"
+#include "app/rehearse/sequence_relay.h"
+#include "app/log/session_log.h"
+#include "app/robot/stand_in.h"
 #include "net/robot_client.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"

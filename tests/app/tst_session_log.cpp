@@ -12,9 +12,9 @@
 #include <sstream>
 #include <thread>
 
-#include "app/headless_runner.h"
-#include "app/session_log.h"
-#include "app/snapshot_codec.h"
+#include "app/tools/headless_runner.h"
+#include "app/log/session_log.h"
+#include "app/log/snapshot_codec.h"
 #include "sim/model_loader.h"
 #include "sim/world.h"
 

@@ -1,4 +1,4 @@
-// The stand-in robot as one object (app/stand_in.h): a console client drives
+// The stand-in robot as one object (app/robot/stand_in.h): a console client drives
 // it over loopback, and its session log then holds the files, the operator's
 // commands, samples, link and e-stop events and snapshots, and re-simulates
 // without divergence. Also: telemetry carries the world's dynamic objects,
@@ -20,9 +20,9 @@
 #include <sstream>
 #include <thread>
 
-#include "app/resimulation.h"
-#include "app/session_log.h"
-#include "app/stand_in.h"
+#include "app/log/resimulation.h"
+#include "app/log/session_log.h"
+#include "app/robot/stand_in.h"
 #include "net/robot_client.h"
 #include "tests/app/shared_state.h"
 

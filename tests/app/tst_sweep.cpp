@@ -1,4 +1,4 @@
-// Sweeps (app/sweep.h): the manifest is what a task reads, a sample gives
+// Sweeps (app/sweep/sweep.h): the manifest is what a task reads, a sample gives
 // the same end hash on threads of one process and in a process of its own
 // (as a job array's task runs), missing and failed tasks are named and a
 // resume runs only those. Real files in a temporary folder, the real
@@ -10,7 +10,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "app/sweep.h"
+#include "app/sweep/sweep.h"
 #include "tests/app/sweep_results.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"

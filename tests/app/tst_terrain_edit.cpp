@@ -12,10 +12,10 @@
 #include <deque>
 #include <random>
 
-#include "app/log_player.h"
-#include "app/resimulation.h"
-#include "app/stand_in.h"
-#include "app/terrain_editor.h"
+#include "app/log/log_player.h"
+#include "app/log/resimulation.h"
+#include "app/robot/stand_in.h"
+#include "app/console/terrain_editor.h"
 #include "net/frame.h"
 #include "net/robot_client.h"
 #include "sim/command.h"

@@ -1,4 +1,4 @@
-// Tests of sp::TwinHost (app/twin_host.h): the twin on its own physics
+// Tests of sp::TwinHost (app/robot/twin_host.h): the twin on its own physics
 // thread behind the robot port, stepping through sp::Runner and publishing
 // sp::readRobot's read-out.
 
@@ -10,8 +10,8 @@
 #include <memory>
 #include <thread>
 
-#include "app/session_recorder.h"
-#include "app/twin_host.h"
+#include "app/log/session_recorder.h"
+#include "app/robot/twin_host.h"
 #include "sim/model_loader.h"
 #include "sim/readout.h"
 

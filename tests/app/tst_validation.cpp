@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "app/validation.h"
+#include "app/validation/validation.h"
 
 using namespace sp;
 

@@ -20,7 +20,7 @@
 #include <random>
 #include <thread>
 
-#include "app/twin_host.h"
+#include "app/robot/twin_host.h"
 #include "net/auth.h"
 #include "net/robot_server.h"
 #include "sim/model_loader.h"

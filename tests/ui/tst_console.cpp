@@ -28,10 +28,10 @@
 #include <cmath>
 #include <fstream>
 
-#include "app/console_session.h"
-#include "app/session_log.h"
+#include "app/console/console_session.h"
+#include "app/log/session_log.h"
 #include "ui/connect_dialog.h"
-#include "ui/control_panel.h"
+#include "ui/jobs/drive/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/live_plots.h"
 #include "tests/ui/console_fixture.h"

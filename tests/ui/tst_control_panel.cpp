@@ -1,4 +1,4 @@
-// The operator's controls (ui/control_panel.h) on the WorkPartner model:
+// The operator's controls (ui/jobs/drive/control_panel.h) on the WorkPartner model:
 // limits taken from the robot, keyboard steps, coalesced drive commands,
 // joint targets in SI units, gait and stop.
 
@@ -13,7 +13,7 @@
 
 #include "headless_default.h"
 #include "sim/model_loader.h"
-#include "ui/control_panel.h"
+#include "ui/jobs/drive/control_panel.h"
 #include "ui/limit_spin_box.h"
 
 using namespace sp;

@@ -30,7 +30,7 @@
 
 #include "headless_default.h"
 #include "ui/live_plots.h"
-#include "app/plot.h"
+#include "app/validation/plot.h"
 
 using sp::LaserPlot;
 using sp::LivePlot;

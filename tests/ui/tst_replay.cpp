@@ -19,12 +19,12 @@
 
 #include <cmath>
 
-#include "app/log_player.h"
-#include "ui/control_panel.h"
+#include "app/log/log_player.h"
+#include "ui/jobs/drive/control_panel.h"
 #include "tests/ui/console_fixture.h"
 #include "ui/main_window.h"
-#include "ui/replay_panel.h"
-#include "ui/sequence_panel.h"
+#include "ui/jobs/replay/replay_panel.h"
+#include "ui/jobs/sequence/sequence_panel.h"
 #include "ui/scene_view.h"
 
 using namespace sp;

@@ -20,18 +20,18 @@
 #include <mutex>
 #include <thread>
 
-#include "app/console_session.h"
-#include "app/sequence_relay.h"
-#include "app/stand_in.h"
+#include "app/console/console_session.h"
+#include "app/rehearse/sequence_relay.h"
+#include "app/robot/stand_in.h"
 #include "net/robot_client.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "ui/robot_connection.h"
-#include "app/session_log.h"
+#include "app/log/session_log.h"
 #include "tests/ui/console_fixture.h"
 #include "ui/main_window.h"
 #include "ui/scene_view.h"
-#include "ui/sequence_panel.h"
+#include "ui/jobs/sequence/sequence_panel.h"
 
 using namespace sp;
 
@@ -198,7 +198,7 @@ class TestSequencePanel : public QObject {
                            scene->drawnRehearsalBasePose().p.y - at->base.p.y) < 1e-3);
 
     // Robustness on cluster: the same perturbed rehearsals written as a sweep
-    // (app/sweep.h), from the robot's state; no cluster answers here, so the
+    // (app/sweep/sweep.h), from the robot's state; no cluster answers here, so the
     // status names the folder and what sbatch said, or the command to run.
     const QString sweep = dir_.filePath("cluster-sweep");
     QVERIFY(p->robustnessOnCluster(sweep));

@@ -13,13 +13,13 @@
 #include <algorithm>
 #include <cmath>
 
-#include "app/console_session.h"
+#include "app/console/console_session.h"
 #include "sim/model_loader.h"
 #include "tests/ui/console_fixture.h"
-#include "ui/control_panel.h"
+#include "ui/jobs/drive/control_panel.h"
 #include "ui/main_window.h"
 #include "ui/scene_view.h"
-#include "ui/terrain_panel.h"
+#include "ui/jobs/terrain/terrain_panel.h"
 
 using namespace sp;
 

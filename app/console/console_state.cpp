@@ -1,0 +1,159 @@
+#include "app/console/console_state.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace sp {
+
+namespace {
+
+// Fixed decimals in the C locale's form ("4.8"), as the operator reads it.
+std::string fixed(double value, int decimals) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", decimals, value);
+  return text;
+}
+
+}  // namespace
+
+bool ConsoleState::connection(net::ConnectionState state, std::string detail) {
+  connection_ = state;
+  connectionDetail_ = std::move(detail);
+  bool lost = false;
+  if (state != net::ConnectionState::Ready) {
+    lost = lease_;
+    lease_ = false;
+    // Staleness is a connected robot that went quiet; a dropped link says so itself.
+    stale_ = false;
+  }
+  ++revision_;
+  return lost;
+}
+
+bool ConsoleState::lease(bool yours) {
+  const bool lost = lease_ && !yours;
+  if (lease_ != yours) ++revision_;
+  lease_ = yours;
+  return lost;
+}
+
+void ConsoleState::failsafeReason(std::string text) {
+  failsafeReason_ = std::move(text);
+  ++revision_;
+}
+
+void ConsoleState::filesMismatch(std::string text) {
+  if (text == filesMismatch_) return;
+  filesMismatch_ = std::move(text);
+  ++revision_;
+}
+
+void ConsoleState::terrain(bool heightfield, double width, double depth) {
+  heightfield_ = heightfield;
+  terrainWidth_ = width;
+  terrainDepth_ = depth;
+  ++revision_;
+}
+
+FrameChanges ConsoleState::frame(const RobotFrame& f, double wall, std::optional<double> edge) {
+  FrameChanges changes;
+  lastFrameWall_ = wall;
+  haveFrame_ = true;
+  if (stale_) {
+    stale_ = false;
+    changes.staleEnded = true;
+    ++revision_;
+  }
+  // Near a heightfield's edge the operator is warned before the robot
+  // drives off into a fall (and a divergence); the distance shown moves in
+  // 0.1 m steps so the banner is not rewritten at every frame.
+  const bool wasNear = nearEdge();
+  edge_ = edge;
+  if (wasNear != nearEdge() || (nearEdge() && std::abs(*edge_ - shownEdge_) > 0.1)) {
+    shownEdge_ = edge_.value_or(0);
+    changes.banner = true;
+  }
+  if (f.failsafe != failsafe_ || f.estop != estop_ || f.health != health_) {
+    changes.latchedNow = (f.failsafe && !failsafe_) || (f.estop && !estop_);
+    failsafe_ = f.failsafe;
+    estop_ = f.estop;
+    health_ = f.health;
+    changes.latches = true;
+    changes.banner = true;
+  }
+  if (changes.banner) ++revision_;
+  return changes;
+}
+
+bool ConsoleState::tick(double wall) {
+  const bool stale = connected() && haveFrame_ && wall - lastFrameWall_ > config_.staleAfter;
+  if (stale == stale_) return false;
+  stale_ = stale;
+  ++revision_;
+  return true;
+}
+
+void ConsoleState::clearFrames() {
+  haveFrame_ = false;
+  stale_ = false;
+  edge_.reset();
+  shownEdge_ = 0;
+  ++revision_;
+}
+
+void ConsoleState::replay(std::string label) {
+  replay_ = std::move(label);
+  ++revision_;
+}
+
+std::string ConsoleState::staleText(double wall) const {
+  if (!stale_ || replaying()) return {};
+  const std::string age = fixed(dataAge(wall), 1);
+  return "no data " + age + " s: the robot drawn is where it was " + age + " s ago";
+}
+
+std::vector<std::string> ConsoleState::bannerLines() const {
+  std::vector<std::string> lines;
+  // While a replay is shown, the live robot's alarms still reach the
+  // operator, saying which robot they are about.
+  const std::string live = replaying() ? "Live robot: " : "";
+  if (replaying())
+    lines.push_back("Replay of " + replay_ + ": the live robot is not shown and the drive keys act on nothing. "
+                    "Close the replay to drive.");
+  if (!health_.empty()) lines.push_back(live + "The twin diverged and stopped: " + health_);
+  if (estop_) lines.push_back(live + "E-STOP latched: the robot is stopped. Re-arm to continue.");
+  if (failsafe_)
+    lines.push_back(live + (failsafeReason_.empty()
+                                ? "FAILSAFE latched: the robot stopped itself. Re-arm to continue."
+                                : "FAILSAFE latched: " + failsafeReason_ + "; the robot stopped. Re-arm to continue."));
+  if (nearEdge() && !replaying()) {
+    lines.push_back(*edge_ < 0 ? "The robot is off the terrain (" + fixed(-*edge_, 1) +
+                                     " m beyond its edge): Robot ▸ Reset puts it back."
+                               : "Near the terrain's edge: " + fixed(*edge_, 1) + " m left of the " +
+                                     fixed(terrainWidth_, 1) + " × " + fixed(terrainDepth_, 1) +
+                                     " m heightfield; beyond it the robot falls.");
+  }
+  if (!filesMismatch_.empty()) lines.push_back(live + filesMismatch_);
+  if (connection_ == net::ConnectionState::Waiting || connection_ == net::ConnectionState::Refused)
+    lines.push_back(live + "Robot link down (" + connectionDetail_ + "): the robot's own deadman stops it; reconnecting.");
+  return lines;
+}
+
+std::string ConsoleState::controlsRefusal() const {
+  if (replaying()) return "A replay is shown: close it (File ▸ Close replay) to drive the live robot";
+  if (!connected()) return "Not connected to the robot";
+  if (!lease_) return "Take control first (Robot ▸ Take control)";
+  if (latched()) return "The robot is stopped and latched: re-arm first";
+  return {};
+}
+
+HealthStatus ConsoleState::health() const {
+  if (replaying()) return {"replay", HealthLevel::Neutral, "The views show a logged session, not the live robot"};
+  if (!health_.empty()) return {"diverged", HealthLevel::Alarm, health_};
+  if (stale_) return {"no data", HealthLevel::Warning, {}};
+  if (!connected()) return {"not connected", HealthLevel::Neutral, {}};
+  if (haveFrame_) return {"healthy", HealthLevel::Good, {}};
+  return {"no telemetry", HealthLevel::Neutral, {}};
+}
+
+}  // namespace sp

@@ -1,0 +1,147 @@
+#pragma once
+// What the console knows of the robot link and shows around the 3D view,
+// computed from what arrives (connection changes, the lease, telemetry
+// frames, the robot's events) and what the operator opens (a replay): the
+// latches, whether the data is stale, the terrain's edge, the banner's
+// lines, the health text, which controls may act and why not. Plain values,
+// no Qt: the window only draws what this says, and tests drive it without
+// a window.
+//
+//   sp::ConsoleState state;
+//   state.connection(net::ConnectionState::Ready, "");
+//   state.lease(true);
+//   state.frame(frame, wallSeconds, edge);   // every telemetry frame
+//   state.tick(wallSeconds);                 // at the panel timer: staleness
+//   if (!state.controlsRefusal().empty()) disable controls, say why;
+//
+// Live frames update the state even while a replay is shown: the replay
+// changes what is shown and what the controls may do, never what is known
+// of the live robot.
+//
+// Thread: its owner's only (the console's GUI thread).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/console/robot_frame.h"
+#include "net/robot_client.h"
+
+namespace sp {
+
+/// How the health field looks.
+enum class HealthLevel { Neutral, Good, Warning, Alarm };
+
+/// The status bar's health field: what is shown, and how loudly.
+struct HealthStatus {
+  std::string text;     ///< "healthy", "no data", "diverged", ...
+  HealthLevel level = HealthLevel::Neutral;
+  std::string detail;   ///< the tooltip: the twin's own words, "" if none
+};
+
+/// What a frame changed, for the caller to act on (each bit is rare).
+struct FrameChanges {
+  bool latchedNow = false;   ///< an e-stop or failsafe latched: the controls go back to the robot's state
+  bool latches = false;      ///< failsafe, e-stop or health changed
+  bool banner = false;       ///< the banner's lines changed
+  bool staleEnded = false;   ///< data flows again after being stale
+};
+
+class ConsoleState {
+ public:
+  struct Config {
+    double staleAfter = 0.5;   ///< [s] without telemetry the data is stale (console.stale_after)
+    double edgeWarning = 1.5;  ///< [m] within this of a heightfield's edge the banner warns
+  };
+  ConsoleState() = default;
+  explicit ConsoleState(Config config) : config_(config) {}
+  void setConfig(Config config) { config_ = config; }
+  const Config& config() const { return config_; }
+
+  // --- What arrives -------------------------------------------------------
+  /// The link's state changed. Returns true when the lease was held and is
+  /// lost with it (the controls go back to the robot's state).
+  bool connection(net::ConnectionState state, std::string detail);
+  /// The robot's LEASE_STATE: whether this console holds the lease. Returns
+  /// true when it was held and is not any more.
+  bool lease(bool yours);
+  /// The robot said why it stopped (EVENT failsafe): the banner repeats it.
+  void failsafeReason(std::string text);
+  /// The robot runs other files than the console's ("" = the same).
+  void filesMismatch(std::string text);
+  /// The drawn terrain: a heightfield of `width` × `depth` [m], or a plane.
+  void terrain(bool heightfield, double width, double depth);
+  /// A live telemetry frame arrived at wall time `wall` [s]; `edge` is how
+  /// far its base is inside the heightfield's edge [m] (nullopt on a plane).
+  FrameChanges frame(const RobotFrame& frame, double wall, std::optional<double> edge);
+  /// At wall time `wall` [s]: true when staleness began or ended.
+  bool tick(double wall);
+  /// A new session or world: no frame yet, no edge, nothing latched from
+  /// the old robot's frames.
+  void clearFrames();
+  /// A replay (named `label`) is shown instead of the live robot, or ("") not.
+  void replay(std::string label);
+
+  // --- What the console shows and allows ----------------------------------
+  net::ConnectionState connectionState() const { return connection_; }
+  const std::string& connectionDetail() const { return connectionDetail_; }
+  bool connected() const { return connection_ == net::ConnectionState::Ready; }
+  bool leaseHeld() const { return lease_; }
+  bool failsafe() const { return failsafe_; }
+  bool estop() const { return estop_; }
+  bool latched() const { return failsafe_ || estop_; }
+  /// The twin's divergence report, "" while healthy.
+  const std::string& healthReport() const { return health_; }
+  bool haveFrame() const { return haveFrame_; }
+  /// No live telemetry for config().staleAfter while connected.
+  bool stale() const { return stale_; }
+  /// [s] since the last live frame (0 before the first).
+  double dataAge(double wall) const { return haveFrame_ ? wall - lastFrameWall_ : 0; }
+  /// The line over the 3D view while the data is stale, "" when not shown
+  /// (fresh data, or a replay shown).
+  std::string staleText(double wall) const;
+  const std::optional<double>& edgeDistance() const { return edge_; }
+  bool replaying() const { return !replay_.empty(); }
+  const std::string& replayLabel() const { return replay_; }
+
+  /// The banner over the 3D view, a line each; empty when nothing is wrong.
+  std::vector<std::string> bannerLines() const;
+  /// "" when the drive controls and keys may command the live robot now,
+  /// else why not, for the operator (a replay shown comes first).
+  std::string controlsRefusal() const;
+  /// The status bar's health field for what is shown.
+  HealthStatus health() const;
+  // Robot menu items.
+  bool canReconnect() const { return connection_ == net::ConnectionState::Stopped; }
+  bool canDisconnect() const { return connection_ != net::ConnectionState::Stopped; }
+  bool canTakeControl() const { return connected() && !lease_; }
+  bool canReleaseControl() const { return connected() && lease_; }
+  bool canRearm() const { return connected() && latched(); }
+
+  /// Counts changes of anything bannerLines(), controlsRefusal(), health()
+  /// or the menu items depend on: a view redraws when it moves.
+  uint64_t revision() const { return revision_; }
+
+ private:
+  bool nearEdge() const { return edge_ && *edge_ < config_.edgeWarning; }
+
+  Config config_;
+  net::ConnectionState connection_ = net::ConnectionState::Stopped;
+  std::string connectionDetail_;
+  bool lease_ = false;
+  bool failsafe_ = false, estop_ = false;
+  std::string health_;
+  std::string failsafeReason_;
+  std::string filesMismatch_;
+  bool heightfield_ = false;
+  double terrainWidth_ = 0, terrainDepth_ = 0;
+  std::optional<double> edge_;
+  double shownEdge_ = 0;  // the distance the banner shows (moves in 0.1 m steps)
+  bool haveFrame_ = false, stale_ = false;
+  double lastFrameWall_ = 0;
+  std::string replay_;
+  uint64_t revision_ = 0;
+};
+
+}  // namespace sp

@@ -1,0 +1,230 @@
+#pragma once
+// The predictive ghost: the console's own twin of the robot, re-anchored to
+// telemetry and run ahead over the link's delay, so the operator sees the
+// robot as it will be when a command sent now arrives (not as it was a round
+// trip ago), and the path it takes under the commands sent (the trail).
+//
+// Time. Telemetry carries robot time T. The console estimates the robot's
+// clock as   robot_now(w) = w + offset,  offset = max over the last 2 s of
+// (T - arrival wall time) (the least-delayed frame bounds it best, as NTP's
+// filters do), and the ghost shows robot time
+//     ghost(w) = w + offset + round trip
+// (the robot's now plus the uplink's one-way delay). A command sent at wall
+// time s is taken to arrive at robot time ghost(s). The robot is assumed to
+// run at real time.
+//
+// Three threads, each owning one World built from the same model with the
+// ghost's profile (ghost.step, ghost.iterations; sensors off). The
+// ghost.hold joints (the upper body, the legs' hips and knees; the wheels
+// and the articulation keep turning) are welded where telemetry reports
+// them (sim/rigid.h: fewer bodies and rows, 2-3x faster, and a coarse step
+// stays accurate over bumps, docs/performance.md) while the robot keeps them
+// still and nothing sent moves them; a gait, a joint command in flight or
+// the joints moving switch the ghost to the full robot, and holding resumes
+// (welded anew) once they have been still for 1 s. Held links are drawn as
+// telemetry reports them.
+//   anchor   on the newest telemetry (at most ghost.anchor_rate per second):
+//            the commands in effect by then, the frame's state through
+//            linkMotions + World::setRobotMotion, then run to ghost(now)
+//            applying the commands still in flight at their arrival times;
+//            publishes that state (a Snapshot) as the new base;
+//   present  every frame (16 ms) and at once on a new command or base: from
+//            the base, advance to ghost(now), applying commands as they fall
+//            due; publishes the view (what the 3D view draws) and remembers
+//            what it showed for which robot time;
+//   trail    from the present state, ghost.horizon seconds ahead under the
+//            commands sent: base positions every 0.1 s (restarted at once
+//            when a command is sent; otherwise a new one from the newest
+//            state when the last is done, at most 4 times a second).
+// A keypress thus reaches the view within a frame however long the round
+// trip, while re-anchoring (which re-runs the whole round trip) goes on
+// beside it. The anchor and trail threads run at nice 10: best effort,
+// never at the expense of the robot's twin or the window's frames.
+//
+// Error. Each telemetry frame is compared with what the present thread
+// showed for that frame's robot time: horizontal distance and yaw
+// difference (anchor() returns it; errorMedian() over 10 s of robot time).
+//
+// Latches: while a frame reports an e-stop or failsafe, the robot is held
+// still; the ghost stops the robot too and ignores the commands in flight
+// (the robot refuses commands while latched).
+//
+// Thread: anchor(), commandSent(), view(), errorMedian() from any one
+// thread (the console's GUI thread); the three workers are internal.
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/console/robot_frame.h"
+#include "sim/command.h"
+#include "sim/params.h"
+#include "sim/rigid.h"
+#include "sim/robot_model.h"
+#include "sim/world.h"
+
+namespace sp {
+
+/// What the ghost shows now.
+struct GhostView {
+  int64_t version = 0;       ///< counts views; 0 = none yet (no telemetry)
+  double time = 0;           ///< [s] robot time shown
+  double span = 0;           ///< [s] how far ahead of the newest telemetry that is
+  Pose base;                 ///< link 0 in the world
+  std::vector<double> jointPositions;  ///< model joint order
+  std::vector<ObjectReadout> objects;  ///< dynamic objects
+  std::vector<Vec3> trail;   ///< the base's path on the ground (x, y, terrain height) from `time` on, every 0.1 s, over ghost.horizon
+  double trailTime = 0;      ///< [s] robot time the trail starts at
+  std::string problem;       ///< "" or why the ghost cannot predict (it diverged, a bad frame)
+  uint64_t commands = 0;     ///< of the commands sent (commandsSent()), how many this state has had
+};
+
+/// A telemetry frame against what the ghost had shown for its time.
+struct GhostError {
+  double time = 0;      ///< [s] robot time of the frame
+  double made = 0;      ///< [s] robot time of the telemetry the prediction ran from
+  Pose predicted;       ///< the ghost's base then
+  double position = 0;  ///< [m] horizontal distance to the frame's base
+  double heading = 0;   ///< [rad] absolute yaw difference
+};
+
+/// Counters, for the status bar and benchmarks.
+struct GhostStats {
+  int64_t anchors = 0;        ///< re-anchorings done
+  double anchorMs = 0;        ///< wall time of the last one (its run ahead included)
+  double anchorSpan = 0;      ///< [s] robot time it ran over
+  int64_t trails = 0;         ///< trails completed
+  double trailMs = 0;         ///< wall time of the last one
+  int64_t views = 0;          ///< views published
+  int64_t twins = 0;          ///< worlds built for a new weld or a switch between held and full
+  bool held = false;          ///< the newest is held (ghost.hold joints welded)
+};
+
+class Ghost {
+ public:
+  struct Options {
+    bool runAhead = true;        ///< false: show the newest telemetry's time (no prediction; a control)
+    bool inFlight = true;        ///< false: ignore commands not yet in effect at the robot (a control)
+    double frameInterval = 0.016;  ///< [s] present thread's period
+    double trailSpacing = 0.1;   ///< [s] robot time between trail points
+  };
+
+  /// Builds the three worlds from `world` with the ghost profile of
+  /// `params` and starts the threads. nullptr and `error` if a world cannot
+  /// be built or the world has no robot.
+  static std::unique_ptr<Ghost> create(const WorldModel& world, const SimParams& params, std::string& error);
+  static std::unique_ptr<Ghost> create(const WorldModel& world, const SimParams& params, const Options& options,
+                                       std::string& error);
+  /// Stops and joins the threads.
+  ~Ghost();
+  Ghost(const Ghost&) = delete;
+  Ghost& operator=(const Ghost&) = delete;
+
+  /// A telemetry frame arrived now (joints in the model's order), with the
+  /// link's round trip [s]. Returns the frame against what the ghost showed
+  /// for its time, when it showed something then.
+  std::optional<GhostError> anchor(const RobotFrame& frame, double roundTrip);
+  /// The operator sent `command` now; it is taken to arrive at ghost(now).
+  void commandSent(const Command& command);
+  /// Commands sent so far (commandSent() calls).
+  uint64_t commandsSent() const;
+  /// The ghost as it is now (a copy).
+  GhostView view() const;
+  /// The view's version, cheaper than view() to poll.
+  int64_t viewVersion() const;
+  /// Median of the position and heading errors over the last 10 s of robot
+  /// time; nullopt before the first comparison.
+  std::optional<std::pair<double, double>> errorMedian() const;
+  GhostStats stats() const;
+  /// Robot time the ghost shows at wall time `wall` (steady clock [s]).
+  double ghostTime(double wall) const;
+  /// The steady clock the ghost reads [s].
+  static double now();
+
+ private:
+  struct SentCommand {
+    uint64_t seq = 0;
+    double time = 0;  // robot time it takes effect
+    Command command;
+  };
+  struct Base;  // a published anchored state
+  struct TrailRequest;
+  /// What the ghost's worlds are built from: the world with its robot's
+  /// ghost.hold joints welded at the pose of the first telemetry (or the
+  /// full robot without any).
+  struct Twin {
+    WorldModel world;
+    std::optional<RigidRobot> rigid;
+    std::vector<int> held;  ///< the full robot's joints welded
+  };
+
+  Ghost(const WorldModel& world, const SimParams& params, const Options& options)
+      : model_(world), params_(params), options_(options) {}
+  /// The twin welded at `positions` (the full robot's joints), or the full
+  /// robot when not `hold`. Null and `error` when the hold cannot be made.
+  std::shared_ptr<const Twin> makeTwin(const std::vector<double>& positions, bool hold, std::string& error) const;
+  /// Whether `command` moves a ghost.hold joint (a gait moves the legs).
+  bool movesHeld(const Command& command) const;
+  /// Gives `to` (just built) the controller set-points of `from` (the twin
+  /// it replaces), actuator by name; a joint `from` held holds where
+  /// `positions` (the full robot's) has it.
+  void carryControl(const World& from, const Twin& fromTwin, World& to, const Twin& toTwin,
+                    const std::vector<double>& positions) const;
+  std::unique_ptr<World> buildWorld(const Twin& twin, std::string* error = nullptr) const;
+  /// A state of `twin`'s robot as the full robot's joint positions: held
+  /// ones as `reported` has them (the newest telemetry), when it has them.
+  std::vector<double> fullPositions(const Twin& twin, const std::vector<double>& joints,
+                                    const std::vector<double>* reported) const;
+  void anchorLoop();
+  void presentLoop();
+  void trailLoop();
+  /// Steps `world` from robot time `t` to `target`, submitting the commands
+  /// from `next` on as their times come. False if the world diverged.
+  bool advance(World& world, double& t, double target, const std::vector<SentCommand>& commands, size_t& next,
+               const std::function<bool()>& abort = {}) const;
+  /// The commands sent with seq >= `from`. Caller holds mutex_.
+  std::vector<SentCommand> commandsFrom(uint64_t from) const;
+  double ghostTimeLocked(double wall) const;
+  void setProblem(const std::string& problem);
+
+  WorldModel model_;  // the full world
+  SimParams params_;  // the ghost profile
+  Options options_;
+  std::vector<int> held_;  // joints the ghost may hold rigid (ghost.hold's subtrees but the drive's), sorted
+
+  mutable std::mutex mutex_;  // guards everything below
+  std::condition_variable anchorWake_, presentWake_, trailWake_;
+  bool stop_ = false;
+  std::optional<RobotFrame> frame_;  // newest telemetry
+  uint64_t frameVersion_ = 0;
+  double newestTime_ = 0;            // its robot time
+  std::deque<std::pair<double, double>> offsets_;  // (arrival, T - arrival), last 2 s
+  double offset_ = 0, roundTrip_ = 0;
+  bool haveClock_ = false;
+  std::deque<SentCommand> commands_;  // sent, oldest first; the last 10 s of robot time
+  uint64_t epoch_ = 0;  // counts robot resets (its clock went back)
+  uint64_t nextSeq_ = 0;
+  std::shared_ptr<const Base> base_;
+  uint64_t baseVersion_ = 0;
+  std::shared_ptr<const TrailRequest> trailRequest_;
+  uint64_t trailVersion_ = 0;
+  GhostView view_;
+  struct Shown {
+    double time, made;  // robot time shown; of the telemetry it ran from
+    Pose base;
+  };
+  std::deque<Shown> shown_;  // what the present thread showed, last 20 s of robot time
+  std::deque<GhostError> errors_;  // last 10 s of robot time
+  GhostStats stats_;
+
+  std::thread anchorThread_, presentThread_, trailThread_;
+};
+
+}  // namespace sp

@@ -1,0 +1,413 @@
+#include "app/log/snapshot_codec.h"
+
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <type_traits>
+#include <variant>
+
+#include "sim/height_grid.h"
+
+namespace sp {
+namespace {
+
+// Appends values little-endian.
+class Writer {
+ public:
+  void u8(uint8_t v) { out_.push_back(v); }
+  void u32(uint32_t v) {
+    for (int i = 0; i < 4; ++i) out_.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  }
+  void u64(uint64_t v) {
+    for (int i = 0; i < 8; ++i) out_.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  }
+  void i64(int64_t v) { u64(static_cast<uint64_t>(v)); }
+  void i32(int v) { i64(v); }
+  void boolean(bool v) { u8(v ? 1 : 0); }
+  void f64(double v) {
+    uint64_t bits = 0;
+    std::memcpy(&bits, &v, sizeof bits);
+    u64(bits);
+  }
+  void str(const std::string& s) {
+    u64(s.size());
+    out_.insert(out_.end(), s.begin(), s.end());
+  }
+  void vec3(const Vec3& v) { f64(v.x); f64(v.y); f64(v.z); }
+  void pose(const Pose& p) {
+    vec3(p.p);
+    f64(p.q.w); f64(p.q.x); f64(p.q.y); f64(p.q.z);
+  }
+  std::vector<uint8_t> take() { return std::move(out_); }
+
+ private:
+  std::vector<uint8_t> out_;
+};
+
+struct Truncated : std::runtime_error {
+  Truncated() : std::runtime_error("truncated snapshot data") {}
+};
+
+// Reads what Writer wrote; throws Truncated past the end (caught in decodeSnapshot).
+class Reader {
+ public:
+  explicit Reader(const std::vector<uint8_t>& in) : in_(in) {}
+  uint8_t u8() {
+    need(1);
+    return in_[pos_++];
+  }
+  uint32_t u32() {
+    need(4);
+    uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= static_cast<uint32_t>(in_[pos_++]) << (8 * i);
+    return v;
+  }
+  uint64_t u64() {
+    need(8);
+    uint64_t v = 0;
+    for (int i = 0; i < 8; ++i) v |= static_cast<uint64_t>(in_[pos_++]) << (8 * i);
+    return v;
+  }
+  int64_t i64() { return static_cast<int64_t>(u64()); }
+  int i32() { return static_cast<int>(i64()); }
+  bool boolean() { return u8() != 0; }
+  double f64() {
+    uint64_t bits = u64();
+    double v = 0;
+    std::memcpy(&v, &bits, sizeof v);
+    return v;
+  }
+  std::size_t count(std::size_t minElementSize) {
+    uint64_t n = u64();
+    if (minElementSize > 0 && n > (in_.size() - pos_) / minElementSize) throw Truncated();
+    return static_cast<std::size_t>(n);
+  }
+  std::string str() {
+    std::size_t n = count(1);
+    std::string s(in_.begin() + static_cast<std::ptrdiff_t>(pos_),
+                  in_.begin() + static_cast<std::ptrdiff_t>(pos_ + n));
+    pos_ += n;
+    return s;
+  }
+  Vec3 vec3() {
+    Vec3 v;
+    v.x = f64(); v.y = f64(); v.z = f64();
+    return v;
+  }
+  Pose pose() {
+    Pose p;
+    p.p = vec3();
+    p.q.w = f64(); p.q.x = f64(); p.q.y = f64(); p.q.z = f64();
+    return p;
+  }
+  bool atEnd() const { return pos_ == in_.size(); }
+
+ private:
+  void need(std::size_t n) const {
+    if (in_.size() - pos_ < n) throw Truncated();
+  }
+  const std::vector<uint8_t>& in_;
+  std::size_t pos_ = 0;
+};
+
+struct BadData : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+void writeSensorValue(Writer& w, const SensorValue& value) {
+  w.u8(static_cast<uint8_t>(value.index()));
+  std::visit(
+      [&w](const auto& r) {
+        using T = std::decay_t<decltype(r)>;
+        if constexpr (std::is_same_v<T, PoseReading>) {
+          w.pose(r.pose);
+        } else if constexpr (std::is_same_v<T, LaserReading>) {
+          w.pose(r.sensorPose);
+          w.f64(r.angleMin); w.f64(r.angleStep); w.f64(r.minRange); w.f64(r.maxRange);
+          w.u64(r.ranges.size());
+          for (double d : r.ranges) w.f64(d);
+        } else if constexpr (std::is_same_v<T, EncoderReading>) {
+          w.f64(r.position); w.f64(r.velocity);
+        } else if constexpr (std::is_same_v<T, WheelForceReading>) {
+          w.vec3(r.force); w.f64(r.normal); w.f64(r.tangential); w.i32(r.contacts);
+        } else if constexpr (std::is_same_v<T, JointForceReading>) {
+          w.vec3(r.force); w.vec3(r.torque);
+        } else {
+          static_assert(std::is_same_v<T, ImuReading>);
+          w.f64(r.roll); w.f64(r.pitch); w.vec3(r.angularRate); w.vec3(r.acceleration);
+        }
+      },
+      value);
+}
+
+SensorValue readSensorValue(Reader& r) {
+  switch (r.u8()) {
+    case 0: return PoseReading{r.pose()};
+    case 1: {
+      LaserReading l;
+      l.sensorPose = r.pose();
+      l.angleMin = r.f64(); l.angleStep = r.f64(); l.minRange = r.f64(); l.maxRange = r.f64();
+      l.ranges.resize(r.count(8));
+      for (double& d : l.ranges) d = r.f64();
+      return l;
+    }
+    case 2: {
+      EncoderReading e;
+      e.position = r.f64(); e.velocity = r.f64();
+      return e;
+    }
+    case 3: {
+      WheelForceReading f;
+      f.force = r.vec3(); f.normal = r.f64(); f.tangential = r.f64(); f.contacts = r.i32();
+      return f;
+    }
+    case 4: {
+      JointForceReading f;
+      f.force = r.vec3(); f.torque = r.vec3();
+      return f;
+    }
+    case 5: {
+      ImuReading m;
+      m.roll = r.f64(); m.pitch = r.f64(); m.angularRate = r.vec3(); m.acceleration = r.vec3();
+      return m;
+    }
+    default: throw BadData("unknown sensor reading type");
+  }
+}
+
+void writeCommand(Writer& w, const Command& command) {
+  w.u8(static_cast<uint8_t>(command.index()));
+  std::visit(
+      [&w](const auto& c) {
+        using T = std::decay_t<decltype(c)>;
+        if constexpr (std::is_same_v<T, JointVelocityCmd>) {
+          w.str(c.joint); w.f64(c.velocity);
+        } else if constexpr (std::is_same_v<T, JointTargetCmd>) {
+          w.str(c.joint); w.f64(c.position);
+        } else if constexpr (std::is_same_v<T, JointTorqueCmd>) {
+          w.str(c.joint); w.f64(c.torque);
+        } else if constexpr (std::is_same_v<T, JointModeCmd>) {
+          w.str(c.joint); w.u8(static_cast<uint8_t>(c.mode));
+        } else if constexpr (std::is_same_v<T, WheelsCmd>) {
+          for (double o : c.omega) w.f64(o);
+        } else if constexpr (std::is_same_v<T, DriveCmd>) {
+          w.f64(c.speed); w.f64(c.articulation);
+        } else if constexpr (std::is_same_v<T, StopCmd>) {
+        } else if constexpr (std::is_same_v<T, GaitCmd>) {
+          w.u8(static_cast<uint8_t>(c.gait));
+        } else if constexpr (std::is_same_v<T, TurnCmd>) {
+          w.f64(c.speed); w.f64(c.yawRate);
+        } else {
+          static_assert(std::is_same_v<T, TerrainPatchCmd>);
+          w.i32(c.column); w.i32(c.row); w.i32(c.columns); w.i32(c.rows);
+          w.u64(c.heights.size());
+          for (double h : c.heights) w.f64(h);
+        }
+      },
+      command);
+}
+
+Command readCommand(Reader& r) {
+  switch (r.u8()) {
+    case 0: { JointVelocityCmd c; c.joint = r.str(); c.velocity = r.f64(); return c; }
+    case 1: { JointTargetCmd c; c.joint = r.str(); c.position = r.f64(); return c; }
+    case 2: { JointTorqueCmd c; c.joint = r.str(); c.torque = r.f64(); return c; }
+    case 3: {
+      JointModeCmd c;
+      c.joint = r.str();
+      uint8_t m = r.u8();
+      if (m > static_cast<uint8_t>(JointMode::Free)) throw BadData("unknown joint mode");
+      c.mode = static_cast<JointMode>(m);
+      return c;
+    }
+    case 4: { WheelsCmd c; for (double& o : c.omega) o = r.f64(); return c; }
+    case 5: { DriveCmd c; c.speed = r.f64(); c.articulation = r.f64(); return c; }
+    case 6: return StopCmd{};
+    case 7: {
+      uint8_t g = r.u8();
+      if (g > static_cast<uint8_t>(Gait::Rolking)) throw BadData("unknown gait");
+      return GaitCmd{static_cast<Gait>(g)};
+    }
+    case 8: { TurnCmd c; c.speed = r.f64(); c.yawRate = r.f64(); return c; }
+    case 9: {
+      TerrainPatchCmd c;
+      c.column = r.i32(); c.row = r.i32(); c.columns = r.i32(); c.rows = r.i32();
+      c.heights.resize(r.count(8));
+      for (double& h : c.heights) h = r.f64();
+      return c;
+    }
+    default: throw BadData("unknown command type");
+  }
+}
+
+}  // namespace
+
+std::vector<uint8_t> encodeSnapshot(const Snapshot& s) {
+  static_assert(std::variant_size_v<Command> == 10, "update the snapshot codec");
+  static_assert(std::variant_size_v<SensorValue> == 6, "update the snapshot codec");
+  Writer w;
+  for (char c : std::string("SPSN")) w.u8(static_cast<uint8_t>(c));
+  w.u32(kSnapshotCodecVersion);
+  w.u64(s.modelKey);
+  w.i64(s.step);
+  w.f64(s.stepSize);
+  w.u64(s.bodies.size());
+  for (const BodyState& b : s.bodies) {
+    for (double v : b.position) w.f64(v);
+    for (double v : b.quaternion) w.f64(v);
+    for (double v : b.linearVelocity) w.f64(v);
+    for (double v : b.angularVelocity) w.f64(v);
+  }
+  w.u64(s.robots.size());
+  for (const RobotControlState& rc : s.robots) {
+    w.u64(rc.actuators.size());
+    for (const ActuatorState& a : rc.actuators) {
+      w.u8(static_cast<uint8_t>(a.mode));
+      w.f64(a.velocity); w.f64(a.target); w.f64(a.torque); w.f64(a.integral);
+    }
+    w.boolean(rc.driveActive);
+    w.f64(rc.driveSpeed);
+    w.f64(rc.driveArticulation);
+    w.boolean(rc.driveByYawRate);
+    w.f64(rc.driveYawRate);
+    w.boolean(rc.gaitActive);
+    w.u8(static_cast<uint8_t>(rc.gait.gait));
+    w.i32(rc.gait.phase);
+    w.i64(rc.gait.phaseStart);
+    w.u64(rc.resistance.size());
+    for (size_t l = 0; l < rc.resistance.size(); ++l) {
+      w.f64(rc.resistance[l]);
+      w.f64(l < rc.resistanceShare.size() ? rc.resistanceShare[l] : 1.0);
+    }
+  }
+  w.u64(s.sensors.size());
+  for (const auto& robotSensors : s.sensors) {
+    w.u64(robotSensors.size());
+    for (const SensorState& ss : robotSensors) {
+      w.i64(ss.nextStep);
+      w.vec3(ss.lastVelocity);
+      w.vec3(ss.forceSum);
+      w.vec3(ss.normalSum);
+      w.i32(ss.contactSum);
+      w.i32(ss.stepsSummed);
+      w.i32(ss.latest.robot);
+      w.i32(ss.latest.sensor);
+      w.i64(ss.latest.step);
+      w.f64(ss.latest.time);
+      writeSensorValue(w, ss.latest.value);
+    }
+  }
+  w.u64(static_cast<uint64_t>(s.odeRandom));
+  for (uint64_t v : s.random) w.u64(v);
+  w.boolean(s.terrain != nullptr);
+  if (s.terrain) {
+    w.i32(s.terrain->columns);
+    w.i32(s.terrain->rows);
+    w.f64(s.terrain->width);
+    w.f64(s.terrain->depth);
+    w.u64(s.terrain->heights.size());
+    for (double h : s.terrain->heights) w.f64(h);
+  }
+  w.u64(s.pending.size());
+  for (const auto& [robot, command] : s.pending) {
+    w.i32(robot);
+    writeCommand(w, command);
+  }
+  return w.take();
+}
+
+std::optional<Snapshot> decodeSnapshot(const std::vector<uint8_t>& data, std::string* error) {
+  auto fail = [error](const std::string& message) -> std::optional<Snapshot> {
+    if (error) *error = message;
+    return std::nullopt;
+  };
+  if (data.size() < 8 || std::memcmp(data.data(), "SPSN", 4) != 0) return fail("not a snapshot (bad magic)");
+  Reader r(data);
+  try {
+    for (int i = 0; i < 4; ++i) r.u8();
+    uint32_t version = r.u32();
+    if (version != kSnapshotCodecVersion && version != 1)
+      return fail("snapshot format version " + std::to_string(version) + " is not supported (expected " +
+                  std::to_string(kSnapshotCodecVersion) + ")");
+    Snapshot s;
+    s.modelKey = r.u64();
+    s.step = r.i64();
+    s.stepSize = r.f64();
+    s.bodies.resize(r.count(13 * 8));
+    for (BodyState& b : s.bodies) {
+      for (double& v : b.position) v = r.f64();
+      for (double& v : b.quaternion) v = r.f64();
+      for (double& v : b.linearVelocity) v = r.f64();
+      for (double& v : b.angularVelocity) v = r.f64();
+    }
+    s.robots.resize(r.count(1));
+    for (RobotControlState& rc : s.robots) {
+      rc.actuators.resize(r.count(33));
+      for (ActuatorState& a : rc.actuators) {
+        uint8_t m = r.u8();
+        if (m > static_cast<uint8_t>(JointMode::Free)) throw BadData("unknown joint mode");
+        a.mode = static_cast<JointMode>(m);
+        a.velocity = r.f64(); a.target = r.f64(); a.torque = r.f64(); a.integral = r.f64();
+      }
+      rc.driveActive = r.boolean();
+      rc.driveSpeed = r.f64();
+      rc.driveArticulation = r.f64();
+      rc.driveByYawRate = r.boolean();
+      rc.driveYawRate = r.f64();
+      rc.gaitActive = r.boolean();
+      uint8_t g = r.u8();
+      if (g > static_cast<uint8_t>(Gait::Rolking)) throw BadData("unknown gait");
+      rc.gait.gait = static_cast<Gait>(g);
+      rc.gait.phase = r.i32();
+      rc.gait.phaseStart = r.i64();
+      if (version >= 2) {
+        rc.resistance.resize(r.count(16));
+        rc.resistanceShare.resize(rc.resistance.size());
+        for (size_t l = 0; l < rc.resistance.size(); ++l) {
+          rc.resistance[l] = r.f64();
+          rc.resistanceShare[l] = r.f64();
+        }
+      }
+    }
+    s.sensors.resize(r.count(8));
+    for (auto& robotSensors : s.sensors) {
+      robotSensors.resize(r.count(1));
+      for (SensorState& ss : robotSensors) {
+        ss.nextStep = r.i64();
+        ss.lastVelocity = r.vec3();
+        ss.forceSum = r.vec3();
+        ss.normalSum = r.vec3();
+        ss.contactSum = r.i32();
+        ss.stepsSummed = r.i32();
+        ss.latest.robot = r.i32();
+        ss.latest.sensor = r.i32();
+        ss.latest.step = r.i64();
+        ss.latest.time = r.f64();
+        ss.latest.value = readSensorValue(r);
+      }
+    }
+    s.odeRandom = static_cast<unsigned long>(r.u64());
+    for (uint64_t& v : s.random) v = r.u64();
+    if (r.boolean()) {
+      auto grid = std::make_shared<HeightGrid>();
+      grid->columns = r.i32();
+      grid->rows = r.i32();
+      grid->width = r.f64();
+      grid->depth = r.f64();
+      grid->heights.resize(r.count(8));
+      for (double& h : grid->heights) h = r.f64();
+      s.terrain = std::move(grid);
+    }
+    s.pending.resize(r.count(9));
+    for (auto& [robot, command] : s.pending) {
+      robot = r.i32();
+      command = readCommand(r);
+    }
+    if (!r.atEnd()) return fail("trailing bytes after the snapshot");
+    return s;
+  } catch (const std::exception& e) {
+    return fail(e.what());
+  }
+}
+
+}  // namespace sp

@@ -1,0 +1,288 @@
+#include "app/rehearse/rehearsal.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+
+#include "sim/hash.h"
+#include "sim/kinematics.h"
+#include "sim/random.h"
+#include "sim/rigid.h"
+#include "sim/runner.h"
+#include "sim/text.h"
+#include "sim/world.h"
+
+namespace sp {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The position-mode joints hold where the start found them, the wheels
+// stand: the robot's controllers at rest. A fresh twin's targets are the
+// robot file's initial ones, which a robot that has moved its arms no
+// longer holds.
+void holdStartPose(World& world) {
+  const RobotModel& robot = world.robotModel(0);
+  for (size_t a = 0; a < robot.actuators.size(); ++a) {
+    const ActuatorSpec& spec = robot.actuators[a];
+    const std::string& joint = robot.joints[spec.joint].name;
+    if (spec.hasPid && spec.kp > 0 && !spec.continuous)
+      world.submit(JointTargetCmd{joint, world.jointPosition(0, spec.joint)});
+    else if (spec.mode == JointMode::Velocity)
+      world.submit(JointVelocityCmd{joint, 0});
+  }
+}
+
+// `rigid` (may be null): the held robot the world runs; joints are reported
+// as the full robot's.
+RehearsalSample sampleOf(const World& world, double margin, const RigidRobot* rigid) {
+  RehearsalSample s;
+  s.time = world.time();
+  s.base = world.linkPose(0, 0);
+  const RobotModel& robot = world.robotModel(0);
+  s.jointPositions.resize(robot.joints.size());
+  for (size_t j = 0; j < robot.joints.size(); ++j) s.jointPositions[j] = world.jointPosition(0, static_cast<int>(j));
+  if (rigid) s.jointPositions = fullJoints(*rigid, s.jointPositions);
+  const Vec3 tilted = tilt(s.base.q);
+  s.roll = tilted.x;
+  s.pitch = tilted.y;
+  s.margin = margin;
+  const Vec3 v = world.linkLinearVelocity(0, 0);
+  s.speed = std::hypot(v.x, v.y);
+  return s;
+}
+
+double lerp(double a, double b, double f) { return a + (b - a) * f; }
+
+}  // namespace
+
+std::string RehearsalResult::summary() const {
+  if (!error.empty()) return error;
+  if (cancelled) return "cancelled";
+  for (const RuleVerdict& v : verdicts)
+    if (!v.passed) return v.message();
+  return "passed";
+}
+
+std::optional<RehearsalSample> RehearsalResult::at(double time) const {
+  if (path.empty() || time < path.front().time || time > path.back().time) return std::nullopt;
+  const auto it = std::lower_bound(path.begin(), path.end(), time,
+                                   [](const RehearsalSample& s, double t) { return s.time < t; });
+  if (it == path.begin()) return *it;
+  const RehearsalSample& a = *(it - 1);
+  const RehearsalSample& b = *it;
+  const double f = b.time > a.time ? (time - a.time) / (b.time - a.time) : 0;
+  RehearsalSample s = f < 0.5 ? a : b;  // joints and the rest from the nearer sample
+  s.time = time;
+  s.base.p = {lerp(a.base.p.x, b.base.p.x, f), lerp(a.base.p.y, b.base.p.y, f), lerp(a.base.p.z, b.base.p.z, f)};
+  const double ha = heading(a.base.q);
+  const double h = ha + f * std::remainder(heading(b.base.q) - ha, 2 * kPi);
+  s.base.q = quatFromAxisAngle({0, 0, 1}, h - heading(s.base.q)) * s.base.q;
+  for (size_t j = 0; j < s.jointPositions.size() && j < a.jointPositions.size(); ++j)
+    s.jointPositions[j] = lerp(a.jointPositions[j], b.jointPositions[j], f);
+  return s;
+}
+
+std::vector<int> unmovedJoints(const RobotModel& robot, const std::vector<TimedCommand>& commands) {
+  std::vector<bool> moved(robot.joints.size(), false);
+  auto mark = [&](const std::string& name) {
+    if (const int j = robot.findJoint(name); j >= 0) moved[static_cast<size_t>(j)] = true;
+  };
+  for (const TimedCommand& c : commands)
+    std::visit(
+        [&](const auto& cmd) {
+          if constexpr (requires { cmd.joint; }) mark(cmd.joint);
+        },
+        c.command);
+  if (robot.drive) {
+    if (robot.drive->articulation >= 0) moved[static_cast<size_t>(robot.drive->articulation)] = true;
+    for (int w : robot.drive->wheels)
+      if (w >= 0) moved[static_cast<size_t>(w)] = true;
+  }
+  std::vector<int> held;
+  std::vector<bool> taken(robot.joints.size(), false);
+  for (size_t j = 0; j < robot.joints.size(); ++j) {
+    if (taken[j]) continue;
+    const std::vector<int> sub = subtreeJoints(robot, robot.joints[j].name);
+    if (std::any_of(sub.begin(), sub.end(), [&](int k) { return moved[static_cast<size_t>(k)]; })) continue;
+    for (int k : sub) {
+      taken[static_cast<size_t>(k)] = true;
+      held.push_back(k);
+    }
+  }
+  std::sort(held.begin(), held.end());
+  return held;
+}
+
+std::string placeRobot(World& world, const RehearsalStart& s, const RigidRobot* held) {
+  const RobotModel& robot = world.robotModel(0);
+  const std::vector<double> q = held ? rigidJoints(*held, s.jointPositions) : s.jointPositions;
+  const std::vector<double> dq = held ? rigidJoints(*held, s.jointRates) : s.jointRates;
+  const std::string why =
+      world.setRobotMotion(0, linkMotions(robot, s.base, s.baseLinear, s.baseAngular, q, dq), s.objects);
+  if (why.empty()) holdStartPose(world);
+  return why;
+}
+
+RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress) {
+  const auto t0 = Clock::now();
+  RehearsalResult result;
+  if (plan.world.robots.empty()) {
+    result.error = "the world has no robot";
+    return result;
+  }
+  const RobotModel& full = plan.world.robots[0].model;
+  if (plan.start && (plan.start->jointPositions.size() != full.joints.size() ||
+                     plan.start->jointRates.size() != full.joints.size())) {
+    result.error = "the start state has " + std::to_string(plan.start->jointPositions.size()) +
+                   " joints, the robot " + std::to_string(full.joints.size());
+    return result;
+  }
+  // The joints the sequence leaves alone, welded where the start has them.
+  std::optional<RigidRobot> rigid;
+  WorldModel model = plan.world;
+  if (plan.holdUnmoved) {
+    const std::vector<int> held = unmovedJoints(full, plan.commands);
+    std::string why;
+    const std::vector<double> at = plan.start ? plan.start->jointPositions : std::vector<double>(full.joints.size(), 0.0);
+    if (!held.empty() && (rigid = holdRigid(full, at, held, why))) {
+      model.robots[0].model = rigid->model;
+      result.heldJoints = static_cast<int>(held.size());
+    }
+  }
+  Diagnostics diag;
+  std::unique_ptr<World> world = World::create(model, plan.params, diag);
+  if (!world) {
+    result.error = "cannot build the twin: " + diag.format();
+    return result;
+  }
+  const RobotModel& robot = world->robotModel(0);
+  const RigidRobot* held = rigid ? &*rigid : nullptr;
+  if (plan.start) {
+    if (std::string why = placeRobot(*world, *plan.start, held); !why.empty()) {
+      result.error = "the start state does not fit: " + why;
+      return result;
+    }
+  }
+  result.duration = (plan.commands.empty() ? 0.0 : plan.commands.back().time) + plan.rules.settle;
+  RuleMonitor monitor(plan.rules, robot);
+  Runner runner(*world);
+  runner.schedule(plan.commands);
+  const int64_t total = std::max<int64_t>(1, std::llround(result.duration / plan.params.step));
+  const int64_t sampleEvery = std::max<int64_t>(1, std::llround(RehearsalResult::kSampleInterval / plan.params.step));
+  const int64_t progressEvery = std::max<int64_t>(1, total / 100);
+  result.path.push_back(sampleOf(*world, 0, held));
+  runner.setMonitor([&](const World& w) {
+    monitor.check(w);
+    const int64_t n = w.stepCount();
+    if (n % sampleEvery == 0) result.path.push_back(sampleOf(w, monitor.margin(), held));
+    if (progress && n % progressEvery == 0 && !progress(static_cast<double>(n) / static_cast<double>(total))) {
+      result.cancelled = true;
+      return false;
+    }
+    return true;
+  });
+  const RunOutcome out = runner.advanceTo(total);
+  if (out.stop == RunOutcome::Stop::Diverged) monitor.check(*world);  // the health verdict
+  result.verdicts = monitor.verdicts();
+  result.passed = !result.cancelled && monitor.passed() && world->health().healthy();
+  result.endHash = world->stateHash();
+  result.wallSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return result;
+}
+
+std::string sequenceText(const std::vector<TimedCommand>& commands, const RobotModel* robot) {
+  std::string out;
+  for (const TimedCommand& c : commands) out += shortestText(c.time) + " " + toText(c.command, robot) + "\n";
+  return out;
+}
+
+std::string sequenceHash(const std::string& canonicalText) {
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(fnv1a64(canonicalText)));
+  return hex;
+}
+
+RehearsalPlan perturbed(const RehearsalPlan& plan, uint64_t seed) {
+  RehearsalPlan p = plan;
+  Random random(seed);
+  auto spread = [&](double range) { return range * (2 * random.uniform() - 1); };
+  const FlightRules& r = plan.rules;
+  p.world.defaultContact.mu *= 1 + spread(r.robustFriction);
+  for (ContactSpec& c : p.world.contacts) c.mu *= 1 + spread(r.robustFriction);
+  for (LinkSpec& link : p.world.robots[0].model.links) {
+    const double f = 1 + spread(r.robustMass);
+    link.mass *= f;
+    for (GeomSpec& g : link.geoms) g.mass *= f;
+  }
+  if (p.world.terrain.kind == TerrainSpec::Kind::Heightfield && r.robustTerrain > 0) {
+    // A smooth random field: offsets drawn every kTerrainCell metres and
+    // interpolated between, so the ground is uncertain the way a survey is,
+    // not jagged (independent noise per 5 cm sample makes 40 % slopes).
+    constexpr double kTerrainCell = 1.0;
+    HeightGrid& g = p.world.terrain.grid;
+    const int nx = static_cast<int>(std::ceil(g.width / kTerrainCell)) + 1;
+    const int ny = static_cast<int>(std::ceil(g.depth / kTerrainCell)) + 1;
+    std::vector<double> coarse(static_cast<size_t>(nx) * ny);
+    for (double& c : coarse) c = spread(r.robustTerrain);
+    for (int j = 0; j < g.rows; ++j)
+      for (int i = 0; i < g.columns; ++i) {
+        const double x = i * g.spacingX() / kTerrainCell, y = j * g.spacingY() / kTerrainCell;
+        const int x0 = std::min(static_cast<int>(x), nx - 2), y0 = std::min(static_cast<int>(y), ny - 2);
+        const double fx = x - x0, fy = y - y0;
+        auto at = [&](int a, int b) { return coarse[static_cast<size_t>(b) * nx + a]; };
+        g.at(i, j) += (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) +
+                      fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1));
+      }
+  }
+  const double dx = spread(r.robustStartPosition), dy = spread(r.robustStartPosition);
+  const double dyaw = degToRad(spread(r.robustStartHeading));
+  Pose& base = p.start ? p.start->base : p.world.robots[0].pose;
+  base.p.x += dx;
+  base.p.y += dy;
+  base.q = quatFromAxisAngle({0, 0, 1}, dyaw) * base.q;
+  return p;
+}
+
+RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int threads,
+                            const std::function<bool(int, int)>& progress) {
+  const auto t0 = Clock::now();
+  const int n = plan.rules.robustSamples;
+  RobustnessResult out;
+  out.samples = n;
+  out.endPoses.resize(n);
+  out.samplePassed.assign(n, false);
+  out.failures.resize(n);
+  std::atomic<int> next{0}, done{0};
+  std::atomic<bool> cancelled{false};
+  std::mutex progressMutex;
+  auto work = [&] {
+    for (int i; !cancelled && (i = next++) < n;) {
+      const RehearsalResult r = rehearse(perturbed(plan, seed + static_cast<uint64_t>(i)));
+      out.samplePassed[i] = r.passed;
+      out.failures[i] = r.summary();
+      if (!r.path.empty()) out.endPoses[i] = r.path.back().base;
+      const int d = ++done;
+      if (progress) {
+        std::lock_guard lock(progressMutex);
+        if (!progress(d, n)) cancelled = true;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  out.passed = static_cast<int>(std::count(out.samplePassed.begin(), out.samplePassed.end(), true));
+  Vec3 mean;
+  for (const Pose& p : out.endPoses) mean = mean + (1.0 / n) * p.p;
+  for (const Pose& p : out.endPoses) out.spread = std::max(out.spread, std::hypot(p.p.x - mean.x, p.p.y - mean.y));
+  out.wallSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace sp

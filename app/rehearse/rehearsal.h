@@ -1,0 +1,132 @@
+#pragma once
+// Rehearsal: a command sequence run on the console's own twin, from the
+// robot's current state, faster than real time, with the flight rules
+// (sim/flight_rules.h) checked after every step. Only a sequence that passed
+// is relayed to the robot (app/rehearse/sequence_relay.h), unchanged: the hash of its
+// canonical text names it on both ends.
+//
+//   sp::RehearsalPlan plan{world, params, rules, commands, start};
+//   sp::RehearsalResult r = sp::rehearse(plan, [&](double f) { bar(f); return !cancelled; });
+//   if (r.passed) relay(plan.commands, r);
+//
+// Time: a sequence's command times count from its start (t = 0 when the
+// rehearsal, or the robot's run, begins).
+//
+// Thread: any; rehearse() builds and steps its own World on the calling
+// thread (the console runs it on a worker). robustness() uses `threads`
+// threads of its own.
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sim/command.h"
+#include "sim/flight_rules.h"
+#include "sim/math.h"
+#include "sim/params.h"
+#include "sim/robot_model.h"
+
+namespace sp {
+
+/// The robot's state to rehearse from, as telemetry reports it.
+struct RehearsalStart {
+  Pose base;
+  Vec3 baseLinear, baseAngular;        ///< world frame [m/s], [rad/s]
+  std::vector<double> jointPositions;  ///< model joint order
+  std::vector<double> jointRates;
+  std::vector<std::pair<std::string, Pose>> objects;  ///< dynamic objects by name
+};
+
+/// What to rehearse.
+struct RehearsalPlan {
+  WorldModel world;  ///< robots[0] is the robot
+  SimParams params;
+  FlightRules rules;
+  std::vector<TimedCommand> commands;  ///< times from the start, non-decreasing
+  /// nullopt = the world's own initial state (the stand-in at rest).
+  std::optional<RehearsalStart> start;
+  /// Hold rigid the joints no command of the sequence moves (whole
+  /// subtrees without drive joints: an arm, the head; sim/rigid.h), for
+  /// speed: fewer bodies, the same mass and centre of mass.
+  bool holdUnmoved = true;
+};
+
+class World;
+struct RigidRobot;
+
+/// Puts robot 0 of `world` in `start` (links' poses and velocities, the
+/// objects named) with its controllers holding that pose: position joints
+/// target where they are, velocity joints 0. `held`: the world runs this
+/// rigid form of the robot (start joints are the full robot's). "" or why
+/// the state does not fit.
+std::string placeRobot(World& world, const RehearsalStart& start, const RigidRobot* held = nullptr);
+
+/// The joints `commands` leave alone, as held subtrees: every joint whose
+/// subtree holds no commanded joint and no drive joint, outermost first.
+std::vector<int> unmovedJoints(const RobotModel& robot, const std::vector<TimedCommand>& commands);
+
+/// The robot's state every RehearsalResult::kSampleInterval.
+struct RehearsalSample {
+  double time = 0;  ///< [s] from the start
+  Pose base;
+  std::vector<double> jointPositions;  ///< model joint order
+  double roll = 0, pitch = 0;          ///< [rad]
+  double margin = 0;                   ///< [m] stability margin
+  double speed = 0;                    ///< [m/s] base over ground
+};
+
+struct RehearsalResult {
+  static constexpr double kSampleInterval = 0.05;  ///< [s]
+  bool passed = false;
+  std::string error;       ///< why it could not run ("" if it ran)
+  bool cancelled = false;  ///< stopped by the progress callback
+  std::vector<RuleVerdict> verdicts;  ///< one per Rule
+  std::vector<RehearsalSample> path;
+  double duration = 0;     ///< [s] simulated: last command's time + rules.settle
+  double wallSeconds = 0;  ///< what it took
+  uint64_t endHash = 0;    ///< World::stateHash() at the end
+  int heldJoints = 0;      ///< joints held rigid (plan.holdUnmoved)
+  /// The first failed rule's one-line message, or "passed".
+  std::string summary() const;
+  /// The rehearsed state at `time` [s from the start], interpolated
+  /// between samples (base position linearly, heading by the shorter way);
+  /// nullopt outside the path.
+  std::optional<RehearsalSample> at(double time) const;
+};
+
+/// Runs the plan. `progress(fraction)` is called about every 1 % of the
+/// simulated time; returning false cancels. Never throws for bad input: a
+/// world that cannot be built or a start that does not fit is `error`.
+RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress = {});
+
+/// The canonical text of a sequence (`TIME COMMAND` per line, shortest
+/// times, toText() commands: what SEQUENCE carries) and its hash
+/// (FNV-1a 64, 16 hex digits).
+std::string sequenceText(const std::vector<TimedCommand>& commands, const RobotModel* robot);
+std::string sequenceHash(const std::string& canonicalText);
+
+/// The plan with its parameters drawn for one robustness sample (seeded,
+/// reproducible): every contact's friction and every link's mass scaled
+/// within the rules' ranges, heightfield samples moved, the start shifted.
+RehearsalPlan perturbed(const RehearsalPlan& plan, uint64_t seed);
+
+/// N perturbed rehearsals.
+struct RobustnessResult {
+  int samples = 0, passed = 0;
+  double probability() const { return samples ? static_cast<double>(passed) / samples : 0; }
+  std::vector<Pose> endPoses;         ///< per sample
+  std::vector<bool> samplePassed;     ///< per sample
+  std::vector<std::string> failures;  ///< per sample: summary() ("passed" if it did)
+  double spread = 0;                  ///< [m] largest distance of an end position from their mean
+  double wallSeconds = 0;
+};
+/// rules.robustSamples rehearsals of perturbed(plan, seed + i) on `threads`
+/// threads; `progress(done, total)` after each (from the worker threads; false cancels).
+RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int threads,
+                            const std::function<bool(int, int)>& progress = {});
+
+}  // namespace sp

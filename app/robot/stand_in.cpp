@@ -1,0 +1,168 @@
+#include "app/robot/stand_in.h"
+
+#include <asio.hpp>
+
+#include <thread>
+
+#include "app/tools/headless_runner.h"
+#include "app/log/session_recorder.h"
+#include "app/robot/twin_host.h"
+#include "net/auth.h"
+#include "net/robot_server.h"
+#include "sim/model_loader.h"
+
+namespace sp {
+
+struct StandInRobot::Server {
+  asio::io_context io;
+  std::unique_ptr<net::RobotServer> server;
+  std::thread thread;
+};
+
+namespace {
+
+bool isLoopback(const std::string& address) {
+  return address == "127.0.0.1" || address == "::1" || address == "localhost";
+}
+
+}  // namespace
+
+std::unique_ptr<StandInRobot> StandInRobot::create(const StandInOptions& options, Diagnostics& diag) {
+  if (options.worldFile.empty()) diag.error("<options>", 0, "no world file given");
+  if (options.token.empty() && !isLoopback(options.bind))
+    diag.error("<options>", 0,
+               "refusing to listen on " + options.bind + " without a token: only loopback may run with a generated one");
+  std::optional<SimParams> params = loadRunParams(options.paramsFile, options.overrides, diag);
+  std::optional<WorldModel> model;
+  std::string replacedRobotFile;
+  if (!options.worldFile.empty()) model = loadWorld(options.worldFile, diag);
+  if (model && model->robots.empty()) diag.error(options.worldFile, 0, "the world has no <robot>");
+  if (model && !model->robots.empty() && !options.robotFile.empty()) {
+    std::optional<RobotModel> robot = loadRobot(options.robotFile, diag);
+    if (robot) {
+      replacedRobotFile = model->robots[0].model.file;
+      model->robots[0].model = std::move(*robot);
+    }
+  }
+  if (diag.hasErrors() || !params || !model) return nullptr;
+  if (options.realTimeFactor) params->realTimeFactor = *options.realTimeFactor;
+  std::unique_ptr<World> world = World::create(*model, *params, diag);
+  if (!world) return nullptr;
+  if (options.startState) {
+    if (std::string why = world->restore(*options.startState); !why.empty()) {
+      diag.error(options.worldFile, 0, "cannot start from the given state: " + why);
+      return nullptr;
+    }
+  }
+  auto host = std::make_unique<TwinHost>(std::move(world), params->realTimeFactor);
+  return std::unique_ptr<StandInRobot>(new StandInRobot(options, std::move(*model), std::move(host), *params, std::move(replacedRobotFile)));
+}
+
+StandInRobot::StandInRobot(StandInOptions options, WorldModel world, std::unique_ptr<TwinHost> host,
+                           SimParams params, std::string replacedRobotFile)
+    : options_(std::move(options)),
+      replacedRobotFile_(std::move(replacedRobotFile)),
+      world_(std::move(world)),
+      params_(std::move(params)),
+      token_(options_.token.empty() ? net::randomToken() : options_.token),
+      host_(std::move(host)) {}
+
+StandInRobot::~StandInRobot() { stop(); }
+
+std::string StandInRobot::chooseLogPath(std::string& error) const {
+  if (!options_.logPath.empty()) return options_.logPath;
+  return newSessionLogPath(options_.logDir, error);
+}
+
+std::string StandInRobot::start() {
+  if (started_) return "the stand-in robot was started already";
+  started_ = true;
+
+  auto server = std::make_unique<Server>();
+  net::RobotServerConfig config;
+  config.address = options_.bind;
+  config.port = options_.port.value_or(static_cast<uint16_t>(params_.robotPort));
+  config.link.robotName = world_.robots[0].name;
+  config.link.token = token_;
+  config.link.telemetryRate = params_.telemetryRate;
+  config.link.worldHash = fileHash(world_.file);
+  config.link.robotHash = fileHash(world_.robots[0].model.file);
+  if (options_.terrainEdits) config.link.capabilities = "terrain_edit";
+  host_->acceptTerrainEdits(options_.terrainEdits);
+  config.link.deadman = params_.linkDeadman;
+  config.link.leaseConfirm = params_.linkLeaseConfirm;
+  config.maxConnections = static_cast<size_t>(params_.linkMaxConnections);
+  config.helloTimeout = params_.linkHelloTimeout;
+  config.emulation = options_.emulation;
+  // Both run on the server's thread; the host queues log events for the
+  // physics thread, which stamps them with the twin's step and time.
+  TwinHost& host = *host_;
+  config.log = [&host, lineLog = options_.lineLog](const std::string& line) {
+    host.logEvent("link", line);
+    if (lineLog) lineLog(line);
+  };
+  config.events = [&host, lineLog = options_.lineLog](const std::string& kind, const std::string& text) {
+    host.logEvent(kind, text);
+    if (lineLog) lineLog(kind == "link" ? text : kind + ": " + text);
+  };
+  server->server = std::make_unique<net::RobotServer>(server->io, config, host);
+  if (std::string error = server->server->start(); !error.empty()) return error;
+
+  if (options_.log) {
+    std::string error;
+    const std::string path = chooseLogPath(error);
+    std::unique_ptr<SessionLogWriter> writer;
+    if (!path.empty())
+      writer = openSessionLog(path,
+                              {.worldFile = options_.worldFile,
+                               .robotFile = world_.robots[0].model.file,
+                               .paramsFile = options_.paramsFile,
+                               .terrainFile = world_.terrain.file,
+                               .commandsFile = {},
+                               .overrides = options_.overrides,
+                               .replacedRobotFile = replacedRobotFile_,
+                               .extraMeta = options_.logMeta},
+                              error);
+    if (!writer) {
+      server->server->stop();
+      return error;
+    }
+    logPath_ = path;
+    host.logTo(std::move(writer));
+  }
+
+  port_ = server->server->port();
+  host.start();
+  Server& s = *server;
+  s.thread = std::thread([&s] { s.io.run(); });
+  server_ = std::move(server);
+  return {};
+}
+
+void StandInRobot::stop() {
+  if (server_) {
+    Server& s = *server_;
+    asio::post(s.io, [&s] {
+      s.server->stop();
+      s.io.stop();
+    });
+    if (s.thread.joinable()) s.thread.join();
+    const net::RobotServerStats& st = s.server->stats();
+    stats_ = {st.clientsAccepted, st.framesIn, st.badFrames, st.telemetryDropped, st.emulatedLost};
+    server_.reset();  // the server before the host it refers to
+  }
+  host_->stop();
+}
+
+bool StandInRobot::logFailed() const { return host_->log() && host_->log()->failed(); }
+
+std::string StandInRobot::logError() const { return host_->log() ? host_->log()->errorMessage() : std::string(); }
+
+int64_t StandInRobot::logDropped() const { return host_->log() ? host_->log()->dropped() : 0; }
+
+void StandInRobot::addNote(std::string text) { host_->logEvent("note", std::move(text)); }
+void StandInRobot::logEvent(std::string kind, std::string text) { host_->logEvent(std::move(kind), std::move(text)); }
+
+void StandInRobot::logPrediction(const LogPrediction& prediction) { host_->logPrediction(prediction); }
+
+}  // namespace sp

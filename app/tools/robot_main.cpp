@@ -1,0 +1,159 @@
+// simpartner-robot: the stand-in robot. Runs the twin headless and speaks
+// the robot's side of the link protocol (docs/protocol.md) on TCP, exactly as
+// a real robot's adapter would, so that everything can be tested without
+// hardware.
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <iostream>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "app/robot/line_writer.h"
+#include "app/robot/stand_in.h"
+
+namespace {
+
+constexpr const char* kUsage = R"(usage:
+  simpartner-robot --world FILE [options]
+      Runs the twin as a robot on the link protocol (docs/protocol.md).
+      --port N          TCP port (default: port.robot of the parameters; 0 = any free port)
+      --bind ADDRESS    address to listen on (default 127.0.0.1); any other
+                        address needs --token
+      --token HEX       shared secret, >= 32 hex digits; without it on
+                        loopback a random one is made and printed
+      --params FILE     parameters file; --set KEY=VALUE overrides (repeatable)
+      --rtf X|max       real-time factor (default: realtime.factor)
+      --delay S         emulate a slow link: one-way delay [s] in both directions
+      --jitter S        and +- this much jitter [s]
+      --loss P          and lose each frame with probability P
+      --log FILE        write the session log to FILE (must not exist)
+      --log-dir DIR     write it to a new DIR/session-YYYYMMDD-HHMMSS.splog
+                        (default: sessions/ under the current directory)
+      --no-log          write no session log
+      --no-terrain-edits  refuse terrain edits as a real robot does (the
+                        stand-in, a simulator, takes them by default)
+  Prints `logging to PATH`, then `listening on ADDRESS:PORT` when ready;
+  connections, lease changes and e-stops go to stderr. Stops on SIGINT or
+  SIGTERM. The session log (docs/session-format.md) re-simulates with
+  `simpartner-sim resim PATH`.
+)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  sp::StandInOptions options;
+  // The link's lines go through their own thread: the link thread (which
+  // runs the deadman) never waits for a stderr nobody reads.
+  sp::LineWriter lines(STDERR_FILENO, "simpartner-robot: ");
+  options.lineLog = [&lines](const std::string& line) { lines.write(line); };
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--help" || a == "-h") {
+      std::cout << kUsage;
+      return 0;
+    }
+    if (a == "--no-log") {
+      options.log = false;
+      continue;
+    }
+    if (a == "--no-terrain-edits") {
+      options.terrainEdits = false;
+      continue;
+    }
+    if (i + 1 >= args.size()) {
+      std::cerr << "<command line>: error: unknown option or missing value '" << a << "'\n" << kUsage;
+      return 2;
+    }
+    const std::string& v = args[++i];
+    if (a == "--world") options.worldFile = v;
+    else if (a == "--params") options.paramsFile = v;
+    else if (a == "--set") options.overrides.push_back(v);
+    else if (a == "--bind") options.bind = v;
+    else if (a == "--token") options.token = v;
+    else if (a == "--port") options.port = static_cast<uint16_t>(std::atoi(v.c_str()));
+    else if (a == "--rtf") options.realTimeFactor = v == "max" ? 0.0 : std::atof(v.c_str());
+    else if (a == "--log") options.logPath = v;
+    else if (a == "--log-dir") options.logDir = v;
+    else if (a == "--delay" || a == "--jitter" || a == "--loss") {
+      char* end = nullptr;
+      const double x = std::strtod(v.c_str(), &end);
+      if (end == v.c_str() || *end != '\0' || !(x >= 0) || (a == "--loss" && x > 1)) {
+        std::cerr << "<command line>: error: " << a << ": expected a number " << (a == "--loss" ? "in [0, 1]" : ">= 0")
+                  << ", got '" << v << "'\n";
+        return 2;
+      }
+      sp::net::LinkEmulatorConfig& e = options.emulation;
+      (a == "--delay" ? e.delay : a == "--jitter" ? e.jitter : e.loss) = x;
+    }
+    else {
+      std::cerr << "<command line>: error: unknown option '" << a << "'\n" << kUsage;
+      return 2;
+    }
+  }
+  if (options.worldFile.empty()) {
+    std::cerr << "<command line>: error: --world FILE is required\n" << kUsage;
+    return 2;
+  }
+  const std::string& bind = options.bind;
+  if (options.token.empty() && !(bind == "127.0.0.1" || bind == "::1" || bind == "localhost")) {
+    std::cerr << "<command line>: error: refusing to listen on " << bind
+              << " without --token: only loopback may run with a generated token\n";
+    return 2;
+  }
+  if (!options.log && (!options.logPath.empty() || options.logDir != sp::StandInOptions{}.logDir)) {
+    std::cerr << "<command line>: error: --no-log contradicts --log and --log-dir\n";
+    return 2;
+  }
+
+  sp::Diagnostics diag;
+  std::unique_ptr<sp::StandInRobot> robot = sp::StandInRobot::create(options, diag);
+  std::cerr << diag.format();
+  if (!robot) return 1;
+
+  // SIGINT and SIGTERM are taken by sigtimedwait below: blocked before
+  // start() so that the threads it starts inherit the mask.
+  sigset_t stopSignals;
+  sigemptyset(&stopSignals);
+  sigaddset(&stopSignals, SIGINT);
+  sigaddset(&stopSignals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
+
+  if (const std::string error = robot->start(); !error.empty()) {
+    std::cerr << "error: " << error << "\n";
+    return 1;
+  }
+  if (options.token.empty()) std::cout << "token " << robot->token() << "\n";
+  const sp::net::LinkEmulatorConfig& emulation = options.emulation;
+  if (emulation.active())
+    std::cout << "emulating a link with " << emulation.delay << " s delay, +-" << emulation.jitter << " s jitter, "
+              << emulation.loss * 100 << " % loss\n";
+  if (!robot->logPath().empty()) std::cout << "logging to " << robot->logPath() << "\n";
+  std::cout << "listening on " << bind << ":" << robot->port() << std::endl;
+
+  // Waits for a stop signal, looking at the log's health meanwhile: a
+  // failed log is told once and the twin runs on.
+  bool toldLogFailure = false;
+  const timespec poll{0, 200'000'000};
+  while (sigtimedwait(&stopSignals, nullptr, &poll) < 0) {
+    if (!toldLogFailure && robot->logFailed()) {
+      toldLogFailure = true;
+      lines.write("error: " + robot->logError() + "; the twin runs on without logging");
+    }
+  }
+  robot->stop();
+  const sp::StandInStats stats = robot->stats();
+  std::cout << "stopped: " << stats.clientsAccepted << " clients, " << stats.framesIn << " frames in, "
+            << stats.badFrames << " closed for bad frames, " << stats.telemetryDropped
+            << " telemetry frames dropped for slow clients\n";
+  if (!robot->logPath().empty()) {
+    if (robot->logDropped() > 0)
+      std::cerr << "simpartner-robot: warning: " << robot->logPath() << ": " << robot->logDropped()
+                << " log items dropped\n";
+    std::cout << "session log " << robot->logPath() << "\n";
+  }
+  return 0;
+}

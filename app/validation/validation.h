@@ -1,0 +1,85 @@
+#pragma once
+// The founding paper's validation experiments, run headless on the twin
+// (`simpartner-sim validate`). Each experiment returns its figures beside the
+// paper's, pass or fail against a stated target, the conditions, and the
+// data behind its plots; nothing in a report is typed by hand.
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "app/validation/plot.h"
+#include "sim/params.h"
+
+namespace sp {
+
+/// One figure of an experiment: ours beside the paper's. A judged metric
+/// has a target stated before the run that the figure can miss; an
+/// unjudged one (judged = false) is reported for context and counts for
+/// neither pass nor fail.
+struct Metric {
+  std::string quantity;
+  std::string paper;   ///< the paper's figure as text ("" if it gives none)
+  double ours = 0;
+  std::string unit;
+  std::string target;  ///< what counts as a pass, in words ("" when not judged)
+  bool pass = false;
+  bool judged = true;
+};
+
+struct ExperimentPlot {
+  std::string file;  ///< base name, no extension: file.png and file.csv
+  PlotSpec spec;
+};
+
+struct ExperimentResult {
+  int number = 0;
+  std::string title;
+  std::string conditions;  ///< world, friction, commands
+  std::vector<Metric> metrics;
+  std::vector<ExperimentPlot> plots;
+  std::string discussion;  ///< what the figures mean, with the numbers filled in
+  double simSeconds = 0, wallSeconds = 0;
+  bool pass() const;
+};
+
+struct ValidationOptions {
+  std::string sourceDir = ".";  ///< where robots/ and terrains/ are
+  bool quick = false;           ///< shorter runs (for CI)
+  SimParams params;             ///< physics parameters for every experiment
+};
+
+/// Runs the five experiments in order, logging progress to `log`. Throws
+/// std::runtime_error (with the loader's diagnostics) if a shipped file is
+/// broken. Thread: any; builds its own worlds.
+std::vector<ExperimentResult> runValidation(const ValidationOptions& options, std::ostream& log);
+
+ExperimentResult circularDrive(const ValidationOptions& options);
+ExperimentResult laserSweep(const ValidationOptions& options);
+ExperimentResult pickAndPlace(const ValidationOptions& options);
+ExperimentResult slipperySurface(const ValidationOptions& options);
+ExperimentResult testTrack(const ValidationOptions& options);
+
+/// A least-squares line y = intercept + slope x and its coefficient of
+/// determination (1 = every point on the line; 0 = no better than the mean).
+struct LinearFit {
+  double slope = 0, intercept = 0, r2 = 0;
+};
+LinearFit linearFit(const std::vector<double>& x, const std::vector<double>& y);
+
+/// Range errors sampled over time: errors[i] at range ranges[i] at times[i] (ascending).
+struct ErrorSeries {
+  std::vector<double> times, ranges, errors;
+};
+/// How far two series of range errors are from proportional to the range:
+/// over the instants both have where |error of b| >= floor, the median of
+/// |eb/db - ea/da| / |eb/db|. 0 when the error per metre of range is the
+/// same in both; infinity without such instants.
+double proportionalityMismatch(const ErrorSeries& a, const ErrorSeries& b, double floor);
+
+/// The report in Markdown: a summary table of every metric beside the
+/// paper's with pass or fail, the conditions, then a section per experiment
+/// with its plots (`file.png`) and discussion.
+std::string validationReport(const std::vector<ExperimentResult>& results, const ValidationOptions& options);
+
+}  // namespace sp

@@ -1,0 +1,182 @@
+// Tests of sp::ConsoleState (app/console/console_state.h): what the console
+// shows and allows, computed from link events and frames without a window.
+
+#include <QtTest>
+
+#include "app/console/console_state.h"
+
+using namespace sp;
+using net::ConnectionState;
+
+namespace {
+
+RobotFrame frameWith(bool failsafe, bool estop, std::string health = {}) {
+  RobotFrame f;
+  f.failsafe = failsafe;
+  f.estop = estop;
+  f.health = std::move(health);
+  return f;
+}
+
+// Connected, holding the lease, one healthy frame at wall time 0.
+ConsoleState driving() {
+  ConsoleState s;
+  s.connection(ConnectionState::Ready, {});
+  s.lease(true);
+  s.frame(frameWith(false, false), 0, std::nullopt);
+  return s;
+}
+
+bool anyLineHas(const std::vector<std::string>& lines, const std::string& part) {
+  for (const std::string& l : lines)
+    if (l.find(part) != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+class TestConsoleState : public QObject {
+  Q_OBJECT
+
+ private slots:
+  // Controls act only when connected, holding the lease, unlatched and
+  // showing the live robot; each refusal names its reason.
+  void controlsRefusal_data() {
+    QTest::addColumn<int>("connection");
+    QTest::addColumn<bool>("lease");
+    QTest::addColumn<bool>("estop");
+    QTest::addColumn<bool>("replay");
+    QTest::addColumn<QString>("why");
+    const int ready = static_cast<int>(ConnectionState::Ready);
+    QTest::newRow("driving") << ready << true << false << false << QString();
+    QTest::newRow("waiting") << static_cast<int>(ConnectionState::Waiting) << true << false << false
+                             << "Not connected to the robot";
+    QTest::newRow("no lease") << ready << false << false << false << "Take control first (Robot ▸ Take control)";
+    QTest::newRow("latched") << ready << true << true << false << "The robot is stopped and latched: re-arm first";
+    QTest::newRow("replay") << ready << true << false << true
+                            << "A replay is shown: close it (File ▸ Close replay) to drive the live robot";
+  }
+  void controlsRefusal() {
+    QFETCH(int, connection);
+    QFETCH(bool, lease);
+    QFETCH(bool, estop);
+    QFETCH(bool, replay);
+    QFETCH(QString, why);
+    ConsoleState s;
+    s.connection(static_cast<ConnectionState>(connection), "down");
+    s.lease(lease);
+    s.frame(frameWith(false, estop), 0, std::nullopt);
+    if (replay) s.replay("a.splog");
+    QCOMPARE(QString::fromStdString(s.controlsRefusal()), why);
+  }
+
+  // Losing the link loses the lease, and says so once (the controls go
+  // back to the robot's state then).
+  void linkLossLosesTheLease() {
+    ConsoleState s = driving();
+    QVERIFY(s.leaseHeld());
+    QVERIFY(s.connection(ConnectionState::Waiting, "timeout"));
+    QVERIFY(!s.leaseHeld());
+    QVERIFY(!s.connection(ConnectionState::Connecting, {}));  // nothing more to lose
+    QVERIFY(!anyLineHas(s.bannerLines(), "Robot link down"));  // connecting: no banner line
+    s.connection(ConnectionState::Waiting, "timeout");
+    QVERIFY(anyLineHas(s.bannerLines(), "Robot link down (timeout)"));
+    QVERIFY(!s.canRearm());
+    QVERIFY(!s.canReconnect());
+    QVERIFY(s.canDisconnect());
+  }
+
+  // A latch coming on is reported once, with the failsafe's reason in the
+  // banner; re-arm is offered while connected.
+  void latches() {
+    ConsoleState s = driving();
+    s.failsafeReason("deadman: no command for 0.2 s");
+    const FrameChanges on = s.frame(frameWith(true, false), 0.1, std::nullopt);
+    QVERIFY(on.latchedNow);
+    QVERIFY(on.banner);
+    const FrameChanges again = s.frame(frameWith(true, false), 0.12, std::nullopt);
+    QVERIFY(!again.latchedNow && !again.banner);
+    QVERIFY(anyLineHas(s.bannerLines(), "FAILSAFE latched: deadman: no command for 0.2 s; the robot stopped."));
+    QVERIFY(s.canRearm());
+    const FrameChanges off = s.frame(frameWith(false, false), 0.2, std::nullopt);
+    QVERIFY(!off.latchedNow && off.latches);
+    QVERIFY(s.bannerLines().empty());
+  }
+
+  // Stale: connected, a frame seen, none for longer than staleAfter. The
+  // next frame ends it; a replay shown hides the stale line (issue 27: a
+  // replay showed "no data 4.8 s" while telemetry arrived at 50 Hz).
+  void staleness() {
+    ConsoleState s = driving();
+    QVERIFY(!s.tick(0.4));
+    QVERIFY(s.tick(0.6));
+    QVERIFY(s.stale());
+    QCOMPARE(s.staleText(0.6), std::string("no data 0.6 s: the robot drawn is where it was 0.6 s ago"));
+    QCOMPARE(s.health().text, std::string("no data"));
+    QVERIFY(s.frame(frameWith(false, false), 0.7, std::nullopt).staleEnded);
+    QVERIFY(!s.stale());
+    // Frames keep arriving while a replay is shown: never stale.
+    s.replay("b.splog");
+    for (double t = 0.72; t < 5; t += 0.02) {
+      s.frame(frameWith(false, false), t, std::nullopt);
+      s.tick(t + 0.01);
+    }
+    QVERIFY(!s.stale());
+    QCOMPARE(s.health().text, std::string("replay"));
+    // Not connected: not stale, however old the data.
+    ConsoleState d = driving();
+    d.connection(ConnectionState::Waiting, {});
+    QVERIFY(!d.tick(10));
+    QVERIFY(!d.stale());
+  }
+
+  // The edge warning appears within edgeWarning of a heightfield's edge,
+  // updates in 0.1 m steps, and says so when beyond it.
+  void edge() {
+    ConsoleState s = driving();
+    s.terrain(true, 20, 10);
+    QVERIFY(!s.frame(frameWith(false, false), 0.1, 3.0).banner);
+    QVERIFY(s.frame(frameWith(false, false), 0.2, 1.4).banner);
+    QVERIFY(anyLineHas(s.bannerLines(), "Near the terrain's edge: 1.4 m left of the 20.0 × 10.0 m heightfield"));
+    QVERIFY(!s.frame(frameWith(false, false), 0.3, 1.35).banner);  // under 0.1 m: unchanged
+    QVERIFY(s.frame(frameWith(false, false), 0.4, -0.5).banner);
+    QVERIFY(anyLineHas(s.bannerLines(), "off the terrain (0.5 m beyond its edge)"));
+    s.clearFrames();
+    QVERIFY(s.bannerLines().empty());
+  }
+
+  // While a replay is shown the banner says which robot its alarms are
+  // about; closing the replay brings the live robot's banner back.
+  void replayBanner() {
+    ConsoleState s = driving();
+    s.frame(frameWith(false, true), 0.1, std::nullopt);
+    const uint64_t before = s.revision();
+    s.replay("session-1.splog");
+    QVERIFY(s.revision() > before);
+    const std::vector<std::string> lines = s.bannerLines();
+    QCOMPARE(lines.size(), size_t(2));
+    QVERIFY(anyLineHas(lines, "Replay of session-1.splog"));
+    QVERIFY(anyLineHas(lines, "Live robot: E-STOP latched"));
+    s.replay({});
+    QCOMPARE(s.bannerLines(), std::vector<std::string>{"E-STOP latched: the robot is stopped. Re-arm to continue."});
+  }
+
+  // Health names what is shown: diverged beats stale, not connected, and
+  // healthy only once telemetry came.
+  void health() {
+    ConsoleState s;
+    QCOMPARE(s.health().text, std::string("not connected"));
+    s.connection(ConnectionState::Ready, {});
+    QCOMPARE(s.health().text, std::string("no telemetry"));
+    s.frame(frameWith(false, false), 0, std::nullopt);
+    QCOMPARE(s.health().text, std::string("healthy"));
+    QVERIFY(s.health().level == HealthLevel::Good);
+    s.frame(frameWith(false, false, "body 3 position is NaN"), 0.1, std::nullopt);
+    QCOMPARE(s.health().text, std::string("diverged"));
+    QCOMPARE(s.health().detail, std::string("body 3 position is NaN"));
+    QVERIFY(s.health().level == HealthLevel::Alarm);
+  }
+};
+
+QTEST_GUILESS_MAIN(TestConsoleState)
+#include "tst_console_state.moc"

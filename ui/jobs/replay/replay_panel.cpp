@@ -1,0 +1,542 @@
+#include "ui/jobs/replay/replay_panel.h"
+
+#include <QBoxLayout>
+#include <QComboBox>
+#include <QFile>
+#include <QFileDialog>
+#include <QMessageBox>
+#include <QTextStream>
+#include <QtCharts/QChart>
+#include <QtCharts/QChartView>
+#include <QtCharts/QLineSeries>
+#include <QtCharts/QValueAxis>
+#include <QFileInfo>
+#include <QLabel>
+#include <QListWidget>
+#include <QMouseEvent>
+#include <QPainter>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QSignalBlocker>
+#include <QSlider>
+#include <QTimer>
+
+#include <algorithm>
+#include <cmath>
+
+namespace sp {
+
+// Ticks at the events' times, aligned with the slider above; a click seeks
+// to the nearest event.
+class ReplayPanel::Marks : public QWidget {
+ public:
+  explicit Marks(ReplayPanel* panel) : QWidget(panel), panel_(panel) {
+    setFixedHeight(10);
+    setToolTip(tr("Events of the log; click one to go there"));
+  }
+
+ protected:
+  void paintEvent(QPaintEvent*) override {
+    const LogPlayer* p = panel_->player();
+    if (!p || p->endTime() <= p->startTime()) return;
+    QPainter painter(this);
+    for (const LogEvent& e : p->events()) {
+      const int x = xOf(e.time);
+      painter.setPen(e.kind == "note" ? QColor(0, 110, 200) : e.kind == "estop" || e.kind == "failsafe" || e.kind == "guard"
+                                                              ? QColor(200, 0, 0)
+                                                              : QColor(110, 110, 110));
+      painter.drawLine(x, 0, x, height());
+    }
+  }
+  void mousePressEvent(QMouseEvent* event) override {
+    const LogPlayer* p = panel_->player();
+    if (!p) return;
+    int best = -1, bestDistance = 8;  // pixels
+    for (int i = 0; i < static_cast<int>(p->events().size()); ++i) {
+      const int d = std::abs(xOf(p->events()[static_cast<size_t>(i)].time) - static_cast<int>(event->position().x()));
+      if (d < bestDistance) {
+        best = i;
+        bestDistance = d;
+      }
+    }
+    if (best >= 0) panel_->seekToEvent(best);
+  }
+
+ private:
+  int xOf(double t) const {
+    const LogPlayer* p = panel_->player();
+    const double f = (t - p->startTime()) / (p->endTime() - p->startTime());
+    return static_cast<int>(std::lround(std::clamp(f, 0.0, 1.0) * (width() - 1)));
+  }
+  ReplayPanel* panel_;
+};
+
+ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
+  auto* layout = new QVBoxLayout(this);
+  layout->setContentsMargins(4, 4, 4, 4);
+  title_ = new QLabel(tr("No log open: File ▸ Open session log…"), this);
+  layout->addWidget(title_);
+  auto* row = new QHBoxLayout;
+  auto* back = new QPushButton(QStringLiteral("◀"), this);
+  back->setToolTip(tr("Step back %1 s").arg(kStep));
+  playButton_ = new QPushButton(tr("Play"), this);
+  auto* forward = new QPushButton(QStringLiteral("▶|"), this);
+  forward->setToolTip(tr("Step forward %1 s").arg(kStep));
+  for (QPushButton* b : {back, playButton_, forward}) b->setFocusPolicy(Qt::NoFocus);
+  speedBox_ = new QComboBox(this);
+  for (double s : {0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0}) speedBox_->addItem(QStringLiteral("%1×").arg(s), s);
+  speedBox_->setCurrentIndex(3);
+  slider_ = new QSlider(Qt::Horizontal, this);
+  timeLabel_ = new QLabel(this);
+  timeLabel_->setMinimumWidth(130);
+  row->addWidget(back);
+  row->addWidget(playButton_);
+  row->addWidget(forward);
+  row->addWidget(speedBox_);
+  row->addWidget(timeLabel_, 1);
+  auto* branch = new QPushButton(tr("Simulate from here"), this);
+  branch->setToolTip(tr("A new stand-in session starting from the logged state at the cursor (a new log naming this one)"));
+  branch->setFocusPolicy(Qt::NoFocus);
+  row->addWidget(branch);
+  auto* rehearse = new QPushButton(tr("Rehearse from here"), this);
+  rehearse->setToolTip(tr("The Sequence dock rehearses from the logged state at the cursor, in the logged world"));
+  auto* verifyButton = new QPushButton(tr("Verify"), this);
+  verifyButton->setToolTip(tr("Re-simulate the whole log and compare every logged state hash"));
+  for (QPushButton* b : {branch, rehearse, verifyButton}) b->setFocusPolicy(Qt::NoFocus);
+  row->addWidget(rehearse);
+  row->addWidget(verifyButton);
+  layout->addLayout(row);
+  connect(rehearse, &QPushButton::clicked, this, [this] { rehearseHere(); });
+  connect(verifyButton, &QPushButton::clicked, this, [this] { verify(); });
+  // What runs on the worker: what, how far, Cancel. Enabled while the rest
+  // of the panel is (a log opening is shown on the disabled panel too).
+  progressRow_ = new QWidget(this);
+  auto* progressLayout = new QHBoxLayout(progressRow_);
+  progressLayout->setContentsMargins(0, 0, 0, 0);
+  progressLabel_ = new QLabel(progressRow_);
+  progressBar_ = new QProgressBar(progressRow_);
+  progressBar_->setRange(0, 1000);
+  progressBar_->setTextVisible(false);
+  auto* cancelButton = new QPushButton(tr("Cancel"), progressRow_);
+  progressLayout->addWidget(progressLabel_);
+  progressLayout->addWidget(progressBar_, 1);
+  progressLayout->addWidget(cancelButton);
+  connect(cancelButton, &QPushButton::clicked, this, [this] { cancel(); });
+  layout->addWidget(progressRow_);
+  progressRow_->hide();
+  // The timeline its own full width, the events ticked under it.
+  auto* track = new QVBoxLayout;
+  track->setSpacing(0);
+  track->addWidget(slider_);
+  marks_ = new Marks(this);
+  track->addWidget(marks_);
+  layout->addLayout(track);
+  connect(branch, &QPushButton::clicked, this, [this] { branchHere(); });
+  auto* plotRow = new QHBoxLayout;
+  signalBox_ = new QComboBox(this);
+  signalBox_->setToolTip(tr("The logged signal to plot"));
+  signalBox_->setMinimumContentsLength(22);
+  auto* csv = new QPushButton(tr("CSV…"), this);
+  csv->setToolTip(tr("Export the visible range of the plotted signal as CSV"));
+  auto* png = new QPushButton(tr("PNG…"), this);
+  png->setToolTip(tr("Export the plot as a picture"));
+  readout_ = new QLabel(this);
+  plotRow->addWidget(signalBox_);
+  plotRow->addWidget(csv);
+  plotRow->addWidget(png);
+  plotRow->addWidget(readout_, 1);
+  layout->addLayout(plotRow);
+  auto* chart = new QChart;
+  chart->setAnimationOptions(QChart::NoAnimation);
+  chart->legend()->hide();
+  chart->setMargins({2, 2, 2, 2});
+  series_ = new QLineSeries;
+  cursorLine_ = new QLineSeries;
+  chart->addSeries(series_);
+  chart->addSeries(cursorLine_);
+  chart->createDefaultAxes();
+  chart_ = new QChartView(chart, this);
+  chart_->setRubberBand(QChartView::HorizontalRubberBand);
+  chart_->setMinimumHeight(110);
+  layout->addWidget(chart_, 2);
+  events_ = new QListWidget(this);
+  layout->addWidget(events_, 1);
+  replotTimer_ = new QTimer(this);
+  replotTimer_->setSingleShot(true);
+  replotTimer_->setInterval(100);
+  connect(replotTimer_, &QTimer::timeout, this, &ReplayPanel::replot);
+  // Zooming changes the time axis: the log is read again for that range.
+  connect(static_cast<QValueAxis*>(chart->axes(Qt::Horizontal).front()), &QValueAxis::rangeChanged, this,
+          [this] { replotTimer_->start(); });
+  connect(signalBox_, &QComboBox::currentIndexChanged, this, [this](int i) { setSignal(i); });
+  connect(csv, &QPushButton::clicked, this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, tr("Export CSV"), QString(), tr("CSV (*.csv)"));
+    if (const QString e = path.isEmpty() ? QString() : exportCsv(path); !e.isEmpty()) QMessageBox::warning(this, tr("Export CSV"), e);
+  });
+  connect(png, &QPushButton::clicked, this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, tr("Export PNG"), QString(), tr("PNG (*.png)"));
+    if (const QString e = path.isEmpty() ? QString() : exportPng(path); !e.isEmpty()) QMessageBox::warning(this, tr("Export PNG"), e);
+  });
+
+  timer_ = new QTimer(this);
+  timer_->setInterval(16);
+  connect(timer_, &QTimer::timeout, this, &ReplayPanel::tick);
+  connect(playButton_, &QPushButton::clicked, this, [this] { playing_ ? pause() : play(); });
+  connect(back, &QPushButton::clicked, this, [this] { step(-1); });
+  connect(forward, &QPushButton::clicked, this, [this] { step(+1); });
+  connect(speedBox_, &QComboBox::currentIndexChanged, this, [this](int i) { setSpeed(speedBox_->itemData(i).toDouble()); });
+  connect(slider_, &QSlider::valueChanged, this, [this](int ms) { show(ms / 1000.0); });
+  connect(events_, &QListWidget::itemClicked, this, [this](QListWidgetItem* item) { seekToEvent(events_->row(item)); });
+  setEnabled(false);  // until a log is open (or opening: Cancel)
+}
+
+ReplayPanel::~ReplayPanel() {
+  cancel_ = true;
+  if (worker_.joinable()) worker_.join();
+}
+
+QString ReplayPanel::open(const QString& path) {
+  std::string error;
+  std::unique_ptr<LogPlayer> player = LogPlayer::open(path.toStdString(), error);
+  if (!player) return QString::fromStdString(error);
+  adopt(std::move(player), path, std::nullopt);
+  return {};
+}
+
+void ReplayPanel::openInBackground(const QString& path) {
+  runInBackground(tr("Opening %1").arg(QFileInfo(path).fileName()),
+                  [this, path](const std::function<bool(double)>& progress) -> std::function<void()> {
+                    std::string error;
+                    // Held by a shared pointer: std::function needs a copyable closure.
+                    auto player = std::make_shared<std::unique_ptr<LogPlayer>>(LogPlayer::open(path.toStdString(), error));
+                    if (!*player) return [this, e = QString::fromStdString(error)] { emit failed(e); };
+                    if (!progress(0.5)) return {};
+                    // The first plot: 1500 seeks, a second or more on a cold disk.
+                    const LogPlayer& p = **player;
+                    auto points = p.signal(kFirstSignal, p.startTime(), p.endTime(), kPlotPoints);
+                    return [this, player, path, points = std::move(points)] {
+                      // The player moves to the GUI thread now; the worker has let go of it.
+                      adopt(std::move(*player), path, points);
+                    };
+                  });
+}
+
+void ReplayPanel::adopt(std::unique_ptr<LogPlayer> player, const QString& path,
+                        std::optional<std::vector<std::pair<double, double>>> firstPlot) {
+  pause();
+  player_ = std::move(player);
+  lastResult_.clear();
+  setEnabled(true);
+  title_->setText(tr("%1: %2 s, %3 events%4")
+                      .arg(QFileInfo(path).fileName())
+                      .arg(player_->endTime() - player_->startTime(), 0, 'f', 1)
+                      .arg(player_->events().size())
+                      .arg(player_->hasSnapshots() ? QString() : tr(" (telemetry only)")));
+  events_->clear();
+  for (const LogEvent& e : player_->events())
+    events_->addItem(QStringLiteral("%1 s  %2: %3")
+                         .arg(e.time, 0, 'f', 2)
+                         .arg(QString::fromStdString(e.kind), QString::fromStdString(e.text)));
+  {
+    const QSignalBlocker block(slider_);
+    slider_->setRange(static_cast<int>(std::floor(player_->startTime() * 1000)),
+                      static_cast<int>(std::ceil(player_->endTime() * 1000)));
+  }
+  emit opened(player_->world());
+  {
+    const QSignalBlocker block(signalBox_);
+    signalBox_->clear();
+    for (const std::string& name : player_->signalNames()) signalBox_->addItem(QString::fromStdString(name));
+    signalBox_->setCurrentIndex(kFirstSignal);
+  }
+  cursor_ = player_->startTime();
+  terrainShown_ = 0;  // opened() drew the terrain as loaded
+  if (firstPlot) {
+    {
+      const QSignalBlocker block(chart_->chart()->axes(Qt::Horizontal).front());  // no re-read: the points are here
+      setVisibleRange(player_->startTime(), player_->endTime());
+    }
+    plot(*firstPlot);
+  } else {
+    setSignal(signalBox_->currentIndex());
+  }
+  show(cursor_);
+  marks_->update();
+}
+
+bool ReplayPanel::runInBackground(
+    const QString& what, std::function<std::function<void()>(const std::function<bool(double)>& progress)> work) {
+  if (busy_) {
+    emit failed(tr("%1: wait for \"%2\" to end, or cancel it").arg(what, progressLabel_->text()));
+    return false;
+  }
+  if (worker_.joinable()) worker_.join();  // the last one has ended
+  busy_ = true;
+  cancel_ = false;
+  progressLabel_->setText(what + QStringLiteral("…"));
+  progressBar_->setValue(0);
+  progressRow_->show();
+  setEnabled(true);  // for Cancel; every control checks for a player
+  worker_ = std::thread([this, work = std::move(work)] {
+    std::function<void()> done = work([this](double f) {
+      QMetaObject::invokeMethod(this, [this, f] { progressBar_->setValue(static_cast<int>(f * 1000)); },
+                                Qt::QueuedConnection);
+      return !cancel_.load();
+    });
+    QMetaObject::invokeMethod(
+        this,
+        [this, done = std::move(done)] {
+          finishBackground();
+          if (cancel_.load()) {
+            emit failed(tr("Cancelled."));
+            return;
+          }
+          if (done) done();
+        },
+        Qt::QueuedConnection);
+  });
+  return true;
+}
+
+void ReplayPanel::finishBackground() {
+  busy_ = false;
+  progressRow_->hide();
+  progressLabel_->clear();
+  setEnabled(player_ != nullptr);
+}
+
+void ReplayPanel::cancel() { cancel_ = true; }
+
+QString ReplayPanel::progressText() const { return busy_ ? progressLabel_->text() : QString(); }
+
+void ReplayPanel::branchHere() {
+  if (!player_) return;
+  pause();
+  const QString path = QString::fromStdString(player_->path());
+  const double at = cursor_;
+  if (!player_->hasSnapshots()) {
+    // Reconstructed from one sample: no re-simulation, nothing to wait for.
+    std::string error;
+    std::optional<BranchPoint> b = player_->branchAt(at, error);
+    if (!b) emit failed(QString::fromStdString(error));
+    else emit branchReady(path, std::make_shared<const BranchPoint>(std::move(*b)));
+    return;
+  }
+  runInBackground(tr("Re-simulating to t = %1 s").arg(at, 0, 'f', 3),
+                  [this, path, at](const std::function<bool(double)>& progress) -> std::function<void()> {
+                    std::string error;
+                    std::optional<BranchPoint> b = sp::branchAt(path.toStdString(), at, error, progress);
+                    if (!b) return [this, e = QString::fromStdString(error)] { emit failed(e); };
+                    auto point = std::make_shared<const BranchPoint>(std::move(*b));
+                    return [this, path, point] { emit branchReady(path, point); };
+                  });
+}
+
+bool ReplayPanel::rehearseHere() {
+  if (!player_) return false;
+  pause();
+  const std::optional<RehearsalStart> start = player_->startAt(cursor_);
+  if (!start) {
+    emit failed(tr("No sample at t = %1 s to rehearse from").arg(cursor_, 0, 'f', 3));
+    return false;
+  }
+  emit rehearsalStart(*start, player_->world(), player_->params(),
+                      tr("%1 at t = %2 s").arg(QFileInfo(QString::fromStdString(player_->path())).fileName())
+                          .arg(cursor_, 0, 'f', 2));
+  return true;
+}
+
+void ReplayPanel::verify() {
+  if (!player_) return;
+  if (!player_->hasSnapshots()) {
+    lastResult_ = tr("A telemetry-only log holds no snapshots or hashes: there is nothing to re-simulate.");
+    readout_->setText(lastResult_);
+    emit verified(false, lastResult_);
+    return;
+  }
+  const QString path = QString::fromStdString(player_->path());
+  runInBackground(tr("Verifying %1 (re-simulating it)").arg(QFileInfo(path).fileName()),
+                  [this, path](const std::function<bool(double)>& progress) -> std::function<void()> {
+                    std::string error;
+                    const std::optional<ResimReport> r = resimulate(path.toStdString(), {.from = 0, .progress = progress}, error);
+                    QString verdict;
+                    bool passed = false;
+                    if (!r) {
+                      verdict = QString::fromStdString(error);
+                    } else if (r->divergence) {
+                      verdict = tr("Diverges at t = %1 s (step %2): logged hash %3, re-simulated %4")
+                                    .arg(r->divergence->time, 0, 'f', 3)
+                                    .arg(r->divergence->step)
+                                    .arg(QString::fromStdString(hashHex(r->divergence->expected)),
+                                         QString::fromStdString(hashHex(r->divergence->actual)));
+                    } else {
+                      passed = r->hashesCompared > 0;
+                      verdict = tr("Reproduced: %1 logged hashes match, %2 commands re-applied")
+                                    .arg(r->hashesCompared)
+                                    .arg(r->commandsApplied);
+                    }
+                    return [this, passed, verdict] {
+                      lastResult_ = verdict;
+                      title_->setToolTip(verdict);
+                      readout_->setText(verdict);
+                      emit verified(passed, verdict);
+                    };
+                  });
+}
+
+void ReplayPanel::close() {
+  pause();
+  player_.reset();
+  events_->clear();
+  series_->clear();
+  cursorLine_->clear();
+  readout_->clear();
+  {
+    const QSignalBlocker block(signalBox_);
+    signalBox_->clear();
+  }
+  title_->setText(tr("No log open: File ▸ Open session log…"));
+  setEnabled(false);
+  emit closed();
+}
+
+void ReplayPanel::seek(double time) { show(time); }
+
+void ReplayPanel::play() {
+  if (!player_) return;
+  if (cursor_ >= player_->endTime()) show(player_->startTime());  // from the start again
+  playing_ = true;
+  playButton_->setText(tr("Pause"));
+  wall_.start();
+  timer_->start();
+}
+
+void ReplayPanel::pause() {
+  playing_ = false;
+  timer_->stop();
+  playButton_->setText(tr("Play"));
+}
+
+void ReplayPanel::setSpeed(double factor) {
+  speed_ = std::clamp(factor, 0.1, 10.0);
+  const int i = speedBox_->findData(speed_);
+  if (i >= 0 && i != speedBox_->currentIndex()) {
+    const QSignalBlocker block(speedBox_);
+    speedBox_->setCurrentIndex(i);
+  }
+}
+
+void ReplayPanel::step(int direction) {
+  pause();
+  show(cursor_ + direction * kStep);
+}
+
+void ReplayPanel::seekToEvent(int index) {
+  if (!player_ || index < 0 || index >= static_cast<int>(player_->events().size())) return;
+  pause();
+  show(player_->events()[static_cast<size_t>(index)].time);
+}
+
+void ReplayPanel::setSignal(int index) {
+  if (!player_ || index < 0 || index >= signalBox_->count()) return;
+  if (signalBox_->currentIndex() != index) {
+    const QSignalBlocker block(signalBox_);
+    signalBox_->setCurrentIndex(index);
+  }
+  setVisibleRange(player_->startTime(), player_->endTime());
+  replot();
+}
+
+int ReplayPanel::signalIndex() const { return signalBox_->currentIndex(); }
+
+void ReplayPanel::setVisibleRange(double t0, double t1) {
+  auto* x = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Horizontal).front());
+  x->setRange(t0, std::max(t1, t0 + 1e-3));
+}
+
+void ReplayPanel::replot() {
+  replotTimer_->stop();
+  if (!player_) return;
+  auto* x = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Horizontal).front());
+  plot(player_->signal(signalBox_->currentIndex(), x->min(), x->max(), kPlotPoints));
+}
+
+void ReplayPanel::plot(const std::vector<std::pair<double, double>>& points) {
+  auto* y = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Vertical).front());
+  QList<QPointF> list;
+  double lo = 0, hi = 0;
+  for (const auto& [t, v] : points) {
+    if (list.isEmpty()) lo = hi = v;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+    list.append({t, v});
+  }
+  series_->replace(list);
+  const double pad = std::max(1e-6, 0.05 * (hi - lo));
+  y->setRange(lo - pad, hi + pad);
+  y->setTitleText(signalBox_->currentText());
+  moveCursorLine();
+}
+
+void ReplayPanel::moveCursorLine() {
+  auto* y = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Vertical).front());
+  cursorLine_->replace(QList<QPointF>{{cursor_, y->min()}, {cursor_, y->max()}});
+  readout_->setText(readout());
+}
+
+QList<QPointF> ReplayPanel::plotted() const { return series_->points(); }
+
+QString ReplayPanel::readout() const {
+  const QList<QPointF> p = series_->points();
+  if (p.isEmpty()) return {};
+  // The plotted point at or before the cursor.
+  auto it = std::upper_bound(p.begin(), p.end(), cursor_, [](double t, const QPointF& q) { return t < q.x(); });
+  const QPointF at = it == p.begin() ? p.front() : *(it - 1);
+  return tr("t = %1 s: %2 = %3").arg(cursor_, 0, 'f', 3).arg(signalBox_->currentText()).arg(at.y(), 0, 'g', 6);
+}
+
+QString ReplayPanel::exportCsv(const QString& path) const {
+  QFile f(path);
+  if (!f.open(QIODevice::WriteOnly | QIODevice::Truncate | QIODevice::Text)) return path + ": " + f.errorString();
+  QTextStream out(&f);
+  out << "time [s]," << signalBox_->currentText() << "\n";
+  auto* x = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Horizontal).front());
+  for (const QPointF& p : series_->points())
+    if (p.x() >= x->min() && p.x() <= x->max()) out << QString::number(p.x(), 'g', 17) << ',' << QString::number(p.y(), 'g', 17) << "\n";
+  out.flush();
+  if (out.status() != QTextStream::Ok || !f.flush()) return path + ": " + f.errorString();
+  return {};
+}
+
+QString ReplayPanel::exportPng(const QString& path) const {
+  const QPixmap picture = chart_->grab();
+  return picture.save(path, "PNG") ? QString() : path + tr(": cannot write the picture");
+}
+
+void ReplayPanel::tick() {
+  // Wall time since the last tick, not the timer's nominal period: the pace
+  // holds when ticks come late.
+  const double dt = static_cast<double>(wall_.nsecsElapsed()) * 1e-9;
+  wall_.start();
+  show(cursor_ + dt * speed_);
+  if (cursor_ >= player_->endTime()) pause();
+}
+
+void ReplayPanel::show(double time) {
+  if (!player_) return;
+  cursor_ = std::clamp(time, player_->startTime(), player_->endTime());
+  {
+    const QSignalBlocker block(slider_);
+    slider_->setValue(static_cast<int>(std::lround(cursor_ * 1000)));
+  }
+  timeLabel_->setText(tr("%1 / %2 s").arg(cursor_, 0, 'f', 2).arg(player_->endTime(), 0, 'f', 1));
+  moveCursorLine();
+  if (std::optional<RobotFrame> f = player_->frameAt(cursor_)) emit frame(*f);
+  if (std::optional<LaserFrame> l = player_->laserAt(cursor_)) emit laser(*l);
+  if (const size_t edits = player_->terrainEditsAt(cursor_); edits != terrainShown_) {
+    terrainShown_ = edits;
+    emit terrain(player_->terrainAfter(edits));
+  }
+}
+
+}  // namespace sp

@@ -1,0 +1,223 @@
+#pragma once
+// The console's first job: a command sequence is written here, rehearsed on
+// the console's own twin from the robot's current state, and only a sequence
+// that passed is sent to the robot, unchanged. While it runs on board, the
+// guard compares telemetry with the rehearsal and aborts it when the robot
+// departs.
+//
+//   editor      the `.seq` text; errors inline as you type (the line
+//               underlined, the message below), a template per command,
+//               open and save;
+//   rehearse    on a worker thread, with progress and cancel; the verdict of
+//               every flight rule (a failed one seeks the scrubber to its
+//               time); the rehearsed path and an amber robot in the 3D view;
+//               a scrubber over the rehearsal and a plot of its stability
+//               margin, roll and pitch with the scrubber's time marked;
+//   robustness  rules' robust.samples perturbed rehearsals on both cores:
+//               success probability and the spread of the end positions
+//               (their hull drawn with the path); "On cluster…" writes the
+//               same rehearsals as a sweep folder and submits it to Slurm
+//               (app/sweep/sweep.h, docs/sweeps.md);
+//   relay       Send (only after a pass, with the text unchanged since),
+//               the robot's progress, Abort.
+//
+// The panel holds no link: it asks for the start state and sends through
+// the callbacks and signals MainWindow connects (app/rehearse/sequence_relay.h does
+// the protocol's side).
+//
+// Thread: GUI thread. Rehearsals run on a std::thread of the panel's,
+// cancelled and joined by the destructor.
+
+#include <QCoreApplication>
+#include <QString>
+#include <QStringList>
+#include <QWidget>
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <thread>
+
+#include "app/rehearse/rehearsal.h"
+#include "app/rehearse/sequence_guard.h"
+#include "net/message.h"
+
+class QLabel;
+class QListWidget;
+class QPlainTextEdit;
+class QProgressBar;
+class QPushButton;
+class QSlider;
+class QTimer;
+class QTreeWidget;
+class QToolButton;
+QT_FORWARD_DECLARE_CLASS(QChartView)
+QT_FORWARD_DECLARE_CLASS(QLineSeries)
+
+namespace sp {
+
+class SequencePanel : public QWidget {
+  Q_OBJECT
+
+ public:
+  explicit SequencePanel(QWidget* parent = nullptr);
+  /// Cancels and joins a rehearsal in progress.
+  ~SequencePanel() override;
+
+  /// The world and parameters rehearsals run on (robots[0] is the robot);
+  /// re-checks the text. Drops the last rehearsal.
+  void setWorld(const WorldModel& world, const SimParams& params);
+  void setRules(const FlightRules& rules);
+  const FlightRules& rules() const { return rules_; }
+  /// Where a rehearsal starts: the robot's state now (nullopt = not known:
+  /// then the world's own start). Called when Rehearse is pressed.
+  void setStartProvider(std::function<std::optional<RehearsalStart>()> provider);
+  /// Rehearse from a logged moment (Replay ▸ Rehearse from here): until
+  /// unpinned, rehearsals start from `start` in the logged `world` with its
+  /// `params` instead of the robot's state now. Such a rehearsal is a
+  /// what-if: it cannot be sent (the robot is not there).
+  void pinStart(const RehearsalStart& start, const WorldModel& world, const SimParams& params, const QString& label);
+  void unpinStart();
+  /// "" while rehearsals start from the robot; else where they start.
+  QString pinnedStart() const { return pinned_ ? pinned_->label : QString(); }
+  /// The terrain was edited: rehearsals run on the edited heights, and the
+  /// last rehearsal (on the old ones) cannot be sent until rehearsed again.
+  void terrainEdited(const TerrainPatchCmd& patch);
+  /// Whether a sequence may go to the robot now (connected, holding the
+  /// lease, nothing latched).
+  void setLinkReady(bool ready);
+
+  void setText(const QString& text);
+  QString text() const;
+  /// The text's problems, "line N: message" each; empty when it parses and
+  /// passes the robot's limits. Up to date after checkNow().
+  QStringList errors() const { return errors_; }
+  /// Checks the text now (typing checks it 150 ms after the last key).
+  void checkNow();
+  /// The lines marked in the editor.
+  QList<int> markedLines() const;
+
+  /// Starts a rehearsal of the text (false, and the reason in status(), if
+  /// it has errors or one runs). `rehearsed` is emitted when it ends.
+  bool rehearse();
+  /// Starts the robustness rehearsals (needs a passed rehearsal).
+  bool checkRobustness();
+  /// The same robustness rehearsals as a sweep in `dir` (app/sweep/sweep.h:
+  /// sample i equals the local robustness's sample i), submitted with
+  /// sbatch when this machine has it; status() says where and what next.
+  bool robustnessOnCluster(const QString& dir);
+  /// The simpartner-sim a cluster's tasks run (default: beside this program).
+  void setSimBinary(const QString& path) { simBinary_ = path; }
+  bool busy() const { return busy_; }
+  /// The last rehearsal, if any (and whether the text is still what it rehearsed).
+  const std::optional<RehearsalResult>& result() const { return result_; }
+  const std::optional<RobustnessResult>& robustnessResult() const { return robust_; }
+  bool rehearsalCurrent() const;
+  /// Sends the rehearsed sequence (false and status() says why if it
+  /// cannot go: not passed, edited since, link not ready).
+  bool send();
+  /// Asks the robot to abort the running sequence.
+  void abort(const QString& reason);
+  /// The guard the link's worker feeds (RobotConnection::guard()); the
+  /// panel arms it on Send and shows its state.
+  void setGuard(std::shared_ptr<SequenceGuard> guard);
+  /// Where the relayed sequence stands.
+  SequenceGuard::Status relay() const { return guard_->status(); }
+  QString status() const;
+  /// Seeks the scrubber to `time` [s from the sequence's start].
+  void scrubTo(double time);
+  double scrubTime() const;
+
+  QPushButton* rehearseButton() const { return rehearseButton_; }
+  QPushButton* sendButton() const { return sendButton_; }
+  QPushButton* abortButton() const { return abortButton_; }
+  QTreeWidget* verdictList() const { return verdicts_; }
+
+ public slots:
+  /// The robot's SEQUENCE_STATE (after the guard has taken it).
+  void onSequenceState(const sp::net::SequenceStateMsg& state);
+  /// The guard tripped; its ABORT has gone out already.
+  void onGuardTripped(const QString& hash, const sp::GuardDeparture& departure);
+
+ signals:
+  void rehearsed(bool passed);
+  void robustnessDone();
+  /// Send this SEQUENCE to the robot.
+  void sendRequested(const sp::net::SequenceMsg& message);
+  /// Send ABORT for `hash` (the operator's Abort).
+  void abortRequested(const QString& hash, const QString& reason);
+  /// The scrubber moved: draw the rehearsed robot here.
+  void scrubbed(const sp::Pose& base, const std::vector<double>& jointPositions);
+  /// A new rehearsal path (base positions on the ground) and the robustness
+  /// envelope (hull of end positions; empty for none).
+  void pathChanged(const std::vector<sp::Vec3>& path, const std::vector<sp::Vec3>& envelope);
+  /// Something for the session log: kind "rehearsal", "relay" or "guard".
+  void logEvent(const QString& kind, const QString& text);
+  /// The operator must know now (the guard tripped, the robot refused).
+  void alert(const QString& text);
+
+ private:
+  void buildTemplateMenu(QToolButton* button);
+  void openFile();
+  void saveFile();
+  void startWorker(std::function<void()> work);
+  void rehearsalDone(RehearsalPlan plan, RehearsalResult result);
+  void robustnessFinished(RobustnessResult result);
+  void showVerdicts();
+  void showScrub(int index);
+  void updateButtons();
+  void setStatus(const QString& text);
+
+  std::optional<WorldModel> world_;
+  SimParams params_;
+  FlightRules rules_;
+  std::function<std::optional<RehearsalStart>()> startProvider_;
+  bool linkReady_ = false;
+
+  QPlainTextEdit* editor_ = nullptr;
+  QListWidget* errorList_ = nullptr;
+  QTimer* checkTimer_ = nullptr;
+  QStringList errors_;
+  QList<int> marked_;
+  QPushButton* rehearseButton_ = nullptr;
+  QPushButton* robustButton_ = nullptr;
+  QPushButton* clusterButton_ = nullptr;
+  QString simBinary_ = QCoreApplication::applicationDirPath() + "/simpartner-sim";
+  QPushButton* cancelButton_ = nullptr;
+  QProgressBar* progress_ = nullptr;
+  QTreeWidget* verdicts_ = nullptr;
+  QSlider* scrubber_ = nullptr;
+  QLabel* scrubLabel_ = nullptr;
+  QChartView* chart_ = nullptr;
+  QLineSeries* marginSeries_ = nullptr;
+  QLineSeries* rollSeries_ = nullptr;
+  QLineSeries* pitchSeries_ = nullptr;
+  QLineSeries* cursor_ = nullptr;
+  QPushButton* sendButton_ = nullptr;
+  QPushButton* abortButton_ = nullptr;
+  QLabel* status_ = nullptr;
+
+  bool busy_ = false;
+  std::atomic<bool> cancel_{false};
+  std::thread worker_;
+  std::optional<RehearsalPlan> plan_;  // of result_
+  struct Pinned {
+    RehearsalStart start;
+    WorldModel world;
+    SimParams params;
+    QString label;
+  };
+  std::optional<Pinned> pinned_;
+  bool planPinned_ = false;
+  bool terrainEditedSince_ = false;  // the terrain changed after result_  // plan_ started from pinned_, not the robot
+  QLabel* startLabel_ = nullptr;
+  QPushButton* unpinButton_ = nullptr;
+  std::optional<RehearsalResult> result_;
+  QString rehearsedText_;              // the text result_ rehearsed
+  std::optional<RobustnessResult> robust_;
+  std::shared_ptr<SequenceGuard> guard_ = std::make_shared<SequenceGuard>();
+  SequenceRelay::Phase shownPhase_ = SequenceRelay::Phase::Idle;
+};
+
+}  // namespace sp
