@@ -4,10 +4,14 @@
 // bar with the twin's time, real-time factor and health, and the menus to
 // open robot and world files and the session log folder.
 //
-// The session itself (the stand-in robot it runs on loopback or the robot
+// The window hosts, lays out and routes menus; it does not do the console's
+// jobs. The session (the stand-in robot it runs on loopback or the robot
 // elsewhere it connects to, the world, the log) is a Qt-free ConsoleSession
-// (app/console/console_session.h); the views draw what a RobotFeed gives them (today
-// the live link, ui/robot_feed.h).
+// (app/console/console_session.h); what is known of the link, and what it
+// allows, is a Qt-free ConsoleState (app/console/console_state.h); the views
+// draw what the feed switch shows (ui/robot_feed.h: the live link or a
+// replay); each job (ui/jobs/: drive, sequence, terrain, replay) installs its
+// docks and menu items through a ConsoleContext (ui/console_context.h).
 //
 // Thread: GUI thread only. The stand-in's physics and network threads and
 // the link client's worker thread reach the window only through queued
@@ -18,26 +22,34 @@
 #include <QString>
 #include <QStringList>
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
 
+#include "app/console/console_state.h"
 #include "app/console/robot_frame.h"
 #include "net/message.h"
 #include "net/robot_client.h"
 #include "sim/robot_model.h"
+#include "ui/console_context.h"
 
 class QAction;
 class QLabel;
 class QDockWidget;
+class QMenu;
 
 namespace sp {
 
+class BackgroundJobs;
 struct BranchPoint;
 class ConsoleSession;
 class ControlPanel;
+class FeedSwitch;
+class GhostFeed;
 class LiveLinkFeed;
+class RobotFeed;
 class LaserPlot;
 class LinkPanel;
 class PredictionErrorPlot;
@@ -66,39 +78,52 @@ struct ConsoleOptions {
   QString replay;             ///< a session log to open in the Replay dock
 };
 
-class MainWindow : public QMainWindow {
+class MainWindow : public QMainWindow, public ConsoleHost {
   Q_OBJECT
 
  public:
   explicit MainWindow(ConsoleOptions options, QWidget* parent = nullptr);
   ~MainWindow() override;
 
-  /// Loads the world, starts the stand-in (unless connecting elsewhere) and
-  /// connects. Returns "" or what went wrong (with file:line where there is one).
+  /// Loads the world, starts the stand-in (unless connecting elsewhere),
+  /// connects, and lets each job open what the command line named. Returns
+  /// "" or what went wrong (with file:line where there is one).
   QString start();
+
+  /// Installs `job` (a dock with its menu items) into the running window.
+  /// The built-in jobs are installed by the constructor (ui/jobs/jobs.cpp).
+  ConsoleJob* installJob(std::unique_ptr<ConsoleJob> job);
+  /// The installed job of type J, or null.
+  template <class J>
+  J* job() const {
+    for (const auto& j : jobs_)
+      if (auto* found = qobject_cast<J*>(j.get())) return found;
+    return nullptr;
+  }
+  ConsoleContext& context() const { return *context_; }
+  const ConsoleState& consoleState() const { return state_; }
 
   // For tests and the status of the session.
   SceneView* sceneView() const { return scene_; }
-  ControlPanel* controlPanel() const { return controls_; }
   LinkPanel* linkPanel() const { return link_; }
-  SequencePanel* sequencePanel() const { return sequence_; }
-  TerrainPanel* terrainPanel() const { return terrain_; }
+  ControlPanel* controlPanel() const;
+  SequencePanel* sequencePanel() const;
+  TerrainPanel* terrainPanel() const;
+  ReplayPanel* replayPanel() const;
   /// Terrain edits applied since the start (each dab, undo or redo).
-  int64_t terrainEdits() const { return terrainEdits_; }
-  ReplayPanel* replayPanel() const { return replay_; }
+  int64_t terrainEdits() const;
   /// File ▸ Open session log: the views show the log at the replay cursor
   /// (the live link goes on unseen) until the replay is closed. "" or why
   /// not (shown in a dialog unless `quiet`).
   QString openLog(const QString& path, bool quiet = false);
-  /// File ▸ Session logs: the log folder's logs with sizes; replay or delete.
-  void showSessionLogs();
-  bool replaying() const { return replaying_; }
   /// Opens a log for replay on the Replay dock's worker, with progress.
   void openLogInBackground(const QString& path);
-  /// File ▸ Recent session logs: the last kRecentLogs logs opened for
-  /// replay that still exist, newest first.
+  /// File ▸ Session logs: the log folder's logs with sizes; replay or delete.
+  void showSessionLogs();
+  /// File ▸ Recent session logs: the last logs replayed that still exist.
   QStringList recentLogs() const;
-  static constexpr int kRecentLogs = 8;
+  /// A replay is shown instead of the live robot.
+  bool replaying() const { return state_.replaying(); }
   WheelForcePlot* wheelForcePlot() const { return wheelPlot_; }
   LaserPlot* laserPlot() const { return laserPlot_; }
   PredictionErrorPlot* predictionErrorPlot() const { return errorPlot_; }
@@ -121,20 +146,29 @@ class MainWindow : public QMainWindow {
   double viewShare() const;
   /// Below this share a restored layout is replaced by the default one.
   static constexpr double kMinViewShare = 0.35;
-  /// The first-run layout: controls over link on the right, plots below.
+  /// The first-run layout: the jobs' side docks (tabs) over the link on the
+  /// right, the plots (and bottom docks) under the 3D view.
   void defaultLayout();
-  /// The text of the banner over the 3D view ("" when nothing is latched).
+  /// The text of the banner over the 3D view ("" when nothing is shown).
   QString bannerText() const;
 
   /// Loads `path` as the world; on errors shows them (file:line) in a
   /// dialog (unless `quiet`) and returns them, leaving the session as it was.
-  QString openWorld(const QString& path, bool quiet = false);
+  QString openWorld(const QString& path, bool quiet = false) override;
   /// Loads `path` as the robot, placed where the current world's robot is.
   QString openRobot(const QString& path, bool quiet = false);
   /// Adds an operator note to the session log.
   void addNote(const QString& text);
 
+  // ConsoleHost
+  QString startBranch(const QString& logPath, const BranchPoint& point, bool quiet) override;
+  QDockWidget* addDock(const QString& title, const QString& objectName, QWidget* panel, DockPlace place,
+                       bool scrolled) override;
+  QMenu* menu(const QString& title) override;
+  void addMenuAction(const QString& title, QAction* action) override;
+
  public slots:
+  /// Sends the e-stop to the live robot (whatever the views show).
   void emergencyStop();
   /// Asks the operator to confirm, then re-arms (clears a latched failsafe
   /// or e-stop) and zeroes the controls.
@@ -150,68 +184,54 @@ class MainWindow : public QMainWindow {
 
  private:
   void buildMenus();
-  void buildDocks();
-  /// Replaces what is drawn and controlled by `world` (its first robot).
-  void showWorld(const WorldModel& world);
+  void buildLinkDock();
+  void buildStatusBar();
+  /// The console's world changed (`fresh`: a new one, not the same shown
+  /// again): jobs and, while the live robot is shown, the views follow.
+  void showWorld(const WorldModel& world, bool fresh);
   /// After the session started or switched robots: redraw, reconnect.
   void sessionChanged();
   void connectToRobot();
-  void onFrame(const RobotFrame& frame);
-  void onLaser(const LaserFrame& scan);
-  /// At every 3D frame: the ghost's newest view into the scene.
-  void pullGhost();
-  void sendCommand(const Command& command);
+  /// A live telemetry frame: what is known of the robot (drawn or not).
+  void onLiveFrame(const RobotFrame& frame);
+  /// A frame of the feed shown: drawn.
+  void onShownFrame(const RobotFrame& frame);
+  void onFeedSwitched(RobotFeed* feed);
+  /// state_ may have changed: banner, menus, jobs follow.
+  void stateChanged();
   void refreshStatus();
-  void updateBanner();
-  /// Controls enabled only while connected, holding the lease and unlatched.
-  void updateControlsEnabled();
-  /// Menu items follow the state: what cannot be done now is greyed.
-  void updateActions();
-  /// No telemetry for console.stale_after: the robot greys, the status says so.
   void updateStale();
-  void showLoadErrors(const QString& title, const QString& text);
-  /// An event of the console's own (e-stop sent, re-arm sent), shown in the
-  /// link dock and logged.
+  /// A new session or world: forget the last robot's frames and plots.
+  void clearFrames();
+  /// An event of the console's own, shown in the link dock and logged.
   void linkEvent(const QString& kind, const QString& text);
+  double wallSeconds() const;
 
   ConsoleOptions options_;
+  QString logDir_;
   std::unique_ptr<ConsoleSession> session_;
-  int shownWorld_ = -1;  // the session's worldVersion() the views show
+  ConsoleState state_;
+  uint64_t shownRevision_ = ~uint64_t{0};
+  int shownWorld_ = -1;  // the session's worldVersion() the jobs have
   RobotConnection* connection_ = nullptr;
-  LiveLinkFeed* feed_ = nullptr;
+  LiveLinkFeed* liveFeed_ = nullptr;
+  GhostFeed* ghostFeed_ = nullptr;
+  FeedSwitch* feeds_ = nullptr;
+  BackgroundJobs* background_ = nullptr;
+  ConsoleContext* context_ = nullptr;
+  std::vector<std::unique_ptr<ConsoleJob>> jobs_;
 
   SceneView* scene_ = nullptr;
-  ControlPanel* controls_ = nullptr;
   LinkPanel* link_ = nullptr;
-  SequencePanel* sequence_ = nullptr;
-  TerrainPanel* terrain_ = nullptr;
-  QDockWidget* terrainDock_ = nullptr;
-  int64_t terrainWorld_ = -1;  // the world version the terrain panel edits
-  int64_t terrainEdits_ = 0;
-  static constexpr size_t kTerrainPartHeights = 2000;  // per COMMAND: fits a 64 KiB frame
-  void applyTerrainEdit(const TerrainPatchCmd& patch);
-  /// A dock named `name` holding `panel` in a scroll area.
-  QDockWidget* scrolledDock(const QString& title, const QString& name, QWidget* panel);
-  bool robotTakesTerrainEdits() const;
-  void updateTerrainReach();
-  QDockWidget* sequenceDock_ = nullptr;
-  /// Replay ▸ Simulate from here, once the dock has the state: the
-  /// stand-in restarts from it, the replay closes and the views show it live.
-  QString startBranch(const QString& logPath, const BranchPoint& point, bool quiet);
-  ReplayPanel* replay_ = nullptr;
-  QDockWidget* replayDock_ = nullptr;
-  bool replaying_ = false;
-  bool ghostShownBeforeReplay_ = false;
   WheelForcePlot* wheelPlot_ = nullptr;
   LaserPlot* laserPlot_ = nullptr;
   PredictionErrorPlot* errorPlot_ = nullptr;
-  QAction* ghostAction_ = nullptr;
-  QLabel* ghostLabel_ = nullptr;
-  int64_t ghostVersion_ = -1;     // of the view the scene shows
-  double ghostTrailTime_ = -1;    // of the trail the scene shows
-  QDockWidget* controlsDock_ = nullptr;
   QDockWidget* plotsDock_ = nullptr;
   QDockWidget* linkDock_ = nullptr;
+  std::vector<QDockWidget*> sideDocks_, bottomDocks_;  // the jobs', in install order
+  std::map<QString, QAction*> menuAnchors_;  // jobs' items go before these
+  QAction* ghostAction_ = nullptr;
+  bool ghostShownBeforeReplay_ = false;
   QLabel* banner_ = nullptr;
   QLabel* staleLabel_ = nullptr;
   QAction* reconnectAction_ = nullptr;
@@ -220,28 +240,14 @@ class MainWindow : public QMainWindow {
   QAction* releaseAction_ = nullptr;
   QAction* rearmAction_ = nullptr;
   QAction* resetAction_ = nullptr;
+  QLabel* ghostLabel_ = nullptr;
   QLabel* terrainLabel_ = nullptr;
-  /// [m] within this of a heightfield's edge the banner warns.
-  static constexpr double kEdgeWarning = 1.5;
-  std::optional<double> edgeDistance_;  // of the last frame; nullopt on a plane
-  double shownEdge_ = 0;                // the distance the banner shows
   QLabel* simTime_ = nullptr;
   QLabel* rtfLabel_ = nullptr;
   QLabel* health_ = nullptr;
   QLabel* logLabel_ = nullptr;
-
-  std::vector<double> modelPositions_;   // joint positions in model order
-  bool measuredDirty_ = false;  // modelPositions_ changed since the controls showed them
+  QElapsedTimer clock_;  // wall time for state_ (monotonic)
   int64_t panelTicks_ = 0;
-  bool failsafe_ = false, estop_ = false;
-  bool leaseHeld_ = false;
-  net::ConnectionState connectionState_ = net::ConnectionState::Stopped;
-  QString connectionDetail_;
-  QString failsafeText_;
-  QString filesMismatch_;  // the robot's files are not the console's ("" = same or not announced)  // the robot's EVENT text: why it stopped
-  QElapsedTimer lastFrameClock_;
-  bool haveFrame_ = false, stale_ = false;
-  QString healthText_;
 };
 
 }  // namespace sp

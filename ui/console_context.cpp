@@ -1,0 +1,36 @@
+#include "ui/console_context.h"
+
+#include <QMainWindow>
+#include <QMessageBox>
+
+#include "app/console/console_session.h"
+#include "ui/robot_connection.h"
+
+namespace sp {
+
+QString ConsoleContext::sendCommand(const Command& command) {
+  // A replay shown is not the robot the operator means: nothing goes out.
+  std::string why = state().replaying() ? state().controlsRefusal() : session().commandRefusal(state().leaseHeld());
+  if (!why.empty()) {
+    const QString text = QString::fromStdString(why);
+    status(text, 4000);
+    return text;
+  }
+  connection().send(command, session().robot());
+  session().commandSent(command);
+  return {};
+}
+
+void ConsoleContext::logEvent(const QString& kind, const QString& text) const {
+  session().logEvent(kind.toStdString(), text.toStdString());
+}
+
+void ConsoleContext::showError(const QString& title, const QString& text) const {
+  QMessageBox box(QMessageBox::Warning, title, title + tr(". The running session is unchanged."), QMessageBox::Ok,
+                  parts_.window);
+  box.setDetailedText(text);
+  box.setInformativeText(text.section(QLatin1Char('\n'), 0, 4));
+  box.exec();
+}
+
+}  // namespace sp

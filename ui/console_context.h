@@ -1,0 +1,172 @@
+#pragma once
+// What a console job gets to work with. A job (ui/jobs/<name>/: driving,
+// rehearsing sequences, replaying logs, editing terrain, ...) is a dock with
+// its menu items; it installs itself through a ConsoleContext and never
+// reaches into the window (gz-sim's GUI plugins, PlotJuggler's plugins):
+//
+//   feeds()       which robot the views show (live link, replay) and the ghost
+//   sendCommand() the command sink: the lease and the shown feed are checked
+//   state()       what the console knows of the link (app/console/console_state.h)
+//   scene(), the plots: the views, to draw into
+//   status(), event(), logEvent(): the status bar, the event list, the log
+//   background(): one worker with progress and Cancel for long work
+//   addDock(), menu(): a place in the window
+//
+// Thread: GUI thread only, as every job.
+
+#include <QMainWindow>
+#include <QObject>
+#include <QString>
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "app/console/console_state.h"
+#include "app/rehearse/rehearsal.h"
+#include "sim/command.h"
+#include "sim/params.h"
+#include "sim/robot_model.h"
+#include "sim/terrain_brush.h"
+
+class QAction;
+class QDockWidget;
+class QMenu;
+class QWidget;
+
+namespace sp {
+
+class BackgroundJobs;
+struct BranchPoint;
+class ConsoleSession;
+class FeedSwitch;
+class GhostFeed;
+class LaserPlot;
+class PredictionErrorPlot;
+class RobotConnection;
+class SceneView;
+class WheelForcePlot;
+
+/// Where a job's dock goes in the default layout.
+enum class DockPlace {
+  Side,    ///< a tab behind the controls, right of the 3D view
+  Bottom,  ///< a tab behind the plots, under the 3D view
+};
+
+/// What the console (the window) does for its jobs that a job cannot do on
+/// its own, because it changes the whole console. MainWindow implements it.
+class ConsoleHost {
+ public:
+  virtual ~ConsoleHost() = default;
+  /// Opens `path` as the console's world: "" or why not (shown unless `quiet`).
+  virtual QString openWorld(const QString& path, bool quiet) = 0;
+  /// Restarts the stand-in from a replayed log's state: "" or why not.
+  virtual QString startBranch(const QString& logPath, const BranchPoint& point, bool quiet) = 0;
+  /// A dock for `panel` (scrolled when `scrolled`), placed by `place`.
+  virtual QDockWidget* addDock(const QString& title, const QString& objectName, QWidget* panel, DockPlace place,
+                               bool scrolled) = 0;
+  /// The menu bar's menu titled `title` ("&File", "&Robot", "&View", ...), made if missing.
+  virtual QMenu* menu(const QString& title) = 0;
+  /// Puts `action` into menu `title` among the jobs' items (in the File
+  /// menu: after the window's Open items, before the log and Quit items).
+  virtual void addMenuAction(const QString& title, QAction* action) = 0;
+};
+
+/// Everything a job may use; the window owns it and outlives every job.
+class ConsoleContext : public QObject {
+  Q_OBJECT
+
+ public:
+  struct Parts {
+    ConsoleHost* host = nullptr;
+    QMainWindow* window = nullptr;
+    ConsoleSession* session = nullptr;
+    RobotConnection* connection = nullptr;
+    FeedSwitch* feeds = nullptr;
+    GhostFeed* ghost = nullptr;
+    const ConsoleState* state = nullptr;
+    SceneView* scene = nullptr;
+    WheelForcePlot* wheelPlot = nullptr;
+    LaserPlot* laserPlot = nullptr;
+    PredictionErrorPlot* errorPlot = nullptr;
+    BackgroundJobs* background = nullptr;
+    /// The status bar, the event list (and log): the window's own.
+    std::function<void(const QString&, int)> status;
+    std::function<void(const QString&, const QString&, bool)> event;
+  };
+  explicit ConsoleContext(Parts parts, QObject* parent = nullptr) : QObject(parent), parts_(std::move(parts)) {}
+
+  ConsoleSession& session() const { return *parts_.session; }
+  RobotConnection& connection() const { return *parts_.connection; }
+  FeedSwitch& feeds() const { return *parts_.feeds; }
+  GhostFeed& ghost() const { return *parts_.ghost; }
+  const ConsoleState& state() const { return *parts_.state; }
+  SceneView& scene() const { return *parts_.scene; }
+  WheelForcePlot& wheelPlot() const { return *parts_.wheelPlot; }
+  LaserPlot& laserPlot() const { return *parts_.laserPlot; }
+  PredictionErrorPlot& errorPlot() const { return *parts_.errorPlot; }
+  BackgroundJobs& background() const { return *parts_.background; }
+  QMainWindow* window() const { return parts_.window; }
+  ConsoleHost& host() const { return *parts_.host; }
+
+  /// The live robot's joint positions as last reported (model order).
+  const std::vector<double>& measuredPositions() const { return measured_; }
+  void setMeasuredPositions(std::vector<double> positions) { measured_ = std::move(positions); }
+
+  /// The command sink: sends `command` to the live robot, or refuses (no
+  /// lease, a replay shown, ...) and says why in the status bar. Returns
+  /// "" when sent, else the reason.
+  QString sendCommand(const Command& command);
+  /// A message in the status bar for `ms` milliseconds (0 = until replaced).
+  void status(const QString& text, int ms = 5000) const { parts_.status(text, ms); }
+  /// An event of the console's own (`kind`: "note", "estop", "link", ...):
+  /// in the event list, and in the session log when `log`.
+  void event(const QString& kind, const QString& text, bool log = true) const { parts_.event(kind, text, log); }
+  /// Something the console decided (`kind` "rehearsal", "relay", "guard"),
+  /// into the session log only.
+  void logEvent(const QString& kind, const QString& text) const;
+  /// Shows `text` (errors with file:line) under `title` in a dialog.
+  void showError(const QString& title, const QString& text) const;
+
+ signals:
+  /// The console's (live) world changed: a new world, robot or session.
+  /// `fresh` is false when the same world is shown again (after a replay).
+  void worldChanged(const sp::WorldModel& world, bool fresh);
+  /// state() changed: what is enabled and why may differ.
+  void stateChanged();
+  /// The robot stopped on its own (a latch, the lease lost, re-armed):
+  /// controls go back to its state (measuredPositions()).
+  void robotStopped();
+  /// The window's panel timer (every 100 ms): replot, show measured values.
+  void panelTick();
+  /// The console's terrain changed (an edit applied to its world).
+  void terrainEdited(const sp::TerrainPatchCmd& patch);
+  /// The default layout was put back: a job shows or hides its docks.
+  void layoutReset();
+  /// Rehearse from a logged moment (the Replay job asks, the Sequence job does).
+  void rehearseFrom(const sp::RehearsalStart& start, const sp::WorldModel& world, const sp::SimParams& params,
+                    const QString& label);
+
+ private:
+  Parts parts_;
+  std::vector<double> measured_;
+};
+
+/// A console job: installs its dock(s), menu items and wiring through the
+/// context. Jobs are listed in ui/jobs/jobs.cpp; a test may install its own.
+class ConsoleJob : public QObject {
+  Q_OBJECT
+
+ public:
+  using QObject::QObject;
+  /// A short name ("drive", "sequence", ...): the job's object name.
+  virtual QString name() const = 0;
+  /// Builds the job's widgets into `context`'s window; called once, after
+  /// the window's own views exist. `context` outlives the job.
+  virtual void install(ConsoleContext& context) = 0;
+  /// The console is starting (after every job is installed): a job may
+  /// open what the command line named. "" or why the console cannot start.
+  virtual QString start() { return {}; }
+};
+
+}  // namespace sp

@@ -1,0 +1,118 @@
+#include "ui/jobs/replay/replay_job.h"
+
+#include <QAction>
+#include <QDockWidget>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QKeySequence>
+#include <QMenu>
+#include <QSettings>
+
+#include "app/console/console_session.h"
+#include "ui/jobs/replay/replay_panel.h"
+#include "ui/jobs/replay/session_logs_dialog.h"
+#include "ui/robot_feed.h"
+
+namespace sp {
+
+void ReplayJob::install(ConsoleContext& context) {
+  context_ = &context;
+  panel_ = new ReplayPanel;
+  feed_ = new ReplayFeed(panel_, this);
+  dock_ = context.host().addDock(tr("Replay"), QStringLiteral("replayDock"), panel_, DockPlace::Bottom, true);
+  dock_->hide();  // until a log is opened
+
+  connect(panel_, &ReplayPanel::opened, this, &ReplayJob::opened);
+  connect(panel_, &ReplayPanel::closed, this, &ReplayJob::closed);
+  connect(panel_, &ReplayPanel::branchReady, this, [this](const QString& log, std::shared_ptr<const BranchPoint> point) {
+    context_->host().startBranch(log, *point, false);
+  });
+  connect(panel_, &ReplayPanel::failed, this, [this](const QString& message) {
+    if (!panel_->isOpen()) dock_->hide();  // a log that did not open
+    context_->status(message, 10000);
+    if (message != tr("Cancelled.")) context_->showError(tr("Replay"), message);
+  });
+  connect(panel_, &ReplayPanel::rehearsalStart, &context, &ConsoleContext::rehearseFrom);
+  connect(panel_, &ReplayPanel::verified, this,
+          [this](bool, const QString& verdict) { context_->status(verdict, 15000); });
+  // The dock is shown only while a log is open (its tab costs the view).
+  connect(&context, &ConsoleContext::layoutReset, this, [this] {
+    dock_->setVisible(panel_->isOpen());
+    if (panel_->isOpen()) dock_->raise();
+  });
+
+  QAction* open = new QAction(tr("Open session &log…"), this);
+  open->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_L));
+  connect(open, &QAction::triggered, this, [this] {
+    const QString path = QFileDialog::getOpenFileName(context_->window(), tr("Open session log"), logDir_,
+                                                      tr("Session logs (*.splog);;All files (*)"));
+    if (!path.isEmpty()) openLogInBackground(path);
+  });
+  // The last logs replayed, newest first (settings "replay/recent"); a
+  // file gone since is left out when the menu opens.
+  auto* recent = new QMenu(tr("&Recent session logs"), context.window());
+  connect(recent, &QMenu::aboutToShow, this, [this, recent] {
+    recent->clear();
+    for (const QString& path : recentLogs())
+      recent->addAction(QFileInfo(path).fileName(), this, [this, path] { openLogInBackground(path); })->setToolTip(path);
+    if (recent->isEmpty()) recent->addAction(tr("(none yet)"))->setEnabled(false);
+  });
+  recent->setToolTipsVisible(true);
+  QAction* logs = new QAction(tr("Session &logs…"), this);
+  connect(logs, &QAction::triggered, this, &ReplayJob::showSessionLogs);
+  QAction* close = new QAction(tr("Close replay"), this);
+  connect(close, &QAction::triggered, panel_, &ReplayPanel::close);
+  for (QAction* a : {open, recent->menuAction(), logs, close}) context.host().addMenuAction(tr("&File"), a);
+}
+
+QString ReplayJob::start() { return replay_.isEmpty() ? QString() : openLog(replay_, true); }
+
+void ReplayJob::opened() {
+  QStringList recent = recentLogs();
+  const QString path = QFileInfo(QString::fromStdString(panel_->player()->path())).absoluteFilePath();
+  recent.removeAll(path);
+  recent.prepend(path);
+  QSettings().setValue(QStringLiteral("replay/recent"), recent.mid(0, kRecent));
+  context_->feeds().show(feed_);
+  context_->status(tr("Replaying %1: the live robot goes on unseen; close the replay to see it again")
+                       .arg(QFileInfo(path).fileName()),
+                   0);
+}
+
+void ReplayJob::closed() {
+  dock_->hide();
+  context_->feeds().show(nullptr);
+  context_->status({}, 0);
+}
+
+QString ReplayJob::openLog(const QString& path, bool quiet) {
+  const QString error = panel_->open(path);
+  if (!error.isEmpty()) {
+    if (!quiet) context_->showError(tr("Open session log"), error);
+    return error;
+  }
+  dock_->show();
+  dock_->raise();
+  return {};
+}
+
+void ReplayJob::openLogInBackground(const QString& path) {
+  dock_->show();  // its progress row shows the opening, with Cancel
+  dock_->raise();
+  panel_->openInBackground(path);
+}
+
+void ReplayJob::showSessionLogs() {
+  SessionLogsDialog dialog(logDir_, QString::fromStdString(context_->session().logPath()), context_->window());
+  connect(&dialog, &SessionLogsDialog::replayRequested, this, &ReplayJob::openLogInBackground);
+  dialog.exec();
+}
+
+QStringList ReplayJob::recentLogs() const {
+  QStringList logs;
+  for (const QString& path : QSettings().value(QStringLiteral("replay/recent")).toStringList())
+    if (QFileInfo::exists(path)) logs << path;
+  return logs;
+}
+
+}  // namespace sp

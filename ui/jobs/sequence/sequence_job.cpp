@@ -1,0 +1,87 @@
+#include "ui/jobs/sequence/sequence_job.h"
+
+#include <QDockWidget>
+#include <QFile>
+
+#include "app/console/console_session.h"
+#include "sim/diagnostics.h"
+#include "ui/jobs/sequence/sequence_panel.h"
+#include "ui/robot_connection.h"
+#include "ui/robot_feed.h"
+#include "ui/scene_view.h"
+
+namespace sp {
+
+void SequenceJob::install(ConsoleContext& context) {
+  context_ = &context;
+  panel_ = new SequencePanel;
+  dock_ = context.host().addDock(tr("Sequence"), QStringLiteral("sequenceDock"), panel_, DockPlace::Side, true);
+
+  // Rehearsals start from the live robot's newest telemetry.
+  panel_->setStartProvider([this]() -> std::optional<RehearsalStart> {
+    const auto* live = qobject_cast<const LiveLinkFeed*>(context_->feeds().live());
+    const RobotModel* robot = context_->session().robot();
+    if (!live || !live->lastTelemetry() || !robot) return std::nullopt;
+    std::string why;
+    std::optional<RehearsalStart> start = startFromTelemetry(*live->lastTelemetry(), *robot, why);
+    if (!start) context_->status(tr("Rehearsing from the world's start: %1").arg(QString::fromStdString(why)), 6000);
+    return start;
+  });
+
+  RobotConnection& link = context.connection();
+  connect(panel_, &SequencePanel::sendRequested, &link, &RobotConnection::sendSequence);
+  connect(panel_, &SequencePanel::abortRequested, &link, &RobotConnection::abortSequence);
+  connect(&link, &RobotConnection::sequenceState, panel_, &SequencePanel::onSequenceState);
+  panel_->setGuard(link.guard());
+  connect(&link, &RobotConnection::guardTripped, panel_, &SequencePanel::onGuardTripped);
+
+  SceneView& scene = context.scene();
+  connect(panel_, &SequencePanel::scrubbed, &scene, [&scene](const Pose& base, const std::vector<double>& joints) {
+    scene.setRehearsalState(base, joints);
+    scene.setRehearsalVisible(true);
+  });
+  connect(panel_, &SequencePanel::pathChanged, &scene,
+          [&scene](const std::vector<Vec3>& path, const std::vector<Vec3>& envelope) {
+            scene.setRehearsalPath(path);
+            scene.setRehearsalEnvelope(envelope);
+            scene.setRehearsalVisible(!path.empty());
+          });
+  connect(panel_, &SequencePanel::logEvent, this,
+          [this](const QString& kind, const QString& text) { context_->logEvent(kind, text); });
+  connect(panel_, &SequencePanel::alert, this, [this](const QString& text) {
+    context_->event(QStringLiteral("sequence"), text, false);
+    context_->status(text, 10000);
+    dock_->raise();
+  });
+
+  connect(&context, &ConsoleContext::stateChanged, this,
+          [this] { panel_->setLinkReady(context_->state().controlsRefusal().empty()); });
+  connect(&context, &ConsoleContext::worldChanged, this,
+          [this](const WorldModel& world) { panel_->setWorld(world, context_->session().params()); });
+  connect(&context, &ConsoleContext::terrainEdited, panel_, &SequencePanel::terrainEdited);
+  connect(&context, &ConsoleContext::rehearseFrom, this,
+          [this](const RehearsalStart& start, const WorldModel& world, const SimParams& params, const QString& label) {
+            panel_->pinStart(start, world, params, label);
+            dock_->show();
+            dock_->raise();
+            context_->status(tr("The Sequence dock rehearses from %1 now").arg(label), 8000);
+          });
+}
+
+QString SequenceJob::start() {
+  if (!rules_.isEmpty()) {
+    FlightRules rules;
+    Diagnostics diag;
+    if (!loadFlightRules(rules_.toStdString(), rules, diag)) return QString::fromStdString(diag.format()).trimmed();
+    panel_->setRules(rules);
+  }
+  if (!sequence_.isEmpty()) {
+    QFile f(sequence_);
+    if (!f.open(QIODevice::ReadOnly) || f.size() > 1 << 20)
+      return tr("%1: error: cannot read sequence file (or larger than 1 MiB)").arg(sequence_);
+    panel_->setText(QString::fromUtf8(f.readAll()));
+  }
+  return {};
+}
+
+}  // namespace sp

@@ -1,0 +1,39 @@
+#pragma once
+// The console's second job: rehearsing a command sequence on the twin
+// before relaying exactly what passed (the Sequence dock, ui/jobs/sequence/
+// sequence_panel.h). It rehearses from the live robot's newest telemetry,
+// draws the rehearsed path and phantom in the 3D view, relays over the
+// link, and is pinned to a replayed log's moment by the Replay job
+// (ConsoleContext::rehearseFrom).
+//
+// Thread: GUI thread only.
+
+#include "ui/console_context.h"
+
+class QDockWidget;
+
+namespace sp {
+
+class SequencePanel;
+
+class SequenceJob : public ConsoleJob {
+  Q_OBJECT
+
+ public:
+  /// `rules`: a flight rules file ("" = the built-in defaults); `sequence`:
+  /// a sequence file to open at the start ("" = none).
+  SequenceJob(QString rules, QString sequence, QObject* parent = nullptr)
+      : ConsoleJob(parent), rules_(std::move(rules)), sequence_(std::move(sequence)) {}
+  QString name() const override { return QStringLiteral("sequence"); }
+  void install(ConsoleContext& context) override;
+  QString start() override;
+  SequencePanel* panel() const { return panel_; }
+
+ private:
+  ConsoleContext* context_ = nullptr;
+  SequencePanel* panel_ = nullptr;
+  QDockWidget* dock_ = nullptr;
+  QString rules_, sequence_;
+};
+
+}  // namespace sp
