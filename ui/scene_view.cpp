@@ -12,6 +12,7 @@
 #include <QWheelEvent>
 
 #include <osg/BlendFunc>
+#include <osg/ColorMask>
 #include <osg/Fog>
 #include <osg/Depth>
 #include <osg/Geode>
@@ -54,6 +55,9 @@ constexpr double kPlaneCell = 10.0;       // [m]; coarse: software GL pays per v
 constexpr int kGridHalfSize = 50;         // [m] of 1 m grid around the origin
 constexpr double kGridLift = 0.005;       // [m] lines above the ground, with polygon offset
 constexpr double kDefaultAzimuth = degToRad(-150);  // behind the robot, to its right
+// Render bins of the translucent robots: after the opaque scene (0) and
+// OSG's depth-sorted transparent bin (10): their depth pass, then colour.
+constexpr int kPhantomBin = 20;
 constexpr double kDefaultElevation = degToRad(19);
 constexpr double kDefaultDistance = 7.0;  // [m]
 constexpr double kMinElevation = degToRad(1), kMaxElevation = degToRad(89);
@@ -402,7 +406,8 @@ struct SceneView::Impl {
   // Translucent robots (the predictive ghost, the rehearsal): the same link
   // geometry, shared, under transforms of their own, each with its path.
   struct Phantom {
-    osg::ref_ptr<osg::Group> node;
+    osg::ref_ptr<osg::Group> node;  // the two passes, each over `body`
+    osg::ref_ptr<osg::Group> body;  // the link transforms
     std::vector<osg::ref_ptr<osg::MatrixTransform>> links;
     osg::ref_ptr<osg::Geode> pathNode;
     osg::ref_ptr<osg::Geometry> path;
@@ -497,8 +502,8 @@ SceneView::Impl::Impl() {
   // The ghost light blue; the rehearsal amber. The paths in the same hues,
   // saturated and opaque: a thin line in a pale tint vanishes against the
   // sky and light ground.
-  buildPhantom(ghost, {0.30f, 0.80f, 1.00f, 0.38f}, {0.05f, 0.45f, 1.00f, 1.0f});
-  buildPhantom(rehearsal, {1.00f, 0.70f, 0.15f, 0.38f}, {0.95f, 0.45f, 0.00f, 1.0f});
+  buildPhantom(ghost, {kGhostTint[0], kGhostTint[1], kGhostTint[2], kGhostTint[3]}, {0.05f, 0.45f, 1.00f, 1.0f});
+  buildPhantom(rehearsal, {1.00f, 0.70f, 0.15f, 0.50f}, {0.95f, 0.45f, 0.00f, 1.0f});
   buildLaser();
   root->addChild(laserNode);
   // The brush footprint: a yellow ring, unlit, drawn over the ground.
@@ -622,20 +627,35 @@ void SceneView::Impl::updateLaser() {
 
 void SceneView::Impl::buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line) {
   p.node = new osg::Group;
+  p.body = new osg::Group;
   root->addChild(p.node);
-  // One translucent tint over every link, drawn after the opaque scene
-  // (transparent bin) without writing depth, so the reported robot shows
-  // through it and it never hides itself.
-  osg::StateSet* g = p.node->getOrCreateStateSet();
+  // A clean translucent silhouette in one colour: the links are drawn
+  // twice, after the opaque scene. First into depth alone, so that only the
+  // phantom's nearest surface survives; then in colour where depth equals
+  // it, blended once. Drawn in one pass without depth (as before), the
+  // links' back faces and inner parts blended over each other in whatever
+  // order they came, and the phantom showed shards of darker and lighter
+  // tints. Lighting still shades the one colour, so the shape reads.
   auto* tint = new osg::Material;
   tint->setColorMode(osg::Material::OFF);
   tint->setDiffuse(osg::Material::FRONT_AND_BACK, body);
-  tint->setAmbient(osg::Material::FRONT_AND_BACK, {body.r() / 3, body.g() / 3, body.b() / 3, body.a()});
+  tint->setAmbient(osg::Material::FRONT_AND_BACK, {body.r() / 2, body.g() / 2, body.b() / 2, body.a()});
   tint->setSpecular(osg::Material::FRONT_AND_BACK, {0, 0, 0, body.a()});
-  g->setAttributeAndModes(tint, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
-  g->setAttributeAndModes(new osg::BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA), osg::StateAttribute::ON);
-  g->setAttributeAndModes(new osg::Depth(osg::Depth::LESS, 0.0, 1.0, false), osg::StateAttribute::ON);
-  g->setRenderingHint(osg::StateSet::TRANSPARENT_BIN);
+  auto* depthPass = new osg::Group;
+  depthPass->addChild(p.body);
+  osg::StateSet* d = depthPass->getOrCreateStateSet();
+  d->setAttributeAndModes(new osg::ColorMask(false, false, false, false), osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+  d->setAttributeAndModes(new osg::Depth(osg::Depth::LESS, 0.0, 1.0, true), osg::StateAttribute::ON);
+  d->setRenderBinDetails(kPhantomBin, "RenderBin");
+  auto* colorPass = new osg::Group;
+  colorPass->addChild(p.body);
+  osg::StateSet* c = colorPass->getOrCreateStateSet();
+  c->setAttributeAndModes(tint, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+  c->setAttributeAndModes(new osg::BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA), osg::StateAttribute::ON);
+  c->setAttributeAndModes(new osg::Depth(osg::Depth::EQUAL, 0.0, 1.0, false), osg::StateAttribute::ON);
+  c->setRenderBinDetails(kPhantomBin + 1, "RenderBin");
+  p.node->addChild(depthPass);
+  p.node->addChild(colorPass);
   p.node->setNodeMask(0);
   p.pathNode = new osg::Geode;
   p.path = newGeometry();
@@ -791,7 +811,7 @@ void SceneView::setWorld(const WorldModel& world) {
   m.worldNode->removeChildren(0, m.worldNode->getNumChildren());
   m.robotNode->removeChildren(0, m.robotNode->getNumChildren());
   for (Impl::Phantom* p : {&m.ghost, &m.rehearsal}) {
-    p->node->removeChildren(0, p->node->getNumChildren());
+    p->body->removeChildren(0, p->body->getNumChildren());
     p->links.clear();
   }
   m.links.clear();
@@ -845,7 +865,7 @@ void SceneView::setWorld(const WorldModel& world) {
       osg::ref_ptr<osg::MatrixTransform> phantom = new osg::MatrixTransform;
       phantom->setDataVariance(osg::Object::DYNAMIC);
       phantom->addChild(shape);
-      p->node->addChild(phantom);
+      p->body->addChild(phantom);
       p->links.push_back(phantom);
     }
   }

@@ -53,6 +53,10 @@ class SceneView : public QOpenGLWidget {
   explicit SceneView(QWidget* parent = nullptr);
   ~SceneView() override;
 
+  /// The ghost's tint (red, green, blue, alpha): one colour over its whole
+  /// silhouette, the scene behind it blended in once.
+  static constexpr float kGhostTint[4] = {0.15f, 0.55f, 1.00f, 0.55f};
+
   /// Builds the scene from `world` (copied; the view keeps what it needs):
   /// the terrain (a plane as a large quad, a heightfield as a lit mesh
   /// coloured by height), the objects at their initial poses, the ground grid
