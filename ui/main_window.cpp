@@ -29,6 +29,7 @@
 #include "app/log/log_player.h"
 #include "ui/background_jobs.h"
 #include "ui/connect_dialog.h"
+#include "ui/console_monitor.h"
 #include "ui/jobs/drive/drive_job.h"
 #include "ui/jobs/jobs.h"
 #include "ui/jobs/replay/replay_job.h"
@@ -41,6 +42,7 @@
 #include "ui/robot_connection.h"
 #include "ui/robot_feed.h"
 #include "ui/scene_view.h"
+#include "ui/status_fields.h"
 
 namespace sp {
 
@@ -63,12 +65,6 @@ ConsoleSessionOptions toSessionOptions(const ConsoleOptions& o, const QString& l
   return s;
 }
 
-QString terrainText(const TerrainSpec& t) {
-  return t.kind == TerrainSpec::Kind::Heightfield
-             ? QObject::tr("terrain %1 × %2 m").arg(formatFixed(t.grid.width, 1), formatFixed(t.grid.depth, 1))
-             : QObject::tr("terrain: endless plane");
-}
-
 }  // namespace
 
 MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
@@ -78,7 +74,6 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
                                               QStringLiteral("/SimPartner/sessions")
                                         : options_.logDir),
       session_(std::make_unique<ConsoleSession>(toSessionOptions(options_, logDir_))) {
-  clock_.start();
   setWindowTitle(tr("SimPartner"));
   // Object names let QSettings restore the docks and toolbars by name.
   setObjectName(QStringLiteral("SimPartnerMainWindow"));
@@ -110,8 +105,14 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   ghostFeed_ = new GhostFeed(session_.get(), this);
   feeds_ = new FeedSwitch(liveFeed_, this);
   background_ = new BackgroundJobs(this);
-  state_.setConfig({session_->params().consoleStaleAfter, ConsoleState::Config{}.edgeWarning});
-  connect(liveFeed_, &RobotFeed::frame, this, &MainWindow::onLiveFrame);
+  monitor_ = new ConsoleMonitor(connection_, liveFeed_, session_.get(), this);
+  connect(monitor_, &ConsoleMonitor::changed, this, &MainWindow::stateChanged);
+  connect(monitor_, &ConsoleMonitor::filesDiffer, this, [this](const QString& text) { linkEvent(QStringLiteral("link"), text); });
+  connect(monitor_, &ConsoleMonitor::latchesChanged, this, [this](bool failsafe, bool estop) { link_->showLatches(failsafe, estop); });
+  connect(liveFeed_, &RobotFeed::frame, this, [this](const RobotFrame& f) {
+    context_->setMeasuredPositions(f.jointPositions);
+    if (const std::optional<GhostError>& e = session_->lastPrediction()) errorPlot_->addSample(e->time, e->position, e->heading);
+  });
   connect(feeds_, &FeedSwitch::frame, this, &MainWindow::onShownFrame);
   connect(feeds_, &FeedSwitch::laser, this, [this](const LaserFrame& scan) {
     scene_->setLaser(scan.angleMin, scan.angleStep, scan.ranges);
@@ -157,7 +158,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   parts.connection = connection_;
   parts.feeds = feeds_;
   parts.ghost = ghostFeed_;
-  parts.state = &state_;
+  parts.state = &monitor_->state();
   parts.scene = scene_;
   parts.wheelPlot = wheelPlot_;
   parts.laserPlot = laserPlot_;
@@ -172,12 +173,13 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
     else link_->appendEvent(text);
   };
   context_ = new ConsoleContext(std::move(parts), this);
+  connect(monitor_, &ConsoleMonitor::robotStopped, context_, &ConsoleContext::robotStopped);
   // The right docks run the window's full height; the plots sit under the
   // 3D view only (defaultLayout()).
   setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
   setCorner(Qt::TopRightCorner, Qt::RightDockWidgetArea);
   for (std::unique_ptr<ConsoleJob>& job : builtInJobs(options_, logDir_)) installJob(std::move(job));
-  buildStatusBar();
+  status_ = new StatusFields(statusBar());
   stateChanged();
 
   // Everything around the 3D view is refreshed by one 100 ms timer, in one
@@ -354,47 +356,8 @@ void MainWindow::buildLinkDock() {
     link_->appendEvent(text);
     if (kind == QLatin1String("refused") || kind == QLatin1String("error")) statusBar()->showMessage(text, 5000);
   });
-  connect(connection_, &RobotConnection::lease, this, [this](const net::LeaseStateMsg& lease) {
-    link_->showLease(lease);
-    // Losing or giving up control stops the robot: the controls show that.
-    if (state_.lease(lease.yours)) emit context_->robotStopped();
-    stateChanged();
-  });
-  connect(connection_, &RobotConnection::connectionChanged, this, [this](net::ConnectionState s, const QString& d) {
-    link_->showConnection(s, d);
-    if (state_.connection(s, d.toStdString())) emit context_->robotStopped();
-    if (s == net::ConnectionState::Ready) {
-      // The ghost is only as good as the files it is built from.
-      const net::RobotClientStats stats = connection_->stats();
-      const std::string mismatch = session_->filesMismatch(stats.robotWorldHash, stats.robotRobotHash);
-      state_.filesMismatch(mismatch);
-      if (!mismatch.empty()) linkEvent(QStringLiteral("link"), qs(mismatch));
-    }
-    stateChanged();
-  });
-  connect(connection_, &RobotConnection::event, this, [this](const net::EventMsg& m) {
-    // The robot says why it stopped; the banner repeats it.
-    if (m.kind == net::EventKind::Failsafe) state_.failsafeReason(m.text);
-    if (m.kind == net::EventKind::Failsafe || m.kind == net::EventKind::Estop || m.kind == net::EventKind::Rearmed)
-      emit context_->robotStopped();
-    stateChanged();
-  });
-}
-
-void MainWindow::buildStatusBar() {
-  simTime_ = new QLabel;
-  rtfLabel_ = new QLabel;
-  health_ = new QLabel;
-  logLabel_ = new QLabel;
-  logLabel_->setTextInteractionFlags(Qt::TextSelectableByMouse);
-  for (QLabel* l : {simTime_, rtfLabel_, health_}) l->setMinimumWidth(l->fontMetrics().horizontalAdvance(QStringLiteral("t = 00000.00 s")));
-  terrainLabel_ = new QLabel;
-  terrainLabel_->setObjectName(QStringLiteral("terrainLabel"));
-  ghostLabel_ = new QLabel;
-  ghostLabel_->setObjectName(QStringLiteral("ghostLabel"));
-  ghostLabel_->setToolTip(tr("The ghost: how far ahead of the newest telemetry it shows the robot (the link's round "
-                             "trip and the telemetry's age), and its error against the telemetry, median over 10 s"));
-  for (QLabel* l : {terrainLabel_, ghostLabel_, simTime_, rtfLabel_, health_, logLabel_}) statusBar()->addPermanentWidget(l);
+  connect(connection_, &RobotConnection::lease, link_, &LinkPanel::showLease);
+  connect(connection_, &RobotConnection::connectionChanged, link_, &LinkPanel::showConnection);
 }
 
 void MainWindow::buildMenus() {
@@ -519,16 +482,10 @@ void MainWindow::connectToRobot() {
 void MainWindow::showWorld(const WorldModel& world, bool fresh) {
   shownWorld_ = session_->worldVersion();
   const TerrainSpec& t = world.terrain;
-  state_.terrain(t.kind == TerrainSpec::Kind::Heightfield, t.grid.width, t.grid.depth);
+  monitor_->state().terrain(t.kind == TerrainSpec::Kind::Heightfield, t.grid.width, t.grid.depth);
   if (feeds_->showingLive()) {
     scene_->setWorld(world);
-    terrainLabel_->setText(terrainText(t));
-    terrainLabel_->setToolTip(t.kind == TerrainSpec::Kind::Heightfield
-                                  ? tr("The heightfield spans x %1..%2 m, y %3..%4 m around its centre; the console warns within %5 m of its edge")
-                                        .arg(formatFixed(t.pose.p.x - t.grid.width / 2, 1), formatFixed(t.pose.p.x + t.grid.width / 2, 1),
-                                             formatFixed(t.pose.p.y - t.grid.depth / 2, 1), formatFixed(t.pose.p.y + t.grid.depth / 2, 1),
-                                             formatFixed(state_.config().edgeWarning, 1))
-                                  : QString());
+    status_->showTerrain(t, false, state().config().edgeWarning);
   }
   if (fresh) {
     for (const SensorSpec& sensor : world.robots.empty() ? std::vector<SensorSpec>{} : world.robots[0].model.sensors)
@@ -537,9 +494,9 @@ void MainWindow::showWorld(const WorldModel& world, bool fresh) {
         laserPlot_->setRangeLimits(sensor.minRange, sensor.maxRange);
         break;
       }
-    if (state_.connected()) {
+    if (state().connected()) {
       const net::RobotClientStats stats = connection_->stats();
-      state_.filesMismatch(session_->filesMismatch(stats.robotWorldHash, stats.robotRobotHash));
+      monitor_->state().filesMismatch(session_->filesMismatch(stats.robotWorldHash, stats.robotRobotHash));
     }
     clearFrames();
     QString title = tr("SimPartner — %1").arg(QFileInfo(qs(world.file)).fileName());
@@ -555,7 +512,7 @@ void MainWindow::clearFrames() {
   errorPlot_->clear();
   ghostFeed_->reset();
   liveFeed_->clear();
-  state_.clearFrames();
+  monitor_->state().clearFrames();
 }
 
 QString MainWindow::openWorld(const QString& path, bool quiet) {
@@ -608,7 +565,7 @@ void MainWindow::addNote(const QString& text) {
 
 void MainWindow::emergencyStop() {
   connection_->estop(tr("operator e-stop"));
-  const QString text = state_.replaying() ? tr("E-STOP sent to the live robot") : tr("E-STOP sent");
+  const QString text = state().replaying() ? tr("E-STOP sent to the live robot") : tr("E-STOP sent");
   linkEvent(QStringLiteral("estop"), text);
   statusBar()->showMessage(text, 5000);
 }
@@ -663,126 +620,71 @@ void MainWindow::resetRobot() {
   sessionChanged();
 }
 
-void MainWindow::onLiveFrame(const RobotFrame& f) {
-  if (!session_->robot()) return;
-  context_->setMeasuredPositions(f.jointPositions);
-  const FrameChanges changes = state_.frame(f, wallSeconds(), session_->edgeDistance(f.base));
-  if (changes.latchedNow) emit context_->robotStopped();  // a latch that comes on stopped the robot
-  if (changes.latches) link_->showLatches(state_.failsafe(), state_.estop());
-  if (changes.staleEnded) updateStale();
-  if (const std::optional<GhostError>& e = session_->lastPrediction()) errorPlot_->addSample(e->time, e->position, e->heading);
-  stateChanged();
-}
-
 void MainWindow::onShownFrame(const RobotFrame& f) {
   scene_->setRobotState(f.base, f.jointPositions);
   std::vector<NamedPose> objects;
   for (const ObjectReadout& o : f.objects) objects.push_back({o.name, o.pose});
   scene_->setObjectPoses(objects);
   wheelPlot_->addSample(f.time, f.wheelNormal);
-  if (!feeds_->showingLive()) simTime_->setText(tr("replay t = %1 s").arg(formatFixed(f.time, 2)));
+  if (!feeds_->showingLive()) status_->showReplayTime(f.time);
 }
 
 void MainWindow::onFeedSwitched(RobotFeed* feed) {
   const bool live = feed == liveFeed_;
   if (!live) {
-    if (!state_.replaying()) ghostShownBeforeReplay_ = scene_->ghostVisible();
+    if (!state().replaying()) ghostShownBeforeReplay_ = scene_->ghostVisible();
     const WorldModel* world = feed->shownWorld();
     if (world) {
       scene_->setWorld(*world);
-      terrainLabel_->setText(tr("replay %1").arg(terrainText(world->terrain)));
+      status_->showTerrain(world->terrain, true, state().config().edgeWarning);
     }
     scene_->setGhostVisible(false);
     wheelPlot_->clear();
     const auto* player = replayPanel() ? replayPanel()->player() : nullptr;
-    state_.replay(player ? QFileInfo(qs(player->path())).fileName().toStdString() : feed->sourceName().toStdString());
-  } else if (state_.replaying()) {
-    state_.replay({});
+    monitor_->state().replay(player ? QFileInfo(qs(player->path())).fileName().toStdString() : feed->sourceName().toStdString());
+  } else if (state().replaying()) {
+    monitor_->state().replay({});
     showWorld(*session_->world(), false);
     scene_->setGhostVisible(ghostShownBeforeReplay_);
     wheelPlot_->clear();
   }
-  stateChanged();
+  monitor_->notify();
   refreshStatus();
 }
 
 void MainWindow::stateChanged() {
-  if (state_.revision() == shownRevision_) return;
-  shownRevision_ = state_.revision();
+  const ConsoleState& now = state();
   QStringList lines;
-  for (const std::string& line : state_.bannerLines()) lines << qs(line);
+  for (const std::string& line : now.bannerLines()) lines << qs(line);
   banner_->setText(lines.join(QLatin1Char('\n')));
   banner_->setVisible(!lines.isEmpty());
   // Replay: a calm banner, the live robot's alarms still red below it.
-  banner_->setStyleSheet(state_.replaying() && !state_.latched() && state_.healthReport().empty()
+  banner_->setStyleSheet(now.replaying() && !now.latched() && now.healthReport().empty()
                              ? QStringLiteral("QLabel { background: #1565c0; color: white; font-weight: bold; padding: 6px; }")
                              : QStringLiteral("QLabel { background: #c62828; color: white; font-weight: bold; padding: 6px; }"));
-  reconnectAction_->setEnabled(state_.canReconnect());
-  disconnectAction_->setEnabled(state_.canDisconnect());
-  takeAction_->setEnabled(state_.canTakeControl());
-  releaseAction_->setEnabled(state_.canReleaseControl());
-  rearmAction_->setEnabled(state_.canRearm());
+  reconnectAction_->setEnabled(now.canReconnect());
+  disconnectAction_->setEnabled(now.canDisconnect());
+  takeAction_->setEnabled(now.canTakeControl());
+  releaseAction_->setEnabled(now.canReleaseControl());
+  rearmAction_->setEnabled(now.canRearm());
   resetAction_->setEnabled(!session_->remote());
   emit context_->stateChanged();
 }
 
 void MainWindow::updateStale() {
-  state_.tick(wallSeconds());
-  const QString text = qs(state_.staleText(wallSeconds()));
+  monitor_->tick();
+  const QString text = qs(state().staleText(monitor_->wallSeconds()));
   staleLabel_->setText(text);
   staleLabel_->setVisible(!text.isEmpty());
   if (const bool grey = !text.isEmpty(); grey != scene_->stale()) {
     scene_->setStale(grey);
-    stateChanged();
     refreshStatus();
   }
 }
 
 void MainWindow::refreshStatus() {
   link_->showStats(connection_->stats());
-  const std::optional<net::TelemetryMsg>& last = liveFeed_->lastTelemetry();
-  if (state_.replaying()) {
-    // the replay's frames set the time shown
-    rtfLabel_->setText(tr("RTF –"));
-  } else if (last) {
-    simTime_->setText(tr("t = %1 s").arg(last->time, 0, 'f', 2));
-    rtfLabel_->setText(tr("RTF %1").arg(session_->realTimeFactor(), 0, 'f', 2));
-  } else {
-    simTime_->setText(tr("t = –"));
-    rtfLabel_->setText(tr("RTF –"));
-  }
-  const HealthStatus h = state_.health();
-  const QString text = qs(h.text).toHtmlEscaped();
-  switch (h.level) {
-    case HealthLevel::Alarm: health_->setText(QStringLiteral("<b style='color:#c62828'>%1</b>").arg(text)); break;
-    case HealthLevel::Warning: health_->setText(QStringLiteral("<b style='color:#616161'>%1</b>").arg(text)); break;
-    case HealthLevel::Good: health_->setText(QStringLiteral("<span style='color:#2e7d32'>%1</span>").arg(text)); break;
-    case HealthLevel::Neutral: health_->setText(text); break;
-  }
-  health_->setToolTip(qs(h.detail));
-
-  if (state_.replaying()) {
-    ghostLabel_->setText(tr("ghost off (replay)"));
-  } else if (const Ghost* ghost = session_->ghost(); !ghost) {
-    ghostLabel_->setText(session_->ghostError().empty() ? tr("ghost off") : tr("ghost failed"));
-    if (!session_->ghostError().empty()) ghostLabel_->setToolTip(qs(session_->ghostError()));
-  } else if (const GhostView v = ghost->view(); !v.problem.empty()) {
-    ghostLabel_->setText(QStringLiteral("<b style='color:#c62828'>%1</b>").arg(tr("ghost stopped")));
-    ghostLabel_->setToolTip(qs(v.problem));
-  } else if (v.version == 0) {
-    ghostLabel_->setText(tr("ghost –"));
-  } else {
-    QString g = tr("ghost +%1 s").arg(v.span, 0, 'f', 2);
-    if (const auto median = ghost->errorMedian())
-      g += tr(", %1 cm / %2°").arg(median->first * 100, 0, 'f', 1).arg(radToDeg(median->second), 0, 'f', 2);
-    ghostLabel_->setText(g);
-  }
-  const QString log = logPath();
-  logLabel_->setText(log.isEmpty() ? tr("log: off") : tr("log: %1").arg(QFileInfo(log).fileName()));
-  logLabel_->setToolTip(log);
-  const QString logError = qs(session_->logError());
-  if (!logError.isEmpty())
-    logLabel_->setText(QStringLiteral("<b style='color:#c62828'>%1</b>").arg(tr("log failed: %1").arg(logError.toHtmlEscaped())));
+  status_->refresh(state(), *session_, *liveFeed_);
 }
 
 bool MainWindow::eventFilter(QObject* watched, QEvent* event) {
@@ -804,8 +706,8 @@ void MainWindow::closeEvent(QCloseEvent* event) {
   event->accept();
 }
 
-double MainWindow::wallSeconds() const { return static_cast<double>(clock_.nsecsElapsed()) * 1e-9; }
-QString MainWindow::ghostStatus() const { return ghostLabel_->text(); }
+const ConsoleState& MainWindow::state() const { return monitor_->state(); }
+QString MainWindow::ghostStatus() const { return status_->ghostText(); }
 QString MainWindow::bannerText() const { return banner_->isVisible() ? banner_->text() : QString(); }
 QString MainWindow::logPath() const { return qs(session_->logPath()); }
 const std::optional<net::TelemetryMsg>& MainWindow::lastTelemetry() const { return liveFeed_->lastTelemetry(); }

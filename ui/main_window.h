@@ -43,6 +43,8 @@ class QMenu;
 namespace sp {
 
 class BackgroundJobs;
+class ConsoleMonitor;
+class StatusFields;
 struct BranchPoint;
 class ConsoleSession;
 class ControlPanel;
@@ -101,7 +103,7 @@ class MainWindow : public QMainWindow, public ConsoleHost {
     return nullptr;
   }
   ConsoleContext& context() const { return *context_; }
-  const ConsoleState& consoleState() const { return state_; }
+  const ConsoleState& consoleState() const { return state(); }
 
   // For tests and the status of the session.
   SceneView* sceneView() const { return scene_; }
@@ -123,7 +125,7 @@ class MainWindow : public QMainWindow, public ConsoleHost {
   /// File ▸ Recent session logs: the last logs replayed that still exist.
   QStringList recentLogs() const;
   /// A replay is shown instead of the live robot.
-  bool replaying() const { return state_.replaying(); }
+  bool replaying() const { return state().replaying(); }
   WheelForcePlot* wheelForcePlot() const { return wheelPlot_; }
   LaserPlot* laserPlot() const { return laserPlot_; }
   PredictionErrorPlot* predictionErrorPlot() const { return errorPlot_; }
@@ -185,33 +187,29 @@ class MainWindow : public QMainWindow, public ConsoleHost {
  private:
   void buildMenus();
   void buildLinkDock();
-  void buildStatusBar();
   /// The console's world changed (`fresh`: a new one, not the same shown
   /// again): jobs and, while the live robot is shown, the views follow.
   void showWorld(const WorldModel& world, bool fresh);
   /// After the session started or switched robots: redraw, reconnect.
   void sessionChanged();
   void connectToRobot();
-  /// A live telemetry frame: what is known of the robot (drawn or not).
-  void onLiveFrame(const RobotFrame& frame);
   /// A frame of the feed shown: drawn.
   void onShownFrame(const RobotFrame& frame);
   void onFeedSwitched(RobotFeed* feed);
-  /// state_ may have changed: banner, menus, jobs follow.
+  /// The console's state changed: banner, menus, jobs follow.
   void stateChanged();
+  const ConsoleState& state() const;
   void refreshStatus();
   void updateStale();
   /// A new session or world: forget the last robot's frames and plots.
   void clearFrames();
   /// An event of the console's own, shown in the link dock and logged.
   void linkEvent(const QString& kind, const QString& text);
-  double wallSeconds() const;
 
   ConsoleOptions options_;
   QString logDir_;
   std::unique_ptr<ConsoleSession> session_;
-  ConsoleState state_;
-  uint64_t shownRevision_ = ~uint64_t{0};
+  ConsoleMonitor* monitor_ = nullptr;
   int shownWorld_ = -1;  // the session's worldVersion() the jobs have
   RobotConnection* connection_ = nullptr;
   LiveLinkFeed* liveFeed_ = nullptr;
@@ -240,13 +238,7 @@ class MainWindow : public QMainWindow, public ConsoleHost {
   QAction* releaseAction_ = nullptr;
   QAction* rearmAction_ = nullptr;
   QAction* resetAction_ = nullptr;
-  QLabel* ghostLabel_ = nullptr;
-  QLabel* terrainLabel_ = nullptr;
-  QLabel* simTime_ = nullptr;
-  QLabel* rtfLabel_ = nullptr;
-  QLabel* health_ = nullptr;
-  QLabel* logLabel_ = nullptr;
-  QElapsedTimer clock_;  // wall time for state_ (monotonic)
+  StatusFields* status_ = nullptr;
   int64_t panelTicks_ = 0;
 };
 

@@ -1,0 +1,56 @@
+#include "ui/console_monitor.h"
+
+#include "app/console/console_session.h"
+#include "ui/robot_connection.h"
+#include "ui/robot_feed.h"
+
+namespace sp {
+
+ConsoleMonitor::ConsoleMonitor(RobotConnection* connection, LiveLinkFeed* live, ConsoleSession* session, QObject* parent)
+    : QObject(parent), session_(session), connection_(connection) {
+  clock_.start();
+  state_.setConfig({session->params().consoleStaleAfter, ConsoleState::Config{}.edgeWarning});
+  connect(connection, &RobotConnection::lease, this, [this](const net::LeaseStateMsg& lease) {
+    // Losing or giving up control stops the robot.
+    if (state_.lease(lease.yours)) emit robotStopped();
+    notify();
+  });
+  connect(connection, &RobotConnection::connectionChanged, this, [this](net::ConnectionState s, const QString& d) {
+    if (state_.connection(s, d.toStdString())) emit robotStopped();
+    if (s == net::ConnectionState::Ready) {
+      // The ghost is only as good as the files it is built from.
+      const net::RobotClientStats stats = connection_->stats();
+      const std::string differ = session_->filesMismatch(stats.robotWorldHash, stats.robotRobotHash);
+      state_.filesMismatch(differ);
+      if (!differ.empty()) emit filesDiffer(QString::fromStdString(differ));
+    }
+    notify();
+  });
+  connect(connection, &RobotConnection::event, this, [this](const net::EventMsg& m) {
+    // The robot says why it stopped; the banner repeats it.
+    if (m.kind == net::EventKind::Failsafe) state_.failsafeReason(m.text);
+    if (m.kind == net::EventKind::Failsafe || m.kind == net::EventKind::Estop || m.kind == net::EventKind::Rearmed)
+      emit robotStopped();
+    notify();
+  });
+  connect(live, &RobotFeed::frame, this, [this](const RobotFrame& f) {
+    if (!session_->robot()) return;
+    const FrameChanges changes = state_.frame(f, wallSeconds(), session_->edgeDistance(f.base));
+    if (changes.latchedNow) emit robotStopped();  // a latch that comes on stopped the robot
+    if (changes.latches) emit latchesChanged(state_.failsafe(), state_.estop());
+    notify();
+  });
+}
+
+void ConsoleMonitor::tick() {
+  state_.tick(wallSeconds());
+  notify();
+}
+
+void ConsoleMonitor::notify() {
+  if (state_.revision() == notified_) return;
+  notified_ = state_.revision();
+  emit changed();
+}
+
+}  // namespace sp
