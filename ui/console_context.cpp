@@ -21,6 +21,18 @@ QString ConsoleContext::sendCommand(const Command& command) {
   return {};
 }
 
+void ConsoleContext::event(const QString& kind, const QString& text, bool log) {
+  if (log) session().event(kind.toStdString(), text.toStdString());
+  emit eventShown(text);
+}
+
+void ConsoleContext::emergencyStop() {
+  connection().estop(tr("operator e-stop"));
+  const QString text = state().replaying() ? tr("E-STOP sent to the live robot") : tr("E-STOP sent");
+  event(QStringLiteral("estop"), text);
+  status(text, 5000);
+}
+
 void ConsoleContext::logEvent(const QString& kind, const QString& text) const {
   session().logEvent(kind.toStdString(), text.toStdString());
 }

@@ -51,6 +51,7 @@ class WheelForcePlot;
 enum class DockPlace {
   Side,    ///< a tab behind the controls, right of the 3D view
   Bottom,  ///< a tab behind the plots, under the 3D view
+  Link,    ///< under the side docks, right of the 3D view (the link's own dock)
 };
 
 /// What the console (the window) does for its jobs that a job cannot do on
@@ -62,6 +63,10 @@ class ConsoleHost {
   virtual QString openWorld(const QString& path, bool quiet) = 0;
   /// Restarts the stand-in from a replayed log's state: "" or why not.
   virtual QString startBranch(const QString& logPath, const BranchPoint& point, bool quiet) = 0;
+  /// The session switched robots (connected elsewhere, reset, ...): the
+  /// views follow its world (forgetting the old robot's frames when
+  /// `clearFrames`), and the link reconnects.
+  virtual void restarted(bool clearFrames) = 0;
   /// A dock for `panel` (scrolled when `scrolled`), placed by `place`.
   virtual QDockWidget* addDock(const QString& title, const QString& objectName, QWidget* panel, DockPlace place,
                                bool scrolled) = 0;
@@ -90,9 +95,8 @@ class ConsoleContext : public QObject {
     LaserPlot* laserPlot = nullptr;
     PredictionErrorPlot* errorPlot = nullptr;
     BackgroundJobs* background = nullptr;
-    /// The status bar, the event list (and log): the window's own.
+    /// The status bar: the window's own.
     std::function<void(const QString&, int)> status;
-    std::function<void(const QString&, const QString&, bool)> event;
   };
   explicit ConsoleContext(Parts parts, QObject* parent = nullptr) : QObject(parent), parts_(std::move(parts)) {}
 
@@ -121,14 +125,23 @@ class ConsoleContext : public QObject {
   void status(const QString& text, int ms = 5000) const { parts_.status(text, ms); }
   /// An event of the console's own (`kind`: "note", "estop", "link", ...):
   /// in the event list, and in the session log when `log`.
-  void event(const QString& kind, const QString& text, bool log = true) const { parts_.event(kind, text, log); }
+  void event(const QString& kind, const QString& text, bool log = true);
   /// Something the console decided (`kind` "rehearsal", "relay", "guard"),
   /// into the session log only.
   void logEvent(const QString& kind, const QString& text) const;
   /// Shows `text` (errors with file:line) under `title` in a dialog.
   void showError(const QString& title, const QString& text) const;
 
+ public slots:
+  /// Sends the e-stop to the live robot (whatever the views show) before
+  /// anything else: then the event list, the log and the status bar.
+  void emergencyStop();
+
  signals:
+  /// The session's robot endpoint may have changed: the link (re)connects.
+  void sessionChanged();
+  /// An event for the event list (event()).
+  void eventShown(const QString& text);
   /// The console's (live) world changed: a new world, robot or session.
   /// `fresh` is false when the same world is shown again (after a replay).
   void worldChanged(const sp::WorldModel& world, bool fresh);

@@ -1,5 +1,7 @@
 #include "ui/live_plots.h"
 
+#include <QSplitter>
+
 #include <QBoxLayout>
 #include <QCheckBox>
 #include <QColor>
@@ -671,6 +673,16 @@ bool PredictionErrorPlot::replot(bool) {
   setAxis(positionAxis_, 0, pTop, tickSpacing(pTop, 4));
   setAxis(headingAxis_, 0, hTop, tickSpacing(hTop, 4));
   return true;
+}
+
+QWidget* plotRow(const std::vector<std::pair<LivePlot*, int>>& plots) {
+  auto* row = new QSplitter(Qt::Horizontal);
+  for (const auto& [plot, stretch] : plots) {
+    plot->setOwnTimer(false);
+    row->addWidget(plot);
+    row->setStretchFactor(row->count() - 1, stretch);
+  }
+  return row;
 }
 
 }  // namespace sp

@@ -304,4 +304,8 @@ class PredictionErrorPlot : public LivePlot {
   QValueAxis* headingAxis_ = nullptr;
 };
 
+/// The plots side by side in a splitter, each with its stretch factor,
+/// replotted by their owner's tick() rather than their own timers.
+QWidget* plotRow(const std::vector<std::pair<LivePlot*, int>>& plots);
+
 }  // namespace sp

@@ -13,17 +13,13 @@
 #include <QLineEdit>
 #include <QMenuBar>
 #include <QMessageBox>
-#include <QPushButton>
 #include <QScrollArea>
 #include <QSettings>
-#include <QSplitter>
 #include <QStandardPaths>
 #include <QStatusBar>
 #include <QTimer>
 #include <QUrl>
 #include <QVBoxLayout>
-
-#include <cmath>
 
 #include "app/console/console_session.h"
 #include "app/log/log_player.h"
@@ -32,6 +28,7 @@
 #include "ui/console_monitor.h"
 #include "ui/jobs/drive/drive_job.h"
 #include "ui/jobs/jobs.h"
+#include "ui/jobs/link/link_job.h"
 #include "ui/jobs/replay/replay_job.h"
 #include "ui/jobs/replay/replay_panel.h"
 #include "ui/jobs/sequence/sequence_job.h"
@@ -107,8 +104,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   background_ = new BackgroundJobs(this);
   monitor_ = new ConsoleMonitor(connection_, liveFeed_, session_.get(), this);
   connect(monitor_, &ConsoleMonitor::changed, this, &MainWindow::stateChanged);
-  connect(monitor_, &ConsoleMonitor::filesDiffer, this, [this](const QString& text) { linkEvent(QStringLiteral("link"), text); });
-  connect(monitor_, &ConsoleMonitor::latchesChanged, this, [this](bool failsafe, bool estop) { link_->showLatches(failsafe, estop); });
+  connect(monitor_, &ConsoleMonitor::filesDiffer, this, [this](const QString& text) { context_->event(QStringLiteral("link"), text); });
   connect(liveFeed_, &RobotFeed::frame, this, [this](const RobotFrame& f) {
     context_->setMeasuredPositions(f.jointPositions);
     if (const std::optional<GhostError>& e = session_->lastPrediction()) errorPlot_->addSample(e->time, e->position, e->heading);
@@ -132,19 +128,11 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
           [this](const RobotFrame& f) { scene_->setGhostState(f.base, f.jointPositions); });
   connect(ghostFeed_, &GhostFeed::trail, scene_, &SceneView::setGhostTrail);
 
-  buildLinkDock();
-  auto* plots = new QSplitter(Qt::Horizontal);
   wheelPlot_ = new WheelForcePlot;
   laserPlot_ = new LaserPlot;
   errorPlot_ = new PredictionErrorPlot;
   // The plots replot from the window's panel timer (see there), not their own.
-  for (LivePlot* p : std::initializer_list<LivePlot*>{wheelPlot_, laserPlot_, errorPlot_}) {
-    p->setOwnTimer(false);
-    plots->addWidget(p);
-  }
-  plots->setStretchFactor(0, 3);
-  plots->setStretchFactor(1, 2);
-  plots->setStretchFactor(2, 3);
+  QWidget* plots = plotRow({{wheelPlot_, 3}, {laserPlot_, 2}, {errorPlot_, 3}});
   plotsDock_ = new QDockWidget(tr("Plots"), this);
   plotsDock_->setObjectName(QStringLiteral("plotsDock"));
   plotsDock_->setWidget(plots);
@@ -167,10 +155,6 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   parts.status = [this](const QString& text, int ms) {
     if (text.isEmpty()) statusBar()->clearMessage();
     else statusBar()->showMessage(text, ms);
-  };
-  parts.event = [this](const QString& kind, const QString& text, bool log) {
-    if (log) linkEvent(kind, text);
-    else link_->appendEvent(text);
   };
   context_ = new ConsoleContext(std::move(parts), this);
   connect(monitor_, &ConsoleMonitor::robotStopped, context_, &ConsoleContext::robotStopped);
@@ -269,11 +253,15 @@ QDockWidget* MainWindow::addDock(const QString& title, const QString& objectName
   } else {
     dock->setWidget(panel);
   }
-  if (place == DockPlace::Side) {
+  if (place == DockPlace::Link) {
+    linkDock_ = dock;
+    addDockWidget(Qt::RightDockWidgetArea, dock);
+    menu(tr("&View"))->addAction(dock->toggleViewAction());
+  } else if (place == DockPlace::Side) {
     // The first side dock is the anchor: the link dock under it, the others tabs of it.
     if (sideDocks_.empty()) {
       addDockWidget(Qt::RightDockWidgetArea, dock);
-      splitDockWidget(dock, linkDock_, Qt::Vertical);
+      if (linkDock_) splitDockWidget(dock, linkDock_, Qt::Vertical);
     } else {
       tabifyDockWidget(sideDocks_.front(), dock);
       sideDocks_.front()->raise();
@@ -312,7 +300,7 @@ void MainWindow::defaultLayout() {
   // can leave another in the group (the link dock ended up a tab of the
   // controls).
   std::vector<QDockWidget*> docks = sideDocks_;
-  docks.push_back(linkDock_);
+  if (linkDock_) docks.push_back(linkDock_);
   docks.push_back(plotsDock_);
   docks.insert(docks.end(), bottomDocks_.begin(), bottomDocks_.end());
   for (QDockWidget* dock : docks) {
@@ -321,9 +309,9 @@ void MainWindow::defaultLayout() {
   }
   if (!sideDocks_.empty()) {
     addDockWidget(Qt::RightDockWidgetArea, sideDocks_.front());
-    splitDockWidget(sideDocks_.front(), linkDock_, Qt::Vertical);
+    if (linkDock_) splitDockWidget(sideDocks_.front(), linkDock_, Qt::Vertical);
     for (size_t i = 1; i < sideDocks_.size(); ++i) tabifyDockWidget(sideDocks_.front(), sideDocks_[i]);
-  } else {
+  } else if (linkDock_) {
     addDockWidget(Qt::RightDockWidgetArea, linkDock_);
   }
   addDockWidget(Qt::BottomDockWidgetArea, plotsDock_);
@@ -332,32 +320,10 @@ void MainWindow::defaultLayout() {
   if (!sideDocks_.empty()) sideDocks_.front()->raise();
   plotsDock_->raise();
   emit context_->layoutReset();  // a job hides what it shows only on demand
-  if (!sideDocks_.empty()) {
-    resizeDocks({sideDocks_.front()}, {320}, Qt::Horizontal);
+  if (!sideDocks_.empty()) resizeDocks({sideDocks_.front()}, {320}, Qt::Horizontal);
+  if (!sideDocks_.empty() && linkDock_)
     resizeDocks({sideDocks_.front(), linkDock_}, {height() / 2, height() / 2}, Qt::Vertical);
-  }
   resizeDocks({plotsDock_}, {178}, Qt::Vertical);
-}
-
-void MainWindow::buildLinkDock() {
-  link_ = new LinkPanel;
-  linkDock_ = new QDockWidget(tr("Link"), this);
-  linkDock_->setObjectName(QStringLiteral("linkDock"));
-  linkDock_->setWidget(link_);
-  addDockWidget(Qt::RightDockWidgetArea, linkDock_);
-  connect(link_, &LinkPanel::connectRequested, this, &MainWindow::connectToRobot);
-  connect(link_, &LinkPanel::disconnectRequested, connection_, &RobotConnection::close);
-  connect(link_, &LinkPanel::takeControlRequested, connection_, &RobotConnection::acquireLease);
-  connect(link_, &LinkPanel::releaseControlRequested, connection_, &RobotConnection::releaseLease);
-  connect(link_, &LinkPanel::estopRequested, this, &MainWindow::emergencyStop);
-  connect(link_, &LinkPanel::rearmRequested, this, &MainWindow::rearm);
-
-  connect(liveFeed_, &RobotFeed::event, this, [this](const QString& kind, const QString& text) {
-    link_->appendEvent(text);
-    if (kind == QLatin1String("refused") || kind == QLatin1String("error")) statusBar()->showMessage(text, 5000);
-  });
-  connect(connection_, &RobotConnection::lease, link_, &LinkPanel::showLease);
-  connect(connection_, &RobotConnection::connectionChanged, link_, &LinkPanel::showConnection);
 }
 
 void MainWindow::buildMenus() {
@@ -389,21 +355,7 @@ void MainWindow::buildMenus() {
   file->addSeparator();
   file->addAction(tr("&Quit"), QKeySequence::Quit, this, &QWidget::close);
 
-  QMenu* robot = menu(tr("&Robot"));
-  robot->addAction(tr("&Connect to…"), this, &MainWindow::openConnectDialog);
-  reconnectAction_ = robot->addAction(tr("&Reconnect"), this, &MainWindow::connectToRobot);
-  disconnectAction_ = robot->addAction(tr("&Disconnect"), connection_, &RobotConnection::close);
-  robot->addSeparator();
-  takeAction_ = robot->addAction(tr("&Take control"), connection_, &RobotConnection::acquireLease);
-  releaseAction_ = robot->addAction(tr("Re&lease control"), connection_, &RobotConnection::releaseLease);
-  robot->addSeparator();
-  // Esc itself is caught by the application filter; the menu shows the key.
-  QAction* estop = robot->addAction(tr("&E-stop\tEsc"), this, &MainWindow::emergencyStop);
-  estop->setToolTip(tr("Emergency stop of the live robot, whatever the views show"));
-  rearmAction_ = robot->addAction(tr("Re-&arm…"), this, &MainWindow::rearm);
-  robot->addSeparator();
-  resetAction_ = robot->addAction(tr("Re&set to the start"), this, &MainWindow::resetRobot);
-  resetAction_->setToolTip(tr("Restart the stand-in with the robot where the world file puts it (logged)"));
+  menu(tr("&Robot"));  // the link job's items
 
   QMenu* view = menu(tr("&View"));
   QAction* follow = view->addAction(tr("&Follow the robot"));
@@ -435,18 +387,8 @@ void MainWindow::buildMenus() {
   // The jobs' side docks are listed before the plots and the link.
   menuAnchors_[tr("&View")] = plotsDock_->toggleViewAction();
   view->addAction(plotsDock_->toggleViewAction());
-  view->addAction(linkDock_->toggleViewAction());
 
-  QMenu* help = menu(tr("&Help"));
-  help->addAction(tr("&Keys"), this, [this] {
-    QMessageBox::information(this, tr("Keys"),
-                             tr("Esc\temergency stop (anywhere; an open list or menu closes first)\n"
-                                "Up/Down, W/S\tspeed ± 0.05 m/s (3D view focused)\n"
-                                "Left/Right, A/D\tarticulation ± 2°\n"
-                                "Space\tstop driving\n"
-                                "F\tfollow the robot\nHome\treset the view\n"
-                                "Ctrl+N\tnote in the session log"));
-  });
+  menu(tr("&Help"));  // the jobs' items (the drive keys, ...)
 }
 
 QString MainWindow::start() {
@@ -458,25 +400,15 @@ QString MainWindow::start() {
 }
 
 void MainWindow::sessionChanged() {
-  link_->setEndpoint(qs(session_->endpoint().label));
   if (session_->worldVersion() != shownWorld_) showWorld(*session_->world(), true);
   const std::string error = session_->logError();
   if (!error.empty()) statusBar()->showMessage(tr("session log: %1").arg(qs(error)));
-  connectToRobot();
+  emit context_->sessionChanged();
 }
 
-void MainWindow::connectToRobot() {
-  const RobotEndpoint& e = session_->endpoint();
-  if (e.port == 0) return;
-  net::RobotClientConfig config;
-  config.host = e.host;
-  config.port = e.port;
-  config.token = e.token;
-  config.name = QStringLiteral("console@%1").arg(QCoreApplication::applicationPid()).toStdString();
-  config.keepaliveInterval = session_->params().linkKeepalive;
-  config.commandExpiryMs = static_cast<uint64_t>(std::llround(session_->params().linkCommandExpiry * 1000));
-  connection_->open(config);
-  if (options_.takeControl) connection_->acquireLease();
+void MainWindow::restarted(bool clear) {
+  if (clear) clearFrames();
+  sessionChanged();
 }
 
 void MainWindow::showWorld(const WorldModel& world, bool fresh) {
@@ -500,7 +432,7 @@ void MainWindow::showWorld(const WorldModel& world, bool fresh) {
     }
     clearFrames();
     QString title = tr("SimPartner — %1").arg(QFileInfo(qs(world.file)).fileName());
-    if (!options_.connectTo.isEmpty()) title += tr(" — robot at %1").arg(options_.connectTo);
+    if (session_->remote()) title += tr(" — robot at %1:%2").arg(qs(session_->endpoint().host)).arg(session_->endpoint().port);
     setWindowTitle(title);
   }
   emit context_->worldChanged(world, fresh);
@@ -542,13 +474,13 @@ QString MainWindow::openRobot(const QString& path, bool quiet) {
 QString MainWindow::startBranch(const QString& logPath, const BranchPoint& point, bool quiet) {
   connection_->close();
   if (const std::string error = session_->branchFrom(logPath.toStdString(), point); !error.empty()) {
-    connectToRobot();
+    emit context_->sessionChanged();  // back to the robot it had
     if (!quiet) context_->showError(tr("Simulate from here"), qs(error));
     return qs(error);
   }
   replayPanel()->close();
   const double time = static_cast<double>(point.step) * point.logged.params.step;
-  linkEvent(QStringLiteral("note"), tr("branch of %1 at t = %2 s%3")
+  context_->event(QStringLiteral("note"), tr("branch of %1 at t = %2 s%3")
                                         .arg(logPath)
                                         .arg(time, 0, 'f', 3)
                                         .arg(point.reconstructed ? tr(" (reconstructed from telemetry)") : QString()));
@@ -559,65 +491,8 @@ QString MainWindow::startBranch(const QString& logPath, const BranchPoint& point
 
 void MainWindow::addNote(const QString& text) {
   session_->note(text.toStdString());
-  link_->appendEvent(tr("note: %1").arg(text));
+  emit context_->eventShown(tr("note: %1").arg(text));
   statusBar()->showMessage(tr("note logged"), 3000);
-}
-
-void MainWindow::emergencyStop() {
-  connection_->estop(tr("operator e-stop"));
-  const QString text = state().replaying() ? tr("E-STOP sent to the live robot") : tr("E-STOP sent");
-  linkEvent(QStringLiteral("estop"), text);
-  statusBar()->showMessage(text, 5000);
-}
-
-void MainWindow::rearm() {
-  // Deliberate: a confirmation whose default is No, so that no stray Enter
-  // or Space re-arms a stopped robot.
-  QMessageBox box(QMessageBox::Question, tr("Re-arm"),
-                  tr("Re-arm the robot?\n\nThe latch clears; the robot stays stopped until the next command, "
-                     "and the deadman counts from now."),
-                  QMessageBox::NoButton, this);
-  box.setObjectName(QStringLiteral("rearmConfirm"));
-  QPushButton* yes = box.addButton(tr("Re-arm"), QMessageBox::AcceptRole);
-  QPushButton* no = box.addButton(tr("Cancel"), QMessageBox::RejectRole);
-  box.setDefaultButton(no);
-  box.exec();
-  if (box.clickedButton() != yes) return;
-  emit context_->robotStopped();
-  linkEvent(QStringLiteral("rearm"), tr("re-arm sent"));
-  connection_->rearm();
-}
-
-void MainWindow::openConnectDialog() {
-  ConnectDialog dialog(this, [](const QString& hostPort, const QString& token) {
-    std::string error;
-    return parseEndpoint(hostPort.toStdString(), token.toStdString(), error) ? QString() : qs(error);
-  });
-  if (dialog.exec() != QDialog::Accepted) return;
-  connection_->close();
-  const std::string error = dialog.standIn() ? session_->useStandIn()
-                                             : session_->connectTo(dialog.hostPort().toStdString(), dialog.token().toStdString());
-  if (!error.empty()) {
-    context_->showError(tr("Cannot connect"), qs(error));
-    connectToRobot();  // back to where the console was
-    return;
-  }
-  if (!dialog.standIn()) ConnectDialog::remember(dialog.hostPort());
-  options_.connectTo = dialog.standIn() ? QString() : dialog.hostPort();
-  linkEvent(QStringLiteral("link"), tr("connecting to %1").arg(qs(session_->endpoint().label)));
-  sessionChanged();
-}
-
-void MainWindow::resetRobot() {
-  connection_->close();
-  if (const std::string error = session_->resetRobot(); !error.empty()) {
-    statusBar()->showMessage(qs(error), 6000);
-    connectToRobot();
-    return;
-  }
-  linkEvent(QStringLiteral("note"), tr("reset: the robot is back at its start"));
-  clearFrames();
-  sessionChanged();
 }
 
 void MainWindow::onShownFrame(const RobotFrame& f) {
@@ -662,12 +537,6 @@ void MainWindow::stateChanged() {
   banner_->setStyleSheet(now.replaying() && !now.latched() && now.healthReport().empty()
                              ? QStringLiteral("QLabel { background: #1565c0; color: white; font-weight: bold; padding: 6px; }")
                              : QStringLiteral("QLabel { background: #c62828; color: white; font-weight: bold; padding: 6px; }"));
-  reconnectAction_->setEnabled(now.canReconnect());
-  disconnectAction_->setEnabled(now.canDisconnect());
-  takeAction_->setEnabled(now.canTakeControl());
-  releaseAction_->setEnabled(now.canReleaseControl());
-  rearmAction_->setEnabled(now.canRearm());
-  resetAction_->setEnabled(!session_->remote());
   emit context_->stateChanged();
 }
 
@@ -683,7 +552,6 @@ void MainWindow::updateStale() {
 }
 
 void MainWindow::refreshStatus() {
-  link_->showStats(connection_->stats());
   status_->refresh(state(), *session_, *liveFeed_);
 }
 
@@ -693,7 +561,7 @@ bool MainWindow::eventFilter(QObject* watched, QEvent* event) {
     // closed with Esc e-stopped the live robot); everywhere else Esc is
     // the e-stop, dialogs included.
     if (QApplication::activePopupWidget()) return QMainWindow::eventFilter(watched, event);
-    if (!static_cast<QKeyEvent*>(event)->isAutoRepeat()) emergencyStop();
+    if (!static_cast<QKeyEvent*>(event)->isAutoRepeat()) context_->emergencyStop();
     return true;
   }
   return QMainWindow::eventFilter(watched, event);
@@ -715,9 +583,10 @@ int64_t MainWindow::telemetryReceived() const { return liveFeed_->telemetryCount
 int64_t MainWindow::laserReceived() const { return liveFeed_->laserCount(); }
 double MainWindow::realTimeFactor() const { return session_->realTimeFactor(); }
 
-void MainWindow::linkEvent(const QString& kind, const QString& text) {
-  link_->appendEvent(text);
-  session_->event(kind.toStdString(), text.toStdString());
-}
+LinkPanel* MainWindow::linkPanel() const { return job<LinkJob>()->panel(); }
+void MainWindow::emergencyStop() { context_->emergencyStop(); }
+void MainWindow::rearm() { job<LinkJob>()->rearm(); }
+void MainWindow::openConnectDialog() { job<LinkJob>()->openConnectDialog(); }
+void MainWindow::resetRobot() { job<LinkJob>()->resetRobot(); }
 
 }  // namespace sp

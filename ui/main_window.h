@@ -107,7 +107,7 @@ class MainWindow : public QMainWindow, public ConsoleHost {
 
   // For tests and the status of the session.
   SceneView* sceneView() const { return scene_; }
-  LinkPanel* linkPanel() const { return link_; }
+  LinkPanel* linkPanel() const;
   ControlPanel* controlPanel() const;
   SequencePanel* sequencePanel() const;
   TerrainPanel* terrainPanel() const;
@@ -164,6 +164,7 @@ class MainWindow : public QMainWindow, public ConsoleHost {
 
   // ConsoleHost
   QString startBranch(const QString& logPath, const BranchPoint& point, bool quiet) override;
+  void restarted(bool clearFrames) override;
   QDockWidget* addDock(const QString& title, const QString& objectName, QWidget* panel, DockPlace place,
                        bool scrolled) override;
   QMenu* menu(const QString& title) override;
@@ -186,13 +187,11 @@ class MainWindow : public QMainWindow, public ConsoleHost {
 
  private:
   void buildMenus();
-  void buildLinkDock();
   /// The console's world changed (`fresh`: a new one, not the same shown
   /// again): jobs and, while the live robot is shown, the views follow.
   void showWorld(const WorldModel& world, bool fresh);
   /// After the session started or switched robots: redraw, reconnect.
   void sessionChanged();
-  void connectToRobot();
   /// A frame of the feed shown: drawn.
   void onShownFrame(const RobotFrame& frame);
   void onFeedSwitched(RobotFeed* feed);
@@ -203,8 +202,6 @@ class MainWindow : public QMainWindow, public ConsoleHost {
   void updateStale();
   /// A new session or world: forget the last robot's frames and plots.
   void clearFrames();
-  /// An event of the console's own, shown in the link dock and logged.
-  void linkEvent(const QString& kind, const QString& text);
 
   ConsoleOptions options_;
   QString logDir_;
@@ -220,7 +217,6 @@ class MainWindow : public QMainWindow, public ConsoleHost {
   std::vector<std::unique_ptr<ConsoleJob>> jobs_;
 
   SceneView* scene_ = nullptr;
-  LinkPanel* link_ = nullptr;
   WheelForcePlot* wheelPlot_ = nullptr;
   LaserPlot* laserPlot_ = nullptr;
   PredictionErrorPlot* errorPlot_ = nullptr;
@@ -232,12 +228,6 @@ class MainWindow : public QMainWindow, public ConsoleHost {
   bool ghostShownBeforeReplay_ = false;
   QLabel* banner_ = nullptr;
   QLabel* staleLabel_ = nullptr;
-  QAction* reconnectAction_ = nullptr;
-  QAction* disconnectAction_ = nullptr;
-  QAction* takeAction_ = nullptr;
-  QAction* releaseAction_ = nullptr;
-  QAction* rearmAction_ = nullptr;
-  QAction* resetAction_ = nullptr;
   StatusFields* status_ = nullptr;
   int64_t panelTicks_ = 0;
 };

@@ -6,6 +6,8 @@
 #include <QKeyEvent>
 #include <QLineEdit>
 #include <QMainWindow>
+#include <QMessageBox>
+#include <QAction>
 #include <QPlainTextEdit>
 #include <QTextEdit>
 
@@ -44,6 +46,17 @@ void DriveJob::install(ConsoleContext& context) {
     panel_->showMeasured(context_->measuredPositions());
     measuredDirty_ = false;
   });
+  auto* keys = new QAction(tr("&Keys"), context.window());
+  connect(keys, &QAction::triggered, this, [this] {
+    QMessageBox::information(context_->window(), tr("Keys"),
+                             tr("Esc\temergency stop (anywhere; an open list or menu closes first)\n"
+                                "Up/Down, W/S\tspeed ± 0.05 m/s\n"
+                                "Left/Right, A/D\tarticulation ± 2°\n"
+                                "Space\tstop driving\n"
+                                "F\tfollow the robot (3D view focused)\nHome\treset the view\n"
+                                "Ctrl+N\tnote in the session log"));
+  });
+  context.host().addMenuAction(tr("&Help"), keys);
   // Drive keys wherever the focus is in this window: an application-wide
   // filter sees them before a focused button or slider can.
   qApp->installEventFilter(this);

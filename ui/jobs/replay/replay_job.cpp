@@ -41,7 +41,7 @@ void ReplayJob::install(ConsoleContext& context) {
     if (panel_->isOpen()) dock_->raise();
   });
 
-  QAction* open = new QAction(tr("Open session &log…"), this);
+  QAction* open = new QAction(tr("Open session &log…"), context.window());
   open->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_L));
   connect(open, &QAction::triggered, this, [this] {
     const QString path = QFileDialog::getOpenFileName(context_->window(), tr("Open session log"), logDir_,
@@ -58,9 +58,9 @@ void ReplayJob::install(ConsoleContext& context) {
     if (recent->isEmpty()) recent->addAction(tr("(none yet)"))->setEnabled(false);
   });
   recent->setToolTipsVisible(true);
-  QAction* logs = new QAction(tr("Session &logs…"), this);
+  QAction* logs = new QAction(tr("Session &logs…"), context.window());
   connect(logs, &QAction::triggered, this, &ReplayJob::showSessionLogs);
-  QAction* close = new QAction(tr("Close replay"), this);
+  QAction* close = new QAction(tr("Close replay"), context.window());
   connect(close, &QAction::triggered, panel_, &ReplayPanel::close);
   for (QAction* a : {open, recent->menuAction(), logs, close}) context.host().addMenuAction(tr("&File"), a);
 }
