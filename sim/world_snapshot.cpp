@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "sim/hash.h"
+#include "sim/state_fields.h"
 
 namespace sp {
 using namespace world_detail;
@@ -148,41 +150,48 @@ std::string World::setRobotMotion(int robot, const std::vector<LinkMotion>& link
   return {};
 }
 
+namespace {
+
+// Hashes the fields sim/state_fields.h marks hashed, each as its bytes.
+struct StateHasher {
+  Fnv1a64& h;
+  template <class T, bool Hashed>
+  void operator()(const T& v, std::bool_constant<Hashed>) {
+    if constexpr (Hashed) {
+      static_assert(std::is_trivially_copyable_v<T>, "a hashed field is hashed as its bytes");
+      h.value(v);
+    }
+  }
+  template <StateOf T, bool Hashed>
+  void operator()(const std::vector<T>& items, std::bool_constant<Hashed>) {
+    if constexpr (Hashed)
+      for (const T& item : items) visitState(item, *this);
+  }
+  // Motion resistance only where a surface has it: other runs keep the
+  // hashes they always had.
+  void resistance(const std::vector<double>& forces, const std::vector<double>& shares) {
+    if (std::none_of(forces.begin(), forces.end(), [](double f) { return f != 0; })) return;
+    for (size_t l = 0; l < forces.size(); ++l) {
+      h.value(forces[l]);
+      h.value(shares[l]);
+    }
+  }
+};
+
+}  // namespace
+
 uint64_t World::stateHash() const {
   const Impl& m = *impl_;
   Fnv1a64 h;
   h.value(steps_);
+  StateHasher hash{h};
   for (dBodyID b : m.allBodies) {
-    const BodyState s = readBody(b);
-    h.value(s);
+    const BodyState body = readBody(b);
+    visitState(body, hash);
   }
   for (const Impl::Robot& rt : m.robots) {
-    for (const ActuatorState& a : rt.control.actuators) {
-      h.value(a.mode);
-      h.value(a.velocity);
-      h.value(a.target);
-      h.value(a.torque);
-      h.value(a.integral);
-    }
-    h.value(rt.control.driveActive);
-    h.value(rt.control.driveSpeed);
-    h.value(rt.control.driveArticulation);
-    h.value(rt.control.driveByYawRate);
-    h.value(rt.control.driveYawRate);
-    h.value(rt.control.gaitActive);
-    h.value(rt.control.gait);
-    // Motion resistance only where a surface has it: other runs keep the
-    // hashes they always had.
-    if (std::any_of(rt.control.resistance.begin(), rt.control.resistance.end(), [](double f) { return f != 0; }))
-      for (size_t l = 0; l < rt.control.resistance.size(); ++l) {
-        h.value(rt.control.resistance[l]);
-        h.value(rt.control.resistanceShare[l]);
-      }
-    for (const SensorState& st : rt.sensors) {
-      h.value(st.nextStep);
-      h.value(st.forceSum);
-      h.value(st.stepsSummed);
-    }
+    visitState(rt.control, hash);
+    hash(rt.sensors, kHashed);
   }
   h.value(m.randState);
   h.value(m.random.state());

@@ -170,12 +170,14 @@ int main(int argc, char** argv) {
     const double warmUp = seconds > 6 ? 3.0 : 0.0;
     auto* measure = new QObject(&window);
     auto framesAtWarmUp = std::make_shared<int64_t>(0);
+    auto anchorsAtWarmUp = std::make_shared<int64_t>(0);
     auto wallAtWarmUp = std::make_shared<QElapsedTimer>();
-    QTimer::singleShot(static_cast<int>(warmUp * 1000), measure, [&window, framesAtWarmUp, wallAtWarmUp] {
+    QTimer::singleShot(static_cast<int>(warmUp * 1000), measure, [&window, framesAtWarmUp, anchorsAtWarmUp, wallAtWarmUp] {
       *framesAtWarmUp = window.sceneView()->framesDrawn();
+      if (const sp::Ghost* ghost = window.session()->ghost()) *anchorsAtWarmUp = ghost->stats().anchors;
       wallAtWarmUp->start();
     });
-    QTimer::singleShot(static_cast<int>(seconds * 1000), measure, [&, framesAtWarmUp, wallAtWarmUp] {
+    QTimer::singleShot(static_cast<int>(seconds * 1000), measure, [&, framesAtWarmUp, anchorsAtWarmUp, wallAtWarmUp] {
       const double wall = static_cast<double>(wallAtWarmUp->nsecsElapsed()) * 1e-9;
       const int64_t frames = window.sceneView()->framesDrawn() - *framesAtWarmUp;
       std::cout << "frames " << frames << " in " << wall << " s: " << static_cast<double>(frames) / wall
@@ -186,7 +188,8 @@ int main(int argc, char** argv) {
       if (const sp::Ghost* ghost = window.session()->ghost()) {
         const sp::GhostView v = ghost->view();
         const sp::GhostStats g = ghost->stats();
-        std::cout << "; ghost +" << v.span << " s, " << g.anchors << " re-anchorings (last " << g.anchorMs << " ms), "
+        std::cout << "; ghost +" << v.span << " s, " << g.anchors << " re-anchorings ("
+                  << static_cast<double>(g.anchors - *anchorsAtWarmUp) / wall << " per s measured; last " << g.anchorMs << " ms), "
                   << g.trails << " trails of " << v.trail.size() << " points (last " << g.trailMs << " ms), drawn "
                   << window.sceneView()->drawnTrailPoints();
         if (!v.trail.empty())

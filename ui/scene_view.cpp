@@ -12,7 +12,7 @@
 #include <QWheelEvent>
 
 #include <osg/BlendFunc>
-#include <osg/ColorMask>
+#include <osg/CullFace>
 #include <osg/Fog>
 #include <osg/Depth>
 #include <osg/Geode>
@@ -22,6 +22,7 @@
 #include <osg/LightSource>
 #include <osg/LineWidth>
 #include <osg/Material>
+#include <osgUtil/RenderBin>
 #include <osg/MatrixTransform>
 #include <osg/Point>
 #include <osg/PolygonOffset>
@@ -55,9 +56,20 @@ constexpr double kPlaneCell = 10.0;       // [m]; coarse: software GL pays per v
 constexpr int kGridHalfSize = 50;         // [m] of 1 m grid around the origin
 constexpr double kGridLift = 0.005;       // [m] lines above the ground, with polygon offset
 constexpr double kDefaultAzimuth = degToRad(-150);  // behind the robot, to its right
-// Render bins of the translucent robots: after the opaque scene (0) and
-// OSG's depth-sorted transparent bin (10): their depth pass, then colour.
+// The render bin of the translucent robots: after the opaque scene (0) and
+// OSG's depth-sorted transparent bin (10), sorted nearest first.
 constexpr int kPhantomBin = 20;
+constexpr const char* kFrontToBackBin = "SimPartnerFrontToBack";
+
+/// Registers kFrontToBackBin with OSG (once per process).
+void registerFrontToBackBin() {
+  static const bool registered = [] {
+    osgUtil::RenderBin::addRenderBinPrototype(kFrontToBackBin,
+                                              new osgUtil::RenderBin(osgUtil::RenderBin::SORT_FRONT_TO_BACK));
+    return true;
+  }();
+  (void)registered;
+}
 constexpr double kDefaultElevation = degToRad(19);
 constexpr double kDefaultDistance = 7.0;  // [m]
 constexpr double kMinElevation = degToRad(1), kMaxElevation = degToRad(89);
@@ -626,36 +638,30 @@ void SceneView::Impl::updateLaser() {
 }
 
 void SceneView::Impl::buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line) {
+  registerFrontToBackBin();
   p.node = new osg::Group;
   p.body = new osg::Group;
   root->addChild(p.node);
-  // A clean translucent silhouette in one colour: the links are drawn
-  // twice, after the opaque scene. First into depth alone, so that only the
-  // phantom's nearest surface survives; then in colour where depth equals
-  // it, blended once. Drawn in one pass without depth (as before), the
-  // links' back faces and inner parts blended over each other in whatever
-  // order they came, and the phantom showed shards of darker and lighter
-  // tints. Lighting still shades the one colour, so the shape reads.
+  // A clean translucent silhouette in one colour: each pixel blends the
+  // phantom's nearest surface once. Its links are drawn after the opaque
+  // scene, nearest first, writing depth, with back faces culled, so that a
+  // surface behind one already drawn fails the depth test instead of
+  // blending again. Drawn without depth (as before), the links' faces
+  // blended over each other in whatever order they came, and the phantom
+  // showed shards of darker and lighter tints. Lighting still shades the
+  // one colour, so the shape reads.
   auto* tint = new osg::Material;
   tint->setColorMode(osg::Material::OFF);
   tint->setDiffuse(osg::Material::FRONT_AND_BACK, body);
   tint->setAmbient(osg::Material::FRONT_AND_BACK, {body.r() / 2, body.g() / 2, body.b() / 2, body.a()});
   tint->setSpecular(osg::Material::FRONT_AND_BACK, {0, 0, 0, body.a()});
-  auto* depthPass = new osg::Group;
-  depthPass->addChild(p.body);
-  osg::StateSet* d = depthPass->getOrCreateStateSet();
-  d->setAttributeAndModes(new osg::ColorMask(false, false, false, false), osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
-  d->setAttributeAndModes(new osg::Depth(osg::Depth::LESS, 0.0, 1.0, true), osg::StateAttribute::ON);
-  d->setRenderBinDetails(kPhantomBin, "RenderBin");
-  auto* colorPass = new osg::Group;
-  colorPass->addChild(p.body);
-  osg::StateSet* c = colorPass->getOrCreateStateSet();
-  c->setAttributeAndModes(tint, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
-  c->setAttributeAndModes(new osg::BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA), osg::StateAttribute::ON);
-  c->setAttributeAndModes(new osg::Depth(osg::Depth::EQUAL, 0.0, 1.0, false), osg::StateAttribute::ON);
-  c->setRenderBinDetails(kPhantomBin + 1, "RenderBin");
-  p.node->addChild(depthPass);
-  p.node->addChild(colorPass);
+  p.node->addChild(p.body);
+  osg::StateSet* g = p.node->getOrCreateStateSet();
+  g->setAttributeAndModes(tint, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+  g->setAttributeAndModes(new osg::BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA), osg::StateAttribute::ON);
+  g->setAttributeAndModes(new osg::Depth(osg::Depth::LESS, 0.0, 1.0, true), osg::StateAttribute::ON);
+  g->setAttributeAndModes(new osg::CullFace(osg::CullFace::BACK), osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+  g->setRenderBinDetails(kPhantomBin, kFrontToBackBin);
   p.node->setNodeMask(0);
   p.pathNode = new osg::Geode;
   p.path = newGeometry();

@@ -7,6 +7,7 @@
 #include <variant>
 
 #include "sim/height_grid.h"
+#include "sim/state_fields.h"
 
 namespace sp {
 namespace {
@@ -240,6 +241,107 @@ Command readCommand(Reader& r) {
   }
 }
 
+// Writes the fields sim/state_fields.h lists, in its order.
+struct Encode {
+  Writer& w;
+  void operator()(double v, auto) { w.f64(v); }
+  void operator()(bool v, auto) { w.boolean(v); }
+  void operator()(int v, auto) { w.i32(v); }
+  void operator()(int64_t v, auto) { w.i64(v); }
+  void operator()(JointMode m, auto) { w.u8(static_cast<uint8_t>(m)); }
+  void operator()(const Vec3& v, auto) { w.vec3(v); }
+  template <size_t N>
+  void operator()(const std::array<double, N>& a, auto) {
+    for (double v : a) w.f64(v);
+  }
+  void operator()(const GaitState& g, auto) {
+    w.u8(static_cast<uint8_t>(g.gait));
+    w.i32(g.phase);
+    w.i64(g.phaseStart);
+  }
+  void operator()(const SensorSample& s, auto) {
+    w.i32(s.robot);
+    w.i32(s.sensor);
+    w.i64(s.step);
+    w.f64(s.time);
+    writeSensorValue(w, s.value);
+  }
+  template <StateOf T>
+  void operator()(const std::vector<T>& items, auto) {
+    w.u64(items.size());
+    for (const T& item : items) visitState(item, *this);
+  }
+  void resistance(const std::vector<double>& forces, const std::vector<double>& shares) {
+    w.u64(forces.size());
+    for (size_t l = 0; l < forces.size(); ++l) {
+      w.f64(forces[l]);
+      w.f64(l < shares.size() ? shares[l] : 1.0);
+    }
+  }
+};
+
+// The fewest bytes a T takes encoded (its vectors empty): a count of Ts
+// beyond what is left of the data is a truncated snapshot, not an allocation.
+template <StateOf T>
+size_t minEncodedSize() {
+  static const size_t size = [] {
+    Writer w;
+    Encode encode{w};
+    const T empty{};
+    visitState(empty, encode);
+    return w.take().size();
+  }();
+  return size;
+}
+
+// Reads what Encode wrote; `version` is the snapshot's (1 has no motion resistance).
+struct Decode {
+  Reader& r;
+  uint32_t version;
+  void operator()(double& v, auto) { v = r.f64(); }
+  void operator()(bool& v, auto) { v = r.boolean(); }
+  void operator()(int& v, auto) { v = r.i32(); }
+  void operator()(int64_t& v, auto) { v = r.i64(); }
+  void operator()(JointMode& m, auto) {
+    const uint8_t v = r.u8();
+    if (v > static_cast<uint8_t>(JointMode::Free)) throw BadData("unknown joint mode");
+    m = static_cast<JointMode>(v);
+  }
+  void operator()(Vec3& v, auto) { v = r.vec3(); }
+  template <size_t N>
+  void operator()(std::array<double, N>& a, auto) {
+    for (double& v : a) v = r.f64();
+  }
+  void operator()(GaitState& g, auto) {
+    const uint8_t v = r.u8();
+    if (v > static_cast<uint8_t>(Gait::Rolking)) throw BadData("unknown gait");
+    g.gait = static_cast<Gait>(v);
+    g.phase = r.i32();
+    g.phaseStart = r.i64();
+  }
+  void operator()(SensorSample& s, auto) {
+    s.robot = r.i32();
+    s.sensor = r.i32();
+    s.step = r.i64();
+    s.time = r.f64();
+    s.value = readSensorValue(r);
+  }
+  template <StateOf T>
+  void operator()(std::vector<T>& items, auto) {
+    items.resize(r.count(minEncodedSize<T>()));
+    for (T& item : items) visitState(item, *this);
+  }
+  void resistance(std::vector<double>& forces, std::vector<double>& shares) {
+    if (version < 2) return;
+    forces.resize(r.count(16));
+    shares.resize(forces.size());
+    for (size_t l = 0; l < forces.size(); ++l) {
+      forces[l] = r.f64();
+      shares[l] = r.f64();
+    }
+  }
+};
+
 }  // namespace
 
 std::vector<uint8_t> encodeSnapshot(const Snapshot& s) {
@@ -251,52 +353,11 @@ std::vector<uint8_t> encodeSnapshot(const Snapshot& s) {
   w.u64(s.modelKey);
   w.i64(s.step);
   w.f64(s.stepSize);
-  w.u64(s.bodies.size());
-  for (const BodyState& b : s.bodies) {
-    for (double v : b.position) w.f64(v);
-    for (double v : b.quaternion) w.f64(v);
-    for (double v : b.linearVelocity) w.f64(v);
-    for (double v : b.angularVelocity) w.f64(v);
-  }
-  w.u64(s.robots.size());
-  for (const RobotControlState& rc : s.robots) {
-    w.u64(rc.actuators.size());
-    for (const ActuatorState& a : rc.actuators) {
-      w.u8(static_cast<uint8_t>(a.mode));
-      w.f64(a.velocity); w.f64(a.target); w.f64(a.torque); w.f64(a.integral);
-    }
-    w.boolean(rc.driveActive);
-    w.f64(rc.driveSpeed);
-    w.f64(rc.driveArticulation);
-    w.boolean(rc.driveByYawRate);
-    w.f64(rc.driveYawRate);
-    w.boolean(rc.gaitActive);
-    w.u8(static_cast<uint8_t>(rc.gait.gait));
-    w.i32(rc.gait.phase);
-    w.i64(rc.gait.phaseStart);
-    w.u64(rc.resistance.size());
-    for (size_t l = 0; l < rc.resistance.size(); ++l) {
-      w.f64(rc.resistance[l]);
-      w.f64(l < rc.resistanceShare.size() ? rc.resistanceShare[l] : 1.0);
-    }
-  }
+  Encode encode{w};
+  encode(s.bodies, kHashed);
+  encode(s.robots, kHashed);
   w.u64(s.sensors.size());
-  for (const auto& robotSensors : s.sensors) {
-    w.u64(robotSensors.size());
-    for (const SensorState& ss : robotSensors) {
-      w.i64(ss.nextStep);
-      w.vec3(ss.lastVelocity);
-      w.vec3(ss.forceSum);
-      w.vec3(ss.normalSum);
-      w.i32(ss.contactSum);
-      w.i32(ss.stepsSummed);
-      w.i32(ss.latest.robot);
-      w.i32(ss.latest.sensor);
-      w.i64(ss.latest.step);
-      w.f64(ss.latest.time);
-      writeSensorValue(w, ss.latest.value);
-    }
-  }
+  for (const std::vector<SensorState>& robotSensors : s.sensors) encode(robotSensors, kHashed);
   w.u64(static_cast<uint64_t>(s.odeRandom));
   for (uint64_t v : s.random) w.u64(v);
   w.boolean(s.terrain != nullptr);
@@ -333,59 +394,11 @@ std::optional<Snapshot> decodeSnapshot(const std::vector<uint8_t>& data, std::st
     s.modelKey = r.u64();
     s.step = r.i64();
     s.stepSize = r.f64();
-    s.bodies.resize(r.count(13 * 8));
-    for (BodyState& b : s.bodies) {
-      for (double& v : b.position) v = r.f64();
-      for (double& v : b.quaternion) v = r.f64();
-      for (double& v : b.linearVelocity) v = r.f64();
-      for (double& v : b.angularVelocity) v = r.f64();
-    }
-    s.robots.resize(r.count(1));
-    for (RobotControlState& rc : s.robots) {
-      rc.actuators.resize(r.count(33));
-      for (ActuatorState& a : rc.actuators) {
-        uint8_t m = r.u8();
-        if (m > static_cast<uint8_t>(JointMode::Free)) throw BadData("unknown joint mode");
-        a.mode = static_cast<JointMode>(m);
-        a.velocity = r.f64(); a.target = r.f64(); a.torque = r.f64(); a.integral = r.f64();
-      }
-      rc.driveActive = r.boolean();
-      rc.driveSpeed = r.f64();
-      rc.driveArticulation = r.f64();
-      rc.driveByYawRate = r.boolean();
-      rc.driveYawRate = r.f64();
-      rc.gaitActive = r.boolean();
-      uint8_t g = r.u8();
-      if (g > static_cast<uint8_t>(Gait::Rolking)) throw BadData("unknown gait");
-      rc.gait.gait = static_cast<Gait>(g);
-      rc.gait.phase = r.i32();
-      rc.gait.phaseStart = r.i64();
-      if (version >= 2) {
-        rc.resistance.resize(r.count(16));
-        rc.resistanceShare.resize(rc.resistance.size());
-        for (size_t l = 0; l < rc.resistance.size(); ++l) {
-          rc.resistance[l] = r.f64();
-          rc.resistanceShare[l] = r.f64();
-        }
-      }
-    }
+    Decode decode{r, version};
+    decode(s.bodies, kHashed);
+    decode(s.robots, kHashed);
     s.sensors.resize(r.count(8));
-    for (auto& robotSensors : s.sensors) {
-      robotSensors.resize(r.count(1));
-      for (SensorState& ss : robotSensors) {
-        ss.nextStep = r.i64();
-        ss.lastVelocity = r.vec3();
-        ss.forceSum = r.vec3();
-        ss.normalSum = r.vec3();
-        ss.contactSum = r.i32();
-        ss.stepsSummed = r.i32();
-        ss.latest.robot = r.i32();
-        ss.latest.sensor = r.i32();
-        ss.latest.step = r.i64();
-        ss.latest.time = r.f64();
-        ss.latest.value = readSensorValue(r);
-      }
-    }
+    for (std::vector<SensorState>& robotSensors : s.sensors) decode(robotSensors, kHashed);
     s.odeRandom = static_cast<unsigned long>(r.u64());
     for (uint64_t& v : s.random) v = r.u64();
     if (r.boolean()) {

@@ -199,7 +199,8 @@ class TstSceneView : public QObject {
   // recovering the tint from the image with and without the ghost
   // (tint = (with - (1 - a) * without) / a) must give the ghost's hue
   // (SceneView::kGhostTint's r:g:b) wherever it is bright enough to
-  // measure, within 0.12 in each ratio, for 95 % of its pixels. Drawn
+  // measure, within 0.12 in each ratio, for 95 % of its pixels (measured:
+  // 99.2 % of 8404). Drawn
   // without depth (the code before this test, its tint then 0.30:0.80:1.00
   // at alpha 0.38, measured against that tint), its links' faces blended
   // over each other and the recovered colours strayed: 0.0 % of 3206
