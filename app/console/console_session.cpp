@@ -1,5 +1,7 @@
 #include "app/console/console_session.h"
 
+#include "app/console/terrain_editor.h"
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -37,7 +39,10 @@ const RobotModel* ConsoleSession::robot() const {
 }
 
 void ConsoleSession::setWorld(WorldModel world) {
+  terrain_.reset();  // its history is of the old world's heights
   world_ = std::move(world);
+  if (world_->terrain.kind == TerrainSpec::Kind::Heightfield)
+    terrain_ = std::make_unique<TerrainEditor>(world_->terrain.grid);
   ++worldVersion_;
   positions_.reset();
   rates_.reset();
@@ -245,10 +250,7 @@ void ConsoleSession::commandSent(const Command& command) {
 }
 
 bool ConsoleSession::terrainEdited(const TerrainPatchCmd& patch) {
-  if (!world_ || !patchFits(world_->terrain.kind == TerrainSpec::Kind::Heightfield ? &world_->terrain.grid : nullptr,
-                            patch).empty())
-    return false;
-  applyPatch(world_->terrain.grid, patch);
+  if (!terrain_ || !patchFits(&world_->terrain.grid, patch).empty()) return false;
   commandSent(patch);
   return true;
 }

@@ -32,6 +32,7 @@ namespace sp {
 
 class StandInRobot;
 class TelemetryRecorder;
+class TerrainEditor;
 
 /// What the console starts with (the `simpartner` command line).
 struct ConsoleSessionOptions {
@@ -154,11 +155,15 @@ class ConsoleSession {
   /// A command went out: logged when the robot is remote (the stand-in logs
   /// what it applies itself), and handed to the ghost.
   void commandSent(const Command& command);
-  /// A terrain edit made in the console: the console's world (what is
-  /// drawn, rehearsed and saved) and the ghost take it now, and a remote
-  /// robot's telemetry log records it (the stand-in logs what it applies).
-  /// Sending it to the robot's twin is the caller's (when the robot
-  /// announces `terrain_edit`). False when it does not fit the terrain.
+  /// The console's terrain: the editor of the world's heightfield, which
+  /// edits world()'s heights in place (what is drawn, rehearsed and saved),
+  /// with its undo history; null on a plane. Replaced with the world.
+  TerrainEditor* terrainEditor() { return terrain_.get(); }
+  /// A terrain edit made through terrainEditor() (already in world()'s
+  /// heights): the ghost takes it now, and a remote robot's telemetry log
+  /// records it (the stand-in logs what it applies). Sending it to the
+  /// robot's twin is the caller's (when the robot announces
+  /// `terrain_edit`). False when it does not fit the terrain.
   bool terrainEdited(const TerrainPatchCmd& patch);
   /// An operator note into the session log.
   void note(const std::string& text);
@@ -181,6 +186,7 @@ class ConsoleSession {
   ConsoleSessionOptions options_;
   SimParams params_;
   std::optional<WorldModel> world_;
+  std::unique_ptr<TerrainEditor> terrain_;  // edits world_'s heights
   int worldVersion_ = 0;
   std::string worldFile_;  // the stand-in's world file
   std::string robotFile_;  // the robot file replacing the world's, "" for the world's own

@@ -1,11 +1,14 @@
 #pragma once
 // The console's terrain editor (issue 16): brush strokes on the world's
-// heightfield with many levels of undo and redo. Each dab is a
+// heightfield with many levels of undo and redo. It edits the heights where
+// they live (the console session's world: app/console/console_session.h),
+// so the console has one terrain, which the scene, the ghost, rehearsals
+// and the Terrain dock all read. Each dab is a
 // TerrainPatchCmd (sim/terrain_brush.h) for the twins to apply at their next
 // step; a stroke (the dabs of one drag) is one undo level, undone by the
 // patch of the heights it replaced, bit for bit.
 //
-//   sp::TerrainEditor editor(world.terrain.grid);
+//   sp::TerrainEditor editor(world.terrain.grid);   // edits world's heights in place
 //   for each mouse move:  if (auto p = editor.dab(point, brush)) send(*p);
 //   on release:           editor.endStroke();
 //   Undo:                 if (auto p = editor.undo()) send(*p);
@@ -22,7 +25,11 @@ namespace sp {
 
 class TerrainEditor {
  public:
-  explicit TerrainEditor(HeightGrid grid, size_t maxLevels = 200) : grid_(std::move(grid)), maxLevels_(maxLevels) {}
+  /// Edits `grid` in place (it must outlive the editor), keeping up to
+  /// `maxLevels` undo levels.
+  explicit TerrainEditor(HeightGrid& grid, size_t maxLevels = 200) : grid_(grid), maxLevels_(maxLevels) {}
+  TerrainEditor(const TerrainEditor&) = delete;
+  TerrainEditor& operator=(const TerrainEditor&) = delete;
 
   /// The heights as edited so far.
   const HeightGrid& grid() const { return grid_; }
@@ -49,7 +56,7 @@ class TerrainEditor {
     HeightGrid start;  // the heights when the stroke began
     int i0, j0, i1, j1;  // the samples touched so far (inclusive)
   };
-  HeightGrid grid_;
+  HeightGrid& grid_;
   size_t maxLevels_;
   std::optional<Open> stroke_;
   std::vector<Stroke> done_, undone_;

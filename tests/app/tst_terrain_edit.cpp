@@ -99,7 +99,8 @@ class TestTerrainEdit : public QObject {
   void undoRestoresBitForBit() {
     const WorldModel model = track();
     const HeightGrid original = model.terrain.grid;
-    TerrainEditor editor(original);
+    HeightGrid heights = original;  // the editor edits these in place
+    TerrainEditor editor(heights);
     Diagnostics diag;
     std::unique_ptr<World> world = World::create(model, {}, diag);
     QVERIFY2(world, diag.format().c_str());
@@ -116,6 +117,7 @@ class TestTerrainEdit : public QObject {
     world->step();
     const HeightGrid edited = editor.grid();
     QCOMPARE(world->terrainGrid()->heights, edited.heights);
+    QCOMPARE(heights.heights, edited.heights);  // in place: the grid it was given is the one edited
     QVERIFY(edited.heights != original.heights);
     QCOMPARE(editor.undoLevels(), size_t{30});
     while (auto p = editor.undo()) world->submit(*p);
@@ -128,7 +130,8 @@ class TestTerrainEdit : public QObject {
     QCOMPARE(editor.grid().heights, edited.heights);
     QCOMPARE(world->terrainGrid()->heights, edited.heights);
     // A new stroke drops the redo levels; old levels beyond the limit go.
-    TerrainEditor small(original, 3);
+    HeightGrid smallHeights = original;
+    TerrainEditor small(smallHeights, 3);
     for (int s = 0; s < 5; ++s) {
       small.dab({0.5 * s, 0}, Brush{BrushKind::Raise, 0.4, 0.01, 0, 1});
       small.endStroke();

@@ -95,6 +95,8 @@ class TestTerrainPanel : public QObject {
     const HeightGrid& edited = t->editor()->grid();
     QVERIFY(edited.heights != loaded.heights);
     QCOMPARE(w.session()->world()->terrain.grid.heights, edited.heights);
+    // One terrain: the dock edits the console's world's heights themselves, no copy.
+    QCOMPARE(&edited, &w.session()->world()->terrain.grid);
     const Vec2 at = gridPoint(w.session()->world()->terrain, {base.p.x, base.p.y});  // the sample under the robot
     const int i = static_cast<int>(std::lround((at.x + edited.width / 2) / edited.spacingX()) / 2 * 2);  // a drawn sample (every 2nd)
     const int j = static_cast<int>(std::lround((at.y + edited.depth / 2) / edited.spacingY()) / 2 * 2);

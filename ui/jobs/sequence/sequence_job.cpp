@@ -56,9 +56,10 @@ void SequenceJob::install(ConsoleContext& context) {
 
   connect(&context, &ConsoleContext::stateChanged, this,
           [this] { panel_->setLinkReady(context_->state().controlsRefusal().empty()); });
-  connect(&context, &ConsoleContext::worldChanged, this,
-          [this](const WorldModel& world) { panel_->setWorld(world, context_->session().params()); });
-  connect(&context, &ConsoleContext::terrainEdited, panel_, &SequencePanel::terrainEdited);
+  connect(&context, &ConsoleContext::worldChanged, this, [this](const WorldModel&, bool fresh) {
+    if (fresh) panel_->setWorld([this] { return context_->session().world(); }, context_->session().params());
+  });
+  connect(&context, &ConsoleContext::terrainEdited, panel_, [this] { panel_->terrainEdited(); });
   connect(&context, &ConsoleContext::rehearseFrom, this,
           [this](const RehearsalStart& start, const WorldModel& world, const SimParams& params, const QString& label) {
             panel_->pinStart(start, world, params, label);

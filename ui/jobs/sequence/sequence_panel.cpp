@@ -222,8 +222,8 @@ void SequencePanel::buildTemplateMenu(QToolButton* button) {
   button->setPopupMode(QToolButton::InstantPopup);
 }
 
-void SequencePanel::setWorld(const WorldModel& world, const SimParams& params) {
-  world_ = world;
+void SequencePanel::setWorld(std::function<const WorldModel*()> world, const SimParams& params) {
+  world_ = std::move(world);
   params_ = params;
   plan_.reset();
   result_.reset();
@@ -273,8 +273,8 @@ void SequencePanel::checkNow() {
   marked_.clear();
   errorList_->clear();
   QList<QTextEdit::ExtraSelection> marks;
-  if (world_ && !world_->robots.empty()) {
-    const RobotModel& robot = world_->robots[0].model;
+  if (const WorldModel* world = world_ ? world_() : nullptr; world && !world->robots.empty()) {
+    const RobotModel& robot = world->robots[0].model;
     const std::string text = editor_->toPlainText().toStdString();
     Diagnostics diag;
     const auto commands = parseCommandSequence(text, "sequence", diag, &robot);
@@ -307,8 +307,7 @@ bool SequencePanel::rehearsalCurrent() const {
   return result_ && rehearsedText_ == editor_->toPlainText() && !terrainEditedSince_;
 }
 
-void SequencePanel::terrainEdited(const TerrainPatchCmd& patch) {
-  if (world_ && patchFits(&world_->terrain.grid, patch).empty()) applyPatch(world_->terrain.grid, patch);
+void SequencePanel::terrainEdited() {
   if (result_ && !terrainEditedSince_) {
     terrainEditedSince_ = true;
     setStatus(tr("The terrain was edited since the rehearsal: rehearse again before sending."));
@@ -328,7 +327,7 @@ void SequencePanel::startWorker(std::function<void()> work) {
 bool SequencePanel::rehearse() {
   checkNow();
   if (busy_) return false;
-  const WorldModel* world = pinned_ ? &pinned_->world : world_ ? &*world_ : nullptr;
+  const WorldModel* world = pinned_ ? &pinned_->world : world_ ? world_() : nullptr;
   if (!world || world->robots.empty()) {
     setStatus(tr("No world with a robot to rehearse on."));
     return false;

@@ -65,9 +65,11 @@ class SequencePanel : public QWidget {
   /// Cancels and joins a rehearsal in progress.
   ~SequencePanel() override;
 
-  /// The world and parameters rehearsals run on (robots[0] is the robot);
-  /// re-checks the text. Drops the last rehearsal.
-  void setWorld(const WorldModel& world, const SimParams& params);
+  /// The world rehearsals run on, read when needed (robots[0] is the
+  /// robot; its terrain as edited: the console's one terrain, no copy kept
+  /// here), null without one; and the parameters. Re-checks the text.
+  /// Drops the last rehearsal.
+  void setWorld(std::function<const WorldModel*()> world, const SimParams& params);
   void setRules(const FlightRules& rules);
   const FlightRules& rules() const { return rules_; }
   /// Where a rehearsal starts: the robot's state now (nullopt = not known:
@@ -81,9 +83,10 @@ class SequencePanel : public QWidget {
   void unpinStart();
   /// "" while rehearsals start from the robot; else where they start.
   QString pinnedStart() const { return pinned_ ? pinned_->label : QString(); }
-  /// The terrain was edited: rehearsals run on the edited heights, and the
-  /// last rehearsal (on the old ones) cannot be sent until rehearsed again.
-  void terrainEdited(const TerrainPatchCmd& patch);
+  /// The terrain was edited: the next rehearsal runs on the edited heights
+  /// (the world's), and the last one (on the old heights) cannot be sent
+  /// until rehearsed again.
+  void terrainEdited();
   /// Whether a sequence may go to the robot now (connected, holding the
   /// lease, nothing latched).
   void setLinkReady(bool ready);
@@ -169,7 +172,7 @@ class SequencePanel : public QWidget {
   void updateButtons();
   void setStatus(const QString& text);
 
-  std::optional<WorldModel> world_;
+  std::function<const WorldModel*()> world_;  // the console's world (and terrain) now
   SimParams params_;
   FlightRules rules_;
   std::function<std::optional<RehearsalStart>()> startProvider_;

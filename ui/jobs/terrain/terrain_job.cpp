@@ -32,8 +32,8 @@ void TerrainJob::install(ConsoleContext& context) {
 
   // A new world is edited from its file's heights; the same world shown
   // again after a replay keeps the edits and their undo history.
-  connect(&context, &ConsoleContext::worldChanged, this, [this](const WorldModel& world, bool fresh) {
-    if (fresh) panel_->setWorld(world);
+  connect(&context, &ConsoleContext::worldChanged, this, [this](const WorldModel&, bool fresh) {
+    if (fresh) panel_->setTerrain(context_->session().world(), context_->session().terrainEditor());
   });
   connect(&context, &ConsoleContext::stateChanged, this, [this] {
     // While a replay is shown the view shows the log's ground: no editing the live terrain.
@@ -46,7 +46,7 @@ void TerrainJob::install(ConsoleContext& context) {
 
 void TerrainJob::apply(const TerrainPatchCmd& patch) {
   if (context_->state().replaying()) return;  // the view shows the log's world
-  if (!context_->session().terrainEdited(patch)) return;
+  if (!context_->session().terrainEdited(patch)) return;  // the editor put it in the console's terrain
   context_->scene().applyTerrainPatch(patch);
   emit context_->terrainEdited(patch);
   // The robot's twin, when it is a simulator that takes edits (WELCOME

@@ -136,13 +136,10 @@ TerrainPanel::TerrainPanel(QWidget* parent) : QWidget(parent) {
 
 TerrainPanel::~TerrainPanel() = default;
 
-void TerrainPanel::setWorld(const WorldModel& world) {
+void TerrainPanel::setTerrain(const WorldModel* world, TerrainEditor* editor) {
   world_ = world;
+  editor_ = world ? editor : nullptr;
   lastDab_.reset();
-  if (world.terrain.kind == TerrainSpec::Kind::Heightfield)
-    editor_ = std::make_unique<TerrainEditor>(world.terrain.grid);
-  else
-    editor_.reset();
   if (!editor_) setEditing(false);
   updateState();
 }

@@ -35,10 +35,12 @@ class TerrainPanel : public QWidget {
   ~TerrainPanel() override;
 
   /// The world whose terrain is edited (its file is the base of saved
-  /// worlds). A plane cannot be edited: the panel says so. Drops the undo levels.
-  void setWorld(const WorldModel& world);
+  /// worlds) and the console's editor of its heights (null on a plane,
+  /// which cannot be edited: the panel says so); both must outlive their
+  /// use here (the next setTerrain()). The panel keeps no heights of its own.
+  void setTerrain(const WorldModel* world, TerrainEditor* editor);
   bool editable() const { return editor_ != nullptr; }
-  const TerrainEditor* editor() const { return editor_.get(); }
+  const TerrainEditor* editor() const { return editor_; }
 
   void setBrush(const Brush& brush);
   Brush brush() const;
@@ -93,8 +95,8 @@ class TerrainPanel : public QWidget {
   /// asks to open the world written (or says why it failed).
   void writeAndOpen(const QString& title, const std::function<QString(const QString&, const QString&)>& write);
 
-  std::optional<WorldModel> world_;
-  std::unique_ptr<TerrainEditor> editor_;
+  const WorldModel* world_ = nullptr;
+  TerrainEditor* editor_ = nullptr;
   std::optional<Vec2> lastDab_;
   QPushButton* editButton_ = nullptr;
   QComboBox* kind_ = nullptr;
