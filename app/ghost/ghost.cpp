@@ -9,8 +9,10 @@
 #include <chrono>
 #include <cmath>
 
+#include "app/ghost/hold_policy.h"
 #include "sim/kinematics.h"
 #include "sim/readout.h"
+#include "sim/runner.h"
 
 namespace sp {
 
@@ -34,19 +36,7 @@ struct Ghost::TrailRequest {
 
 namespace {
 
-constexpr double kOffsetWindow = 2;   // [s] of arrivals the clock offset is the max over
-constexpr double kShownWindow = 20;   // [s] of robot time remembered for comparisons
-constexpr double kErrorWindow = 10;   // [s] of robot time the median is over
-constexpr double kMatchWindow = 0.1;  // [s] a shown state this close in time counts
 constexpr double kTrailPeriod = 0.25; // [s] between trails while nothing changes
-// Held joints (ghost.hold) are held only while the robot keeps them still:
-// within kStillBand of their newest position over the last kStillWindow of
-// telemetry (legs flex by up to 0.018 rad over the test track's bumps, and
-// their rates spike to 2 rad/s there, so rates cannot tell). A hold whose
-// weld is kReweld off the reported positions is welded anew.
-constexpr double kStillWindow = 1.0;  // [s] of robot time
-constexpr double kStillBand = 0.03;   // [rad] or [m]
-constexpr double kReweld = 0.05;      // [rad] or [m]
 
 // Seconds as the steady clock's duration (Ghost::now() counts from its epoch).
 std::chrono::steady_clock::duration steady(double seconds) {
@@ -59,12 +49,6 @@ std::chrono::steady_clock::duration steady(double seconds) {
 void yieldToOthers() { setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10); }
 // Names the calling thread (top -H, gdb): at most 15 characters.
 void nameThread(const char* name) { pthread_setname_np(pthread_self(), name); }
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 }  // namespace
 
@@ -157,25 +141,6 @@ std::unique_ptr<World> Ghost::buildWorld(const Twin& twin, std::string* error) c
   return world;
 }
 
-bool Ghost::movesHeld(const Command& command) const {
-  const RobotModel& robot = model_.robots[0].model;
-  const auto held = [&](const std::string& joint) {
-    return std::binary_search(held_.begin(), held_.end(), robot.findJoint(joint));
-  };
-  return std::visit(
-      [&](const auto& c) {
-        using T = std::decay_t<decltype(c)>;
-        if constexpr (std::is_same_v<T, JointVelocityCmd> || std::is_same_v<T, JointTargetCmd> ||
-                      std::is_same_v<T, JointTorqueCmd> || std::is_same_v<T, JointModeCmd>)
-          return held(c.joint);
-        else if constexpr (std::is_same_v<T, GaitCmd>)
-          return c.gait != Gait::Off;  // a gait walks the legs
-        else
-          return false;
-      },
-      command);
-}
-
 void Ghost::carryControl(const World& from, const Twin& fromTwin, World& to, const Twin& toTwin,
                          const std::vector<double>& positions) const {
   const RobotModel& a = fromTwin.world.robots[0].model;
@@ -215,59 +180,25 @@ std::vector<double> Ghost::fullPositions(const Twin& twin, const std::vector<dou
   return full;
 }
 
-double Ghost::ghostTimeLocked(double wall) const {
-  return haveClock_ ? wall + offset_ + roundTrip_ : newestTime_;
-}
-
 double Ghost::ghostTime(double wall) const {
   std::lock_guard lock(mutex_);
-  return ghostTimeLocked(wall);
+  return clock_.ghostTime(wall);
 }
 
 std::optional<GhostError> Ghost::anchor(const RobotFrame& frame, double roundTrip) {
-  const double wall = now();
   std::optional<GhostError> error;
   {
     std::lock_guard lock(mutex_);
-    if (frame_ && frame.time < newestTime_) {
+    if (clock_.frame(frame.time, now(), roundTrip)) {
       // The robot's clock went back (it was reset): what was shown and
       // sent belongs to the old run.
-      shown_.clear();
-      errors_.clear();
-      offsets_.clear();
+      record_.clear();
       commands_.clear();
       ++epoch_;
     }
-    offsets_.emplace_back(wall, frame.time - wall);
-    while (offsets_.front().first < wall - kOffsetWindow) offsets_.pop_front();
-    offset_ = offsets_.front().second;
-    for (const auto& [arrival, offset] : offsets_) offset_ = std::max(offset_, offset);
-    roundTrip_ = std::isfinite(roundTrip) && roundTrip > 0 ? roundTrip : 0;
-    haveClock_ = true;
-    newestTime_ = frame.time;
     // Commands long in effect are in the anchor world's set-points already.
-    while (!commands_.empty() && commands_.front().time < frame.time - kErrorWindow) commands_.pop_front();
-
-    // What was shown for this frame's time, interpolated between the two
-    // shown states around it.
-    const auto after = std::lower_bound(shown_.begin(), shown_.end(), frame.time,
-                                        [](const Shown& s, double t) { return s.time < t; });
-    if (after != shown_.end() && after != shown_.begin() && after->time - frame.time <= kMatchWindow &&
-        frame.time - std::prev(after)->time <= kMatchWindow) {
-      const Shown& a = *std::prev(after);
-      const Shown& b = *after;
-      const double u = b.time > a.time ? (frame.time - a.time) / (b.time - a.time) : 1;
-      GhostError e;
-      e.time = frame.time;
-      e.made = u < 0.5 ? a.made : b.made;
-      e.predicted = u < 0.5 ? a.base : b.base;
-      e.predicted.p = a.base.p + u * (b.base.p - a.base.p);
-      e.position = std::hypot(e.predicted.p.x - frame.base.p.x, e.predicted.p.y - frame.base.p.y);
-      e.heading = std::abs(std::remainder(heading(e.predicted.q) - heading(frame.base.q), 2 * kPi));
-      errors_.push_back(e);
-      while (errors_.front().time < frame.time - kErrorWindow) errors_.pop_front();
-      error = e;
-    }
+    commands_.forgetBefore(frame.time - PredictionRecord::kErrorWindow);
+    error = record_.compare(frame);
     frame_ = frame;
     ++frameVersion_;
   }
@@ -278,7 +209,7 @@ std::optional<GhostError> Ghost::anchor(const RobotFrame& frame, double roundTri
 void Ghost::commandSent(const Command& command) {
   {
     std::lock_guard lock(mutex_);
-    commands_.push_back({nextSeq_++, ghostTimeLocked(now()), command});
+    commands_.add(command, clock_.ghostTime(now()));
   }
   presentWake_.notify_one();
 }
@@ -290,7 +221,7 @@ GhostView Ghost::view() const {
 
 uint64_t Ghost::commandsSent() const {
   std::lock_guard lock(mutex_);
-  return nextSeq_;
+  return commands_.sent();
 }
 
 int64_t Ghost::viewVersion() const {
@@ -299,28 +230,13 @@ int64_t Ghost::viewVersion() const {
 }
 
 std::optional<std::pair<double, double>> Ghost::errorMedian() const {
-  std::vector<double> position, heading;
-  {
-    std::lock_guard lock(mutex_);
-    if (errors_.empty()) return std::nullopt;
-    for (const GhostError& e : errors_) {
-      position.push_back(e.position);
-      heading.push_back(e.heading);
-    }
-  }
-  return std::pair{median(std::move(position)), median(std::move(heading))};
+  std::lock_guard lock(mutex_);
+  return record_.median();
 }
 
 GhostStats Ghost::stats() const {
   std::lock_guard lock(mutex_);
   return stats_;
-}
-
-std::vector<Ghost::SentCommand> Ghost::commandsFrom(uint64_t from) const {
-  std::vector<SentCommand> out;
-  for (const SentCommand& c : commands_)
-    if (c.seq >= from) out.push_back(c);
-  return out;
 }
 
 void Ghost::setProblem(const std::string& problem) {
@@ -331,17 +247,29 @@ void Ghost::setProblem(const std::string& problem) {
 
 bool Ghost::advance(World& world, double& t, double target, const std::vector<SentCommand>& commands, size_t& next,
                     const std::function<bool()>& abort) const {
+  // Robot time t is the world's step boundary `start`; a command acts from
+  // the first boundary at or after its arrival, as on the robot.
   const double h = world.params().step;
-  int steps = 0;
-  while (t + 0.5 * h <= target) {
-    // A command acts from the first step boundary at or after its arrival,
-    // as on the robot.
-    while (next < commands.size() && commands[next].time <= t + 1e-9) world.submit(commands[next++].command);
-    if (!world.step()) return false;
-    t += h;
-    if (abort && ++steps % 64 == 0 && abort()) return false;
+  const int64_t start = world.stepCount();
+  const auto steps = static_cast<int64_t>(std::floor((target - t) / h + 0.5));
+  if (steps <= 0) return true;
+  Runner runner(world);
+  // In the order sent: one that falls due earlier than the one before it
+  // (the clock estimate moved) waits for it, as it would on the robot.
+  int64_t due = 0;
+  for (size_t i = next; i < commands.size(); ++i) {
+    due = std::max(due, static_cast<int64_t>(std::ceil((commands[i].time - t - 1e-9) / h)));
+    if (due >= steps) break;  // after this advance
+    runner.schedule(ScheduledCommand{commands[i].command, 0, start + due});
   }
-  return true;
+  size_t submitted = 0;
+  runner.setSubmitHook([&](const ScheduledCommand&, const std::string&) { ++submitted; });
+  int64_t taken = 0;
+  if (abort) runner.setMonitor([&](const World&) { return ++taken % 64 != 0 || !abort(); });
+  const RunOutcome out = runner.advanceBy(steps);
+  t += static_cast<double>(out.steps) * h;
+  next += submitted;
+  return out.stop == RunOutcome::Stop::Reached;
 }
 
 void Ghost::anchorLoop() {
@@ -351,8 +279,7 @@ void Ghost::anchorLoop() {
   std::unique_ptr<World> world;
   Snapshot anchored;  // the last anchored state, commands in effect included
   uint64_t seen = 0, applied = 0, epoch = 0;
-  bool gaitOn = false;  // a gait is in effect
-  std::deque<std::pair<double, std::vector<double>>> recent;  // (robot time, joint positions), last kStillWindow
+  HoldPolicy policy(held_, model_.robots[0].model);
   double lastStart = -1e9;
   for (;;) {
     RobotFrame frame;
@@ -371,12 +298,11 @@ void Ghost::anchorLoop() {
       if (epoch != epoch_) {  // the robot restarted: weld and build anew
         epoch = epoch_;
         world.reset();
-        recent.clear();
-        gaitOn = false;
-        applied = nextSeq_;
+        policy.reset();
+        applied = commands_.sent();
       }
-      for (SentCommand& c : commandsFrom(applied)) (c.time <= frame.time ? effective : pending).push_back(std::move(c));
-      target = options_.runAhead ? ghostTimeLocked(now()) : frame.time;
+      for (SentCommand& c : commands_.from(applied)) (c.time <= frame.time ? effective : pending).push_back(std::move(c));
+      target = options_.runAhead ? clock_.ghostTime(now()) : frame.time;
     }
     lastStart = now();
     const size_t joints = model_.robots[0].model.joints.size();
@@ -388,30 +314,10 @@ void Ghost::anchorLoop() {
       continue;
     }
     const bool latched = frame.estop || frame.failsafe;
-    // Hold the ghost.hold joints only while the robot keeps them still and
-    // nothing sent moves them (a gait, a joint command in flight).
-    for (const SentCommand& c : effective)
-      if (std::holds_alternative<GaitCmd>(c.command)) gaitOn = std::get<GaitCmd>(c.command).gait != Gait::Off;
-      else if (std::holds_alternative<DriveCmd>(c.command) || std::holds_alternative<TurnCmd>(c.command) ||
-               std::holds_alternative<WheelsCmd>(c.command) || std::holds_alternative<StopCmd>(c.command))
-        gaitOn = false;
-    if (latched) gaitOn = false;
-    while (!recent.empty() && recent.front().first < frame.time - kStillWindow) recent.pop_front();
-    recent.emplace_back(frame.time, frame.jointPositions);
-    // Holding starts after a still window (or on the first frame); it goes on while they stay still.
-    bool still = !world || twin->rigid || frame.time - recent.front().first >= kStillWindow - 0.05;
-    for (const auto& [time, q] : recent)
-      for (int j : held_)
-        still = still && std::abs(q[static_cast<size_t>(j)] - frame.jointPositions[static_cast<size_t>(j)]) <= kStillBand;
-    bool hold = !held_.empty() && still && !gaitOn;
-    for (const SentCommand& c : pending) hold = hold && (latched || !movesHeld(c.command));
-    for (const SentCommand& c : effective) hold = hold && (latched || !movesHeld(c.command));
-    bool rebuild = !world || hold != twin->rigid.has_value();
-    if (!rebuild && twin->rigid)
-      for (int j : held_)
-        rebuild = rebuild || std::abs(twin->rigid->heldPositions[static_cast<size_t>(j)] -
-                                      frame.jointPositions[static_cast<size_t>(j)]) > kReweld;
-    if (rebuild) {
+    const HoldDecision decision =
+        policy.decide(frame, effective, pending, world && twin->rigid ? &*twin->rigid : nullptr, world != nullptr);
+    const bool hold = decision.hold;
+    if (decision.rebuild) {
       std::string error;
       std::shared_ptr<const Twin> next = makeTwin(frame.jointPositions, hold, error);
       std::unique_ptr<World> built = next ? buildWorld(*next, &error) : nullptr;
@@ -502,7 +408,7 @@ void Ghost::presentLoop() {
     {
       std::unique_lock lock(mutex_);
       presentWake_.wait_for(lock, period,
-                            [&] { return stop_ || baseVersion_ != seenBase || nextSeq_ != seenCommands; });
+                            [&] { return stop_ || baseVersion_ != seenBase || commands_.sent() != seenCommands; });
       if (stop_) return;
       if (baseVersion_ != seenBase) {
         seenBase = baseVersion_;
@@ -510,11 +416,11 @@ void Ghost::presentLoop() {
         newBase = true;
         next = base->nextSeq;
       }
-      newCommands = nextSeq_ != seenCommands;
-      seenCommands = nextSeq_;
+      newCommands = commands_.sent() != seenCommands;
+      seenCommands = commands_.sent();
       if (!base) continue;
-      if (!base->latched && options_.inFlight) commands = commandsFrom(next);
-      target = options_.runAhead ? ghostTimeLocked(now()) : newestTime_;
+      if (!base->latched && options_.inFlight) commands = commands_.from(next);
+      target = options_.runAhead ? clock_.ghostTime(now()) : clock_.newest();
     }
     if (newBase && base->twin != twin) {
       twin = base->twin;
@@ -548,16 +454,14 @@ void Ghost::presentLoop() {
       GhostView& v = view_;
       ++v.version;
       v.time = t;
-      v.span = t - newestTime_;
+      v.span = t - clock_.newest();
       v.base = r.base;
       v.jointPositions = fullPositions(*twin, r.jointPositions, frame_ ? &frame_->jointPositions : nullptr);
       v.objects = r.objects;
       v.problem.clear();
       v.commands = next;
       ++stats_.views;
-      while (!shown_.empty() && shown_.back().time >= t) shown_.pop_back();  // superseded
-      shown_.push_back({t, base->made, r.base});
-      while (shown_.front().time < t - kShownWindow) shown_.pop_front();
+      record_.shown(t, base->made, r.base);
       if (trail) {
         trailRequest_ = trail;
         ++trailVersion_;
@@ -582,7 +486,7 @@ void Ghost::trailLoop() {
       if (stop_) return;
       seen = trailVersion_;
       request = trailRequest_;
-      if (!request->latched && options_.inFlight) commands = commandsFrom(request->nextSeq);
+      if (!request->latched && options_.inFlight) commands = commands_.from(request->nextSeq);
     }
     const double start = now();
     if (request->twin != twin) {

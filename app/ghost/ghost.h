@@ -13,6 +13,11 @@
 // time s is taken to arrive at robot time ghost(s). The robot is assumed to
 // run at real time.
 //
+// The pieces, each tested on its own: the clock estimate (ghost_clock.h),
+// the commands in flight (in_flight.h), when to hold joints rigid
+// (hold_policy.h) and what was shown against what came (prediction_record.h);
+// every World steps through sim::Runner.
+//
 // Three threads, each owning one World built from the same model with the
 // ghost's profile (ghost.step, ghost.iterations; sensors off). The
 // ghost.hold joints (the upper body, the legs' hips and knees; the wheels
@@ -64,6 +69,9 @@
 #include <vector>
 
 #include "app/console/robot_frame.h"
+#include "app/ghost/ghost_clock.h"
+#include "app/ghost/in_flight.h"
+#include "app/ghost/prediction_record.h"
 #include "sim/command.h"
 #include "sim/params.h"
 #include "sim/rigid.h"
@@ -86,14 +94,6 @@ struct GhostView {
   uint64_t commands = 0;     ///< of the commands sent (commandsSent()), how many this state has had
 };
 
-/// A telemetry frame against what the ghost had shown for its time.
-struct GhostError {
-  double time = 0;      ///< [s] robot time of the frame
-  double made = 0;      ///< [s] robot time of the telemetry the prediction ran from
-  Pose predicted;       ///< the ghost's base then
-  double position = 0;  ///< [m] horizontal distance to the frame's base
-  double heading = 0;   ///< [rad] absolute yaw difference
-};
 
 /// Counters, for the status bar and benchmarks.
 struct GhostStats {
@@ -149,11 +149,6 @@ class Ghost {
   static double now();
 
  private:
-  struct SentCommand {
-    uint64_t seq = 0;
-    double time = 0;  // robot time it takes effect
-    Command command;
-  };
   struct Base;  // a published anchored state
   struct TrailRequest;
   /// What the ghost's worlds are built from: the world with its robot's
@@ -170,8 +165,6 @@ class Ghost {
   /// The twin welded at `positions` (the full robot's joints), or the full
   /// robot when not `hold`. Null and `error` when the hold cannot be made.
   std::shared_ptr<const Twin> makeTwin(const std::vector<double>& positions, bool hold, std::string& error) const;
-  /// Whether `command` moves a ghost.hold joint (a gait moves the legs).
-  bool movesHeld(const Command& command) const;
   /// Gives `to` (just built) the controller set-points of `from` (the twin
   /// it replaces), actuator by name; a joint `from` held holds where
   /// `positions` (the full robot's) has it.
@@ -185,13 +178,12 @@ class Ghost {
   void anchorLoop();
   void presentLoop();
   void trailLoop();
-  /// Steps `world` from robot time `t` to `target`, submitting the commands
-  /// from `next` on as their times come. False if the world diverged.
+  /// Steps `world` (through sim::Runner) from robot time `t` to `target`,
+  /// submitting commands[next...] at the first step boundary at or after
+  /// their times, as the robot does; `abort` is asked every 64 steps.
+  /// False if the world diverged or was aborted.
   bool advance(World& world, double& t, double target, const std::vector<SentCommand>& commands, size_t& next,
                const std::function<bool()>& abort = {}) const;
-  /// The commands sent with seq >= `from`. Caller holds mutex_.
-  std::vector<SentCommand> commandsFrom(uint64_t from) const;
-  double ghostTimeLocked(double wall) const;
   void setProblem(const std::string& problem);
 
   WorldModel model_;  // the full world
@@ -204,24 +196,15 @@ class Ghost {
   bool stop_ = false;
   std::optional<RobotFrame> frame_;  // newest telemetry
   uint64_t frameVersion_ = 0;
-  double newestTime_ = 0;            // its robot time
-  std::deque<std::pair<double, double>> offsets_;  // (arrival, T - arrival), last 2 s
-  double offset_ = 0, roundTrip_ = 0;
-  bool haveClock_ = false;
-  std::deque<SentCommand> commands_;  // sent, oldest first; the last 10 s of robot time
+  GhostClock clock_;
+  InFlightCommands commands_;  // the last 10 s of robot time
   uint64_t epoch_ = 0;  // counts robot resets (its clock went back)
-  uint64_t nextSeq_ = 0;
   std::shared_ptr<const Base> base_;
   uint64_t baseVersion_ = 0;
   std::shared_ptr<const TrailRequest> trailRequest_;
   uint64_t trailVersion_ = 0;
   GhostView view_;
-  struct Shown {
-    double time, made;  // robot time shown; of the telemetry it ran from
-    Pose base;
-  };
-  std::deque<Shown> shown_;  // what the present thread showed, last 20 s of robot time
-  std::deque<GhostError> errors_;  // last 10 s of robot time
+  PredictionRecord record_;  // what was shown against what came
   GhostStats stats_;
 
   std::thread anchorThread_, presentThread_, trailThread_;

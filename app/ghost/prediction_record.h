@@ -1,0 +1,54 @@
+#pragma once
+// What the ghost showed for which robot time, and each telemetry frame
+// against it: the ghost's prediction error (horizontal distance and yaw
+// difference), and its median over the last kErrorWindow of robot time.
+//
+// Thread: a plain value; its owner guards it (the Ghost's mutex).
+
+#include <deque>
+#include <optional>
+#include <utility>
+
+#include "app/console/robot_frame.h"
+#include "sim/math.h"
+
+namespace sp {
+
+/// A telemetry frame against what the ghost had shown for its time.
+struct GhostError {
+  double time = 0;      ///< [s] robot time of the frame
+  double made = 0;      ///< [s] robot time of the telemetry the prediction ran from
+  Pose predicted;       ///< the ghost's base then
+  double position = 0;  ///< [m] horizontal distance to the frame's base
+  double heading = 0;   ///< [rad] absolute yaw difference
+};
+
+class PredictionRecord {
+ public:
+  static constexpr double kShownWindow = 20;   ///< [s] of robot time remembered for comparisons
+  static constexpr double kErrorWindow = 10;   ///< [s] of robot time the median is over
+  static constexpr double kMatchWindow = 0.1;  ///< [s] a shown state this close in time counts
+
+  /// The ghost showed `base` for robot time `time`, predicted from the
+  /// telemetry of robot time `made`. A later prediction for the same or an
+  /// earlier time supersedes what was shown from then on.
+  void shown(double time, double made, const Pose& base);
+  /// `frame` against what was shown for its time (interpolated between the
+  /// two shown states around it), recorded; nullopt when nothing was shown
+  /// within kMatchWindow of it.
+  std::optional<GhostError> compare(const RobotFrame& frame);
+  /// Median position and heading errors over the last kErrorWindow; nullopt before the first.
+  std::optional<std::pair<double, double>> median() const;
+  /// Forgets everything (the robot was reset).
+  void clear();
+
+ private:
+  struct Shown {
+    double time, made;  // robot time shown; of the telemetry it ran from
+    Pose base;
+  };
+  std::deque<Shown> shown_;
+  std::deque<GhostError> errors_;
+};
+
+}  // namespace sp
