@@ -27,8 +27,8 @@ int BackgroundJobs::run(QObject* owner, const QString& what, Work work) {
         [this, id, cancel, guard, done = std::move(done)] {
           reap(id);
           const bool cancelled = cancel->load();
-          if (!cancelled && guard && done) done();
           emit finished(id, cancelled);
+          if (!cancelled && guard && done) done();
         },
         Qt::QueuedConnection);
   });

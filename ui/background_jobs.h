@@ -51,7 +51,8 @@ class BackgroundJobs : public QObject {
  signals:
   /// Job `id` reports `fraction` (0..1) done.
   void progressed(int id, double fraction);
-  /// Job `id` ended; `cancelled` when it was asked to stop (its result was dropped).
+  /// Job `id` ended; `cancelled` when it was asked to stop (its result is
+  /// dropped). Emitted just before its result runs.
   void finished(int id, bool cancelled);
 
  private:

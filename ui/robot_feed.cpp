@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "app/console/console_session.h"
+#include "app/console/robot_shapes.h"
 #include "ui/jobs/replay/replay_panel.h"
 #include "ui/robot_connection.h"
 
@@ -95,11 +96,7 @@ void GhostFeed::poll() {
   const GhostView v = ghost->view();
   version_ = v.version;
   if (v.version == 0) return;  // nothing predicted yet: the ghost stays where it is
-  RobotFrame f;
-  f.time = v.time;
-  f.base = v.base;
-  f.jointPositions = v.jointPositions;
-  emit frame(f);
+  emit frame(frameFromGhost(v));
   if (v.trailTime != trailTime_) {
     trailTime_ = v.trailTime;
     emit trail(v.trail);

@@ -1,5 +1,6 @@
 #include "app/console/console_session.h"
 
+#include "app/console/robot_shapes.h"
 #include "app/console/terrain_editor.h"
 
 #include <cmath>
@@ -206,24 +207,8 @@ std::string ConsoleSession::logError() const {
 }
 
 RobotFrame ConsoleSession::telemetry(const net::TelemetryMsg& t, double wall, double roundTrip) {
-  RobotFrame f;
-  f.time = t.time;
-  f.base = t.pose;
-  if (t.baseVelocity.size() == 6) {
-    f.hasBaseVelocity = true;
-    f.baseLinearVelocity = {t.baseVelocity[0], t.baseVelocity[1], t.baseVelocity[2]};
-    f.baseAngularVelocity = {t.baseVelocity[3], t.baseVelocity[4], t.baseVelocity[5]};
-  }
-  f.wheelNormal = t.wheelNormal;
-  f.roll = t.roll;
-  f.pitch = t.pitch;
-  f.health = t.health;
-  f.failsafe = t.failsafe;
-  f.estop = t.estop;
-  for (const net::ObjectPose& o : t.objects) f.objects.push_back({o.name, o.pose});
+  RobotFrame f = frameFromTelemetry(t, robot(), positions_, rates_);
   if (const RobotModel* model = robot()) {
-    f.jointPositions = positions_.toModelOrder(t.jointNames, t.jointPositions, *model);
-    f.jointRates = rates_.toModelOrder(t.jointNames, t.jointVelocities, *model);
     if (recorder_) recorder_->telemetry(t, *model);
     if (ghost_) {
       lastPrediction_ = ghost_->anchor(f, roundTrip > 0 ? roundTrip : t.rttMs / 1000);

@@ -1,5 +1,7 @@
 #include "app/log/log_player.h"
 
+#include "app/console/robot_shapes.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -42,20 +44,7 @@ std::unique_ptr<LogPlayer> LogPlayer::open(const std::string& path, std::string&
 std::optional<RobotFrame> LogPlayer::frameAt(double time) const {
   std::optional<LogSample> s = reader_->sampleAt(std::max(time, start_));
   if (!s) return std::nullopt;
-  const RobotModel& robot = logged_.world.robots[0].model;
-  const size_t n = robot.joints.size();
-  RobotFrame f;
-  f.time = s->time;
-  f.base = Pose{{s->base[0], s->base[1], s->base[2]}, {s->quat[0], s->quat[1], s->quat[2], s->quat[3]}};
-  // positions then rates; a log of another robot (fewer values) reads 0 beyond.
-  f.jointPositions.assign(n, 0.0);
-  f.jointRates.assign(n, 0.0);
-  for (size_t j = 0; j < n && j < s->joints.size(); ++j) f.jointPositions[j] = s->joints[j];
-  for (size_t j = 0; j < n && n + j < s->joints.size(); ++j) f.jointRates[j] = s->joints[n + j];
-  f.wheelNormal = s->wheelNormal;
-  f.roll = s->roll;
-  f.pitch = s->pitch;
-  return f;
+  return frameFromSample(*s, logged_.world.robots[0].model.joints.size());
 }
 
 std::optional<LaserFrame> LogPlayer::laserAt(double time) const {

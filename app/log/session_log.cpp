@@ -1,5 +1,7 @@
 #include "app/log/session_log.h"
 
+#include "app/console/robot_shapes.h"
+
 #include <sqlite3.h>
 
 #include <chrono>
@@ -123,22 +125,7 @@ bool execSql(sqlite3* db, const std::string& sql, std::string& error) {
 
 }  // namespace
 
-LogSample makeLogSample(const World& world, int robot) { return toLogSample(readRobot(world, robot)); }
-
-LogSample toLogSample(const RobotReadout& r) {
-  LogSample s;
-  s.step = r.step;
-  s.time = r.time;
-  s.base = {r.base.p.x, r.base.p.y, r.base.p.z};
-  s.quat = {r.base.q.w, r.base.q.x, r.base.q.y, r.base.q.z};
-  s.joints.reserve(r.jointPositions.size() + r.jointRates.size());
-  s.joints.insert(s.joints.end(), r.jointPositions.begin(), r.jointPositions.end());
-  s.joints.insert(s.joints.end(), r.jointRates.begin(), r.jointRates.end());
-  s.wheelNormal = r.wheelNormal;
-  s.roll = r.roll;
-  s.pitch = r.pitch;
-  return s;
-}
+LogSample makeLogSample(const World& world, int robot) { return sampleFromReadout(readRobot(world, robot)); }
 
 std::optional<LogLaser> makeLogLaser(const SensorSample& sample) {
   const auto* l = std::get_if<LaserReading>(&sample.value);

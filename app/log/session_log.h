@@ -110,8 +110,8 @@ struct LogEvent {
 
 /// A read-out as logged: the base pose, every joint's position then rate,
 /// the wheel normal forces, roll and pitch (sim/readout.h).
-LogSample toLogSample(const RobotReadout& readout);
-/// toLogSample(readRobot(world, robot)). Thread: the World's.
+/// The row of readRobot(world, robot) (app/console/robot_shapes.h:
+/// sampleFromReadout). Thread: the World's.
 LogSample makeLogSample(const World& world, int robot = 0);
 
 /// A laser reading as logged; nullopt if `sample` is not a laser scan.

@@ -1,5 +1,7 @@
 #include "app/log/telemetry_recorder.h"
 
+#include "app/console/robot_shapes.h"
+
 #include <cmath>
 
 #include "app/log/session_recorder.h"
@@ -28,18 +30,7 @@ int64_t TelemetryRecorder::rowKey() const { return std::llround(time_ * 1000); }
 
 void TelemetryRecorder::telemetry(const net::TelemetryMsg& t, const RobotModel& robot) {
   time_ = t.time;
-  LogSample s;
-  s.step = rowKey();
-  s.time = t.time;
-  s.base = {t.pose.p.x, t.pose.p.y, t.pose.p.z};
-  s.quat = {t.pose.q.w, t.pose.q.x, t.pose.q.y, t.pose.q.z};
-  // Positions, then velocities, in the model's order, as the twin logs them.
-  s.joints = joints_.toModelOrder(t.jointNames, t.jointPositions, robot);
-  const std::vector<double> rates = joints_.toModelOrder(t.jointNames, t.jointVelocities, robot);
-  s.joints.insert(s.joints.end(), rates.begin(), rates.end());
-  s.wheelNormal = t.wheelNormal;
-  s.roll = t.roll;
-  s.pitch = t.pitch;
+  LogSample s = sampleFromTelemetry(t, rowKey(), robot, joints_, joints_);
   writer_->logSample(std::move(s));
 }
 

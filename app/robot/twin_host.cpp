@@ -1,5 +1,7 @@
 #include "app/robot/twin_host.h"
 
+#include "app/console/robot_shapes.h"
+
 #include <chrono>
 
 #include "sim/command_check.h"
@@ -177,20 +179,7 @@ void TwinHost::publish() {
   // Built outside the lock; the lock only swaps values in.
   const World& w = *world_;
   const RobotReadout r = readRobot(w, 0);
-  net::RobotState s;
-  s.time = r.time;
-  s.pose = r.base;
-  s.baseLinearVelocity = r.baseLinearVelocity;
-  s.baseAngularVelocity = r.baseAngularVelocity;
-  s.jointNames = jointNames_;
-  s.jointPositions = r.jointPositions;
-  s.jointVelocities = r.jointRates;
-  s.wheelNormal = r.wheelNormal;
-  s.wheelTangential = r.wheelTangential;
-  s.roll = r.roll;
-  s.pitch = r.pitch;
-  s.health = r.health;
-  for (const ObjectReadout& o : r.objects) s.objects.push_back({o.name, o.pose});
+  net::RobotState s = stateFromReadout(r, jointNames_);
   int laser = -1;
   for (size_t i = 0; i < model_.sensors.size() && laser < 0; ++i)
     if (model_.sensors[i].type == SensorType::Laser) laser = static_cast<int>(i);

@@ -18,6 +18,7 @@ namespace sp {
 void ReplayJob::install(ConsoleContext& context) {
   context_ = &context;
   panel_ = new ReplayPanel;
+  panel_->setBackground(&context.background());
   feed_ = new ReplayFeed(panel_, this);
   dock_ = context.host().addDock(tr("Replay"), QStringLiteral("replayDock"), panel_, DockPlace::Bottom, true);
   dock_->hide();  // until a log is opened

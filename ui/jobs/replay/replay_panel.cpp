@@ -1,5 +1,7 @@
 #include "ui/jobs/replay/replay_panel.h"
 
+#include "ui/background_jobs.h"
+
 #include <QBoxLayout>
 #include <QComboBox>
 #include <QFile>
@@ -72,6 +74,7 @@ class ReplayPanel::Marks : public QWidget {
 };
 
 ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
+  setBackground(new BackgroundJobs(this));  // until given the console's
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(4, 4, 4, 4);
   title_ = new QLabel(tr("No log open: File ▸ Open session log…"), this);
@@ -191,8 +194,21 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
 }
 
 ReplayPanel::~ReplayPanel() {
-  cancel_ = true;
-  if (worker_.joinable()) worker_.join();
+  if (job_) jobs_->cancel(job_);  // its result goes nowhere now
+}
+
+void ReplayPanel::setBackground(BackgroundJobs* jobs) {
+  if (job_ || !jobs || jobs == jobs_) return;
+  if (jobs_) disconnect(jobs_, nullptr, this, nullptr);
+  jobs_ = jobs;
+  connect(jobs_, &BackgroundJobs::progressed, this, [this](int id, double f) {
+    if (id == job_) progressBar_->setValue(static_cast<int>(f * 1000));
+  });
+  connect(jobs_, &BackgroundJobs::finished, this, [this](int id, bool cancelled) {
+    if (id != job_) return;
+    finishBackground();
+    if (cancelled) emit failed(tr("Cancelled."));
+  });
 }
 
 QString ReplayPanel::open(const QString& path) {
@@ -266,48 +282,30 @@ void ReplayPanel::adopt(std::unique_ptr<LogPlayer> player, const QString& path,
 
 bool ReplayPanel::runInBackground(
     const QString& what, std::function<std::function<void()>(const std::function<bool(double)>& progress)> work) {
-  if (busy_) {
+  if (job_) {
     emit failed(tr("%1: wait for \"%2\" to end, or cancel it").arg(what, progressLabel_->text()));
     return false;
   }
-  if (worker_.joinable()) worker_.join();  // the last one has ended
-  busy_ = true;
-  cancel_ = false;
   progressLabel_->setText(what + QStringLiteral("…"));
   progressBar_->setValue(0);
   progressRow_->show();
   setEnabled(true);  // for Cancel; every control checks for a player
-  worker_ = std::thread([this, work = std::move(work)] {
-    std::function<void()> done = work([this](double f) {
-      QMetaObject::invokeMethod(this, [this, f] { progressBar_->setValue(static_cast<int>(f * 1000)); },
-                                Qt::QueuedConnection);
-      return !cancel_.load();
-    });
-    QMetaObject::invokeMethod(
-        this,
-        [this, done = std::move(done)] {
-          finishBackground();
-          if (cancel_.load()) {
-            emit failed(tr("Cancelled."));
-            return;
-          }
-          if (done) done();
-        },
-        Qt::QueuedConnection);
-  });
+  job_ = jobs_->run(this, what, std::move(work));
   return true;
 }
 
 void ReplayPanel::finishBackground() {
-  busy_ = false;
+  job_ = 0;
   progressRow_->hide();
   progressLabel_->clear();
   setEnabled(player_ != nullptr);
 }
 
-void ReplayPanel::cancel() { cancel_ = true; }
+void ReplayPanel::cancel() {
+  if (job_) jobs_->cancel(job_);
+}
 
-QString ReplayPanel::progressText() const { return busy_ ? progressLabel_->text() : QString(); }
+QString ReplayPanel::progressText() const { return job_ ? progressLabel_->text() : QString(); }
 
 void ReplayPanel::branchHere() {
   if (!player_) return;

@@ -11,8 +11,9 @@
 // snapshot before the cursor), "Verify" (re-simulating the whole log
 // against its hashes).
 //
-// Thread: GUI thread; one worker at a time, cancelled and joined by the
-// destructor. The worker never touches the open player: it opens its own.
+// Thread: GUI thread; one task at a time on a BackgroundJobs runner (the
+// console's, ui/background_jobs.h), its result dropped if the panel is gone
+// first. The task never touches the open player: it opens its own.
 
 #include <QElapsedTimer>
 #include <QList>
@@ -20,10 +21,8 @@
 #include <QString>
 #include <QWidget>
 
-#include <atomic>
 #include <functional>
 #include <memory>
-#include <thread>
 
 #include "app/log/log_player.h"
 
@@ -38,6 +37,8 @@ QT_FORWARD_DECLARE_CLASS(QChartView)
 QT_FORWARD_DECLARE_CLASS(QLineSeries)
 
 namespace sp {
+
+class BackgroundJobs;
 
 class ReplayPanel : public QWidget {
   Q_OBJECT
@@ -62,7 +63,10 @@ class ReplayPanel : public QWidget {
   /// logged hash; the verdict is shown and `verified` emitted.
   void verify();
   /// A worker task is running (opening, branching, verifying).
-  bool busy() const { return busy_; }
+  bool busy() const { return job_ != 0; }
+  /// Runs its long tasks on `jobs` (the console's runner; it must outlive
+  /// the panel) instead of a runner of its own. Not while one runs.
+  void setBackground(BackgroundJobs* jobs);
   /// Stops the worker's task (its result is dropped).
   void cancel();
   /// What the progress row says ("" when idle), and the last task's verdict.
@@ -137,9 +141,8 @@ class ReplayPanel : public QWidget {
                        std::function<std::function<void()>(const std::function<bool(double)>& progress)> work);
   void finishBackground();
 
-  std::thread worker_;
-  std::atomic<bool> cancel_{false};
-  bool busy_ = false;
+  BackgroundJobs* jobs_ = nullptr;  // the console's runner, or the panel's own
+  int job_ = 0;                     // the task running, 0 = none
   size_t terrainShown_ = 0;  // terrain edits drawn (those up to the cursor)
   QString lastResult_;
   QWidget* progressRow_ = nullptr;

@@ -15,6 +15,7 @@ namespace sp {
 void SequenceJob::install(ConsoleContext& context) {
   context_ = &context;
   panel_ = new SequencePanel;
+  panel_->setBackground(&context.background());
   dock_ = context.host().addDock(tr("Sequence"), QStringLiteral("sequenceDock"), panel_, DockPlace::Side, true);
 
   // Rehearsals start from the live robot's newest telemetry.

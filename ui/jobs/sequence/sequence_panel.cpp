@@ -55,6 +55,7 @@ QString seconds(double t) { return QString::number(t, 'f', 2) + " s"; }
 }  // namespace
 
 SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
+  setBackground(new BackgroundJobs(this));  // until given the console's
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(4, 4, 4, 4);
 
@@ -135,7 +136,10 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
     if (!folder.isEmpty())
       robustnessOnCluster(folder + "/robustness-" + QDateTime::currentDateTime().toString("yyyyMMdd-hhmmss"));
   });
-  connect(cancelButton_, &QPushButton::clicked, this, [this] { cancel_ = true; });
+  // Cancel stops the task; what it did so far is shown (a rehearsal's
+  // samples up to there), so the panel keeps its own flag rather than the
+  // runner's, which would drop the result.
+  connect(cancelButton_, &QPushButton::clicked, this, [this] { *cancel_ = true; });
 
   verdicts_ = new QTreeWidget(this);
   verdicts_->setColumnCount(2);
@@ -195,8 +199,16 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
 }
 
 SequencePanel::~SequencePanel() {
-  cancel_ = true;
-  if (worker_.joinable()) worker_.join();
+  *cancel_ = true;  // a task still running stops; its result goes nowhere
+}
+
+void SequencePanel::setBackground(BackgroundJobs* jobs) {
+  if (busy_ || !jobs || jobs == jobs_) return;
+  if (jobs_) disconnect(jobs_, nullptr, this, nullptr);
+  jobs_ = jobs;
+  connect(jobs_, &BackgroundJobs::progressed, this, [this](int id, double f) {
+    if (id == job_) progress_->setValue(static_cast<int>(f * 1000));
+  });
 }
 
 void SequencePanel::buildTemplateMenu(QToolButton* button) {
@@ -315,13 +327,16 @@ void SequencePanel::terrainEdited() {
   }
 }
 
-void SequencePanel::startWorker(std::function<void()> work) {
-  if (worker_.joinable()) worker_.join();  // the last one has ended (busy_ is false)
+std::shared_ptr<std::atomic<bool>> SequencePanel::freshCancel() {
+  cancel_ = std::make_shared<std::atomic<bool>>(false);
+  return cancel_;
+}
+
+void SequencePanel::runTask(const QString& what, BackgroundJobs::Work work) {
   busy_ = true;
-  cancel_ = false;
   progress_->setValue(0);
   updateButtons();
-  worker_ = std::thread(std::move(work));
+  job_ = jobs_->run(this, what, std::move(work));
 }
 
 bool SequencePanel::rehearse() {
@@ -352,21 +367,17 @@ bool SequencePanel::rehearse() {
   setStatus(pinned       ? tr("Rehearsing from %1…").arg(pinned_->label)
             : plan.start ? tr("Rehearsing from the robot's state now…")
                          : tr("Rehearsing from the world's start…"));
-  startWorker([this, plan = std::move(plan), text, pinned]() mutable {
-    RehearsalResult r = sp::rehearse(plan, [this](double f) {
-      QMetaObject::invokeMethod(this, [this, f] { progress_->setValue(static_cast<int>(f * 1000)); },
-                                Qt::QueuedConnection);
-      return !cancel_.load();
-    });
-    QMetaObject::invokeMethod(
-        this,
-        [this, plan = std::move(plan), r = std::move(r), text, pinned]() mutable {
-          rehearsedText_ = text;
-          planPinned_ = pinned;
-          terrainEditedSince_ = false;
-          rehearsalDone(std::move(plan), std::move(r));
-        },
-        Qt::QueuedConnection);
+  runTask(tr("Rehearsing"), [this, plan = std::move(plan), text, pinned, cancel = freshCancel()](
+                                const BackgroundJobs::Progress& progress) mutable -> std::function<void()> {
+    auto r = std::make_shared<RehearsalResult>(
+        sp::rehearse(plan, [&](double f) { return progress(f) && !cancel->load(); }));
+    auto done = std::make_shared<RehearsalPlan>(std::move(plan));
+    return [this, done, r, text, pinned] {
+      rehearsedText_ = text;
+      planPinned_ = pinned;
+      terrainEditedSince_ = false;
+      rehearsalDone(std::move(*done), std::move(*r));
+    };
   });
   return true;
 }
@@ -404,14 +415,11 @@ bool SequencePanel::checkRobustness() {
   }
   const RehearsalPlan plan = *plan_;
   setStatus(tr("Robustness: %1 perturbed rehearsals on 2 threads…").arg(plan.rules.robustSamples));
-  startWorker([this, plan] {
-    RobustnessResult r = robustness(plan, 1, 2, [this](int done, int total) {
-      QMetaObject::invokeMethod(
-          this, [this, done, total] { progress_->setValue(done * 1000 / std::max(1, total)); }, Qt::QueuedConnection);
-      return !cancel_.load();
-    });
-    QMetaObject::invokeMethod(this, [this, r = std::move(r)]() mutable { robustnessFinished(std::move(r)); },
-                              Qt::QueuedConnection);
+  runTask(tr("Robustness"), [this, plan, cancel = freshCancel()](const BackgroundJobs::Progress& progress) -> std::function<void()> {
+    auto r = std::make_shared<RobustnessResult>(robustness(plan, 1, 2, [&](int done, int total) {
+      return progress(static_cast<double>(done) / std::max(1, total)) && !cancel->load();
+    }));
+    return [this, r] { robustnessFinished(std::move(*r)); };
   });
   return true;
 }
@@ -436,25 +444,23 @@ bool SequencePanel::robustnessOnCluster(const QString& dir) {
   } else {
     // sbatch may wait for a slow controller: on the worker, never the GUI.
     setStatus(tr("Robustness on cluster: %1 samples written to %2; submitting…").arg(samples).arg(dir));
-    startWorker([this, dir, samples, later, sim = simBinary_.toStdString()] {
+    runTask(tr("Submitting"), [this, dir, samples, later, sim = simBinary_.toStdString()](
+                                  const BackgroundJobs::Progress&) -> std::function<void()> {
       std::string why;
       const std::string job = submitSlurm(dir.toStdString(), {}, sim, {}, why);
-      QMetaObject::invokeMethod(
-          this,
-          [this, dir, samples, later, job, why] {
-            busy_ = false;
-            updateButtons();
-            if (job.empty())
-              setStatus(tr("Robustness on cluster: %1 samples written to %2; %3")
-                            .arg(samples)
-                            .arg(dir, QString::fromStdString(why)));
-            else
-              setStatus(tr("Robustness on cluster: job array %1, %2 samples in %3; when it is done: %4")
-                            .arg(QString::fromStdString(job))
-                            .arg(samples)
-                            .arg(dir, later));
-          },
-          Qt::QueuedConnection);
+      return [this, dir, samples, later, job, why] {
+        busy_ = false;
+        updateButtons();
+        if (job.empty())
+          setStatus(tr("Robustness on cluster: %1 samples written to %2; %3")
+                        .arg(samples)
+                        .arg(dir, QString::fromStdString(why)));
+        else
+          setStatus(tr("Robustness on cluster: job array %1, %2 samples in %3; when it is done: %4")
+                        .arg(QString::fromStdString(job))
+                        .arg(samples)
+                        .arg(dir, later));
+      };
     });
   }
   emit logEvent("rehearsal", QStringLiteral("robustness on cluster: %1 samples in %2").arg(samples).arg(dir));

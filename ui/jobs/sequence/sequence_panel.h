@@ -25,8 +25,10 @@
 // the callbacks and signals MainWindow connects (app/rehearse/sequence_relay.h does
 // the protocol's side).
 //
-// Thread: GUI thread. Rehearsals run on a std::thread of the panel's,
-// cancelled and joined by the destructor.
+// Thread: GUI thread. Rehearsals, robustness checks and submissions run on
+// a BackgroundJobs runner (the console's, ui/background_jobs.h), one at a
+// time; Cancel stops one and shows what it did so far; a task still running
+// when the panel goes is stopped and its result dropped.
 
 #include <QCoreApplication>
 #include <QString>
@@ -37,11 +39,11 @@
 #include <functional>
 #include <memory>
 #include <optional>
-#include <thread>
 
 #include "app/rehearse/rehearsal.h"
 #include "app/rehearse/sequence_guard.h"
 #include "net/message.h"
+#include "ui/background_jobs.h"
 
 class QLabel;
 class QListWidget;
@@ -113,6 +115,9 @@ class SequencePanel : public QWidget {
   /// The simpartner-sim a cluster's tasks run (default: beside this program).
   void setSimBinary(const QString& path) { simBinary_ = path; }
   bool busy() const { return busy_; }
+  /// Runs rehearsals on `jobs` (the console's runner; it must outlive the
+  /// panel) instead of a runner of its own. Not while one runs.
+  void setBackground(BackgroundJobs* jobs);
   /// The last rehearsal, if any (and whether the text is still what it rehearsed).
   const std::optional<RehearsalResult>& result() const { return result_; }
   const std::optional<RobustnessResult>& robustnessResult() const { return robust_; }
@@ -164,7 +169,10 @@ class SequencePanel : public QWidget {
   void buildTemplateMenu(QToolButton* button);
   void openFile();
   void saveFile();
-  void startWorker(std::function<void()> work);
+  /// A new Cancel flag for the next task (the last one's stays with it).
+  std::shared_ptr<std::atomic<bool>> freshCancel();
+  /// Runs `work` on the runner: busy, progress, Cancel until its result runs.
+  void runTask(const QString& what, BackgroundJobs::Work work);
   void rehearsalDone(RehearsalPlan plan, RehearsalResult result);
   void robustnessFinished(RobustnessResult result);
   void showVerdicts();
@@ -202,8 +210,9 @@ class SequencePanel : public QWidget {
   QLabel* status_ = nullptr;
 
   bool busy_ = false;
-  std::atomic<bool> cancel_{false};
-  std::thread worker_;
+  BackgroundJobs* jobs_ = nullptr;  // the console's runner, or the panel's own
+  int job_ = 0;                     // the task running (for its progress)
+  std::shared_ptr<std::atomic<bool>> cancel_ = std::make_shared<std::atomic<bool>>(false);  // the task's
   std::optional<RehearsalPlan> plan_;  // of result_
   struct Pinned {
     RehearsalStart start;
