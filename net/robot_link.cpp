@@ -45,6 +45,21 @@ void RobotLink::disconnected(ClientId client, double now) {
   }
 }
 
+void RobotLink::stalled(ClientId client, const std::string& why, double now) {
+  const std::string name = who(client);
+  if (holder_ == client)
+    stopEverything(EventKind::Failsafe, "the controller " + name + " stopped reading (" + why + "): it loses control", now);
+  else
+    notice("link", name + " closed: " + why);
+}
+
+void RobotLink::shutdown(const std::string& reason, double now) {
+  stopEverything(EventKind::Estop, reason + ": every motor stopped", now);
+  std::vector<ClientId> everyone;
+  for (const auto& [id, c] : clients_) everyone.push_back(id);
+  for (ClientId id : everyone) close(id, reason);
+}
+
 void RobotLink::notice(std::string kind, std::string text) { notices_.push_back({std::move(kind), std::move(text)}); }
 
 std::string RobotLink::who(ClientId client) const {

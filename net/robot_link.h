@@ -67,6 +67,13 @@ class RobotLink {
   /// Drops the client; a lease holder's lease is released (the deadman
   /// then fires, and the failsafe latches, as for any lost holder).
   void disconnected(ClientId client, double now);
+  /// The server found `client` not reading (`why`) and is closing it: the
+  /// lease holder's robot is stopped with a failsafe saying so, at once
+  /// (its keep-alives alone must not keep a blind controller in control).
+  void stalled(ClientId client, const std::string& why, double now);
+  /// The robot is going away (`reason`): it is stopped as by an e-stop
+  /// (latched), every client is told (EVENT estop) and closed with `reason`.
+  void shutdown(const std::string& reason, double now);
   /// One decoded message from a client at time `now` [s, monotonic].
   void received(ClientId client, const Message& message, double now);
   /// A frame from the client could not be decoded: answers ERROR and asks

@@ -41,7 +41,10 @@ class RobotServer::Session {
     return n;
   }
   bool writing = false, reading = false;
-  bool closing = false;  // write what is queued, then close
+  double writeStartedAt = 0;  // [s] of the write under way
+  bool closing = false;  // write what is queued, then close (nothing more is read)
+  double closingSince = 0;  // [s] a closing client that does not take its last frames is closed
+  bool stalled = false;  // its control queue overflowed: it does not read, closed at once
   bool closed = false;
   uint64_t telemetrySeq = 0, laserSeq = 0, lost = 0;
   LinkEmulator toClient, fromClient;
@@ -119,10 +122,18 @@ void RobotServer::accept() {
       });
       return;
     }
-    if (sessions_.size() >= config_.maxConnections) {
+    if (shuttingDown_) {
+      asio::error_code ignored;
+      socket.close(ignored);
+      return;  // and accept no more
+    }
+    evictForNewcomer();
+    size_t open = 0;
+    for (const auto& [id, s] : sessions_) open += !s->closed;
+    if (open >= config_.maxConnections) {
       ++stats_.refusedConnections;
       if (config_.log)
-        config_.log("connection refused: " + std::to_string(sessions_.size()) + " connections open already (the limit)");
+        config_.log("connection refused: " + std::to_string(open) + " connections open already (the limit)");
       asio::error_code ignored;
       socket.close(ignored);
       accept();
@@ -154,7 +165,9 @@ void RobotServer::accept() {
 
 void RobotServer::startRead(ClientId id) {
   auto it = sessions_.find(id);
-  if (it == sessions_.end() || it->second->closed) return;
+  // Nothing more is read from a closing client: its keep-alives must not
+  // feed the deadman while it is being let go.
+  if (it == sessions_.end() || it->second->closed || it->second->closing) return;
   Session& s = *it->second;
   s.reading = true;
   // Completions look the session up by id: a session closed meanwhile is
@@ -186,7 +199,9 @@ void RobotServer::enqueue(Session& s, const Message& message) {
 
 void RobotServer::enqueueFrame(Session& s, std::string frame, bool telemetry) {
   if (!telemetry && s.queue.size() >= config_.maxQueuedControl) {
-    s.closing = true;  // a client that does not read its replies is dropped
+    // A client that does not read its replies is dropped at once (flush()):
+    // were it the controller, it would go on driving blind.
+    s.stalled = true;
     return;
   }
   double due = 0;
@@ -266,11 +281,26 @@ void RobotServer::flush() {
   }
   for (ClientId id : link_.takeClosing()) {
     auto it = sessions_.find(id);
-    if (it != sessions_.end()) it->second->closing = true;
+    if (it != sessions_.end()) markClosing(*it->second);
   }
   std::vector<ClientId> finished;  // closed after the loop: closing erases sessions
-  for (auto& [id, ptr] : sessions_)
-    if (!writeNext(id, *ptr)) finished.push_back(id);
+  for (auto& [id, ptr] : sessions_) {
+    if (ptr->stalled && !ptr->closed) {
+      // Told to the link first: a controller that cannot receive loses the
+      // lease with a failsafe and its reason, not after a deadman's wait.
+      ++stats_.stalledClients;
+      stats_.lastStallAt = now();
+      const std::string why = ptr->writing && now() - ptr->writeStartedAt > config_.stallTimeout
+                                  ? "nothing taken for " + std::to_string(static_cast<int>((now() - ptr->writeStartedAt) * 1000)) +
+                                        " ms, " + std::to_string(ptr->queue.size()) + " frames unsent"
+                                  : std::to_string(ptr->queue.size()) + " frames unsent: it does not read";
+      if (config_.log) config_.log("client " + std::to_string(id) + " closed: " + why);
+      link_.stalled(id, why, now());
+      finished.push_back(id);
+    } else if (!writeNext(id, *ptr)) {
+      finished.push_back(id);
+    }
+  }
   for (ClientId id : finished) closeSession(id);
 }
 
@@ -279,6 +309,7 @@ bool RobotServer::writeNext(ClientId id, Session& s) {
   if (s.queue.empty()) return !s.closing;
   if (s.queue.front().due > now()) return true;  // the emulated link holds it; the timer comes back
   s.writing = true;
+  s.writeStartedAt = now();
   // One frame per write; the completion continues with this session's next
   // (only: a scan of every session per completion made 500 clients cost
   // the controller its round trip).
@@ -292,6 +323,40 @@ bool RobotServer::writeNext(ClientId id, Session& s) {
     if (!writeNext(id, ses)) closeSession(id);
   });
   return true;
+}
+
+void RobotServer::evictForNewcomer() {
+  size_t open = 0, unauthenticated = 0;
+  ClientId oldest = 0;
+  double oldestAt = 0;
+  for (const auto& [id, s] : sessions_) {
+    if (s->closed) continue;
+    ++open;
+    if (link_.authenticated(id)) continue;
+    ++unauthenticated;
+    if (!oldest || s->connectedAt < oldestAt) oldest = id, oldestAt = s->connectedAt;
+  }
+  if (!oldest || unauthenticated < config_.maxUnauthenticated) return;
+  ++stats_.evictedUnauthenticated;
+  if (config_.log)
+    config_.log("client " + std::to_string(oldest) + " closed: no HELLO yet and " + std::to_string(unauthenticated) +
+                " such connections open; a newer one takes its place");
+  closeSession(oldest);
+}
+
+void RobotServer::shutdown(const std::string& reason) {
+  if (stopped_ || shuttingDown_) return;
+  shuttingDown_ = true;
+  asio::error_code ec;
+  acceptor_.close(ec);
+  link_.shutdown(reason, now());
+  flush();
+}
+
+void RobotServer::markClosing(Session& s) {
+  if (s.closing) return;
+  s.closing = true;
+  s.closingSince = now();
 }
 
 void RobotServer::closeSession(ClientId id) {
@@ -335,6 +400,23 @@ void RobotServer::onTimer() {
   for (const auto& [id, s] : sessions_)
     if (!s->closed && !s->closing && t - s->connectedAt > helloLimit && !link_.authenticated(id))
       silent.push_back(id);
+  // A controller that has taken nothing of a frame for stallTimeout does
+  // not read (the kernel's buffers both ways are full): it is blind, and
+  // loses control with a failsafe at once, as one whose replies overflow.
+  // (A monitor that reads too slowly only loses telemetry.)
+  if (auto it = sessions_.find(link_.holder()); it != sessions_.end()) {
+    Session& s = *it->second;
+    if (!s.closed && !s.stalled && s.writing && t - s.writeStartedAt > config_.stallTimeout) {
+      s.stalled = true;
+      flush();
+    }
+  }
+  // A closing client that has not taken its last frames within a second
+  // does not read: it is closed without them.
+  std::vector<ClientId> lingering;
+  for (const auto& [id, s] : sessions_)
+    if (!s->closed && s->closing && t - s->closingSince > kClosingGrace) lingering.push_back(id);
+  for (ClientId id : lingering) closeSession(id);
   for (ClientId id : silent) {
     ++stats_.helloTimeouts;
     if (config_.log) config_.log("client " + std::to_string(id) + " closed: no HELLO within " +
@@ -353,7 +435,7 @@ void RobotServer::onTimer() {
   const auto fanOut = [&](uint64_t Session::*seq, const auto& makeFrame) {
     for (ClientId id : link_.subscribers()) {
       auto it = sessions_.find(id);
-      if (it == sessions_.end() || it->second->closed) continue;
+      if (it == sessions_.end() || it->second->closed || it->second->closing) continue;  // it has its last frames
       Session& s = *it->second;
       ++(s.*seq);
       if (!telemetryRoom(s)) continue;

@@ -99,9 +99,19 @@ struct RobotServerConfig {
   RobotLinkConfig link;
   size_t maxQueuedFrames = 64;       ///< per client; telemetry beyond it is dropped and counted
   size_t maxQueuedControl = 1024;    ///< replies and events beyond it close a client that does not read
+  /// [s] a controller (the lease holder) that takes no byte of a frame for
+  /// this long does not read (the kernel's buffers are full both ways): it
+  /// is blind, and loses control with a failsafe and its connection.
+  double stallTimeout = 1.0;
   /// Connections open at once; one more is accepted and closed at once
   /// (logged), so the backlog never fills with clients nobody serves.
   size_t maxConnections = 64;
+  /// Of those, connections that have not authenticated yet. When they are
+  /// this many, a new connection closes the oldest of them: a flood of
+  /// connections that dribble their HELLO can never lock the operator out
+  /// (a connection on loopback or a LAN says HELLO within milliseconds).
+  /// More than maxConnections: no such pool (a test's control).
+  size_t maxUnauthenticated = 16;
   /// [s] a connection without a good HELLO by then is closed.
   double helloTimeout = 2.0;
   /// Where the server reports connections, refusals and bad frames (one
@@ -125,6 +135,9 @@ struct RobotServerStats {
   uint64_t refusedConnections = 0;  ///< closed at once: maxConnections were open
   uint64_t helloTimeouts = 0;       ///< closed for no HELLO within helloTimeout
   uint64_t acceptErrors = 0;        ///< accept() failures (out of descriptors, say); accepting goes on
+  uint64_t stalledClients = 0;      ///< closed at once: their replies filled maxQueuedControl (they do not read)
+  double lastStallAt = 0;           ///< [s, steady clock] when the last of them was found
+  uint64_t evictedUnauthenticated = 0;  ///< connections without HELLO closed to admit a newer one
 };
 
 class RobotServer {
@@ -135,6 +148,11 @@ class RobotServer {
   /// a non-loopback address without a token, a token under 128 bits).
   std::string start();
   void stop();
+  /// The robot is going away (SIGTERM): no new connections; the robot is
+  /// stopped as by an e-stop (latched), every client gets EVENT estop and
+  /// then ERROR with `reason`, and is closed once it has them (or after a
+  /// second). The server runs on until stop().
+  void shutdown(const std::string& reason);
   uint16_t port() const { return port_; }
   const RobotServerStats& stats() const { return stats_; }
   const RobotLink& link() const { return link_; }
@@ -156,7 +174,13 @@ class RobotServer {
   void received(ClientId id, const std::string& bytes);
   void deliverDue();
   void closeSession(ClientId id);
+  /// Writes what is queued, then closes; nothing more is read.
+  void markClosing(Session& session);
+  /// Makes room for a new connection among those without HELLO (see
+  /// maxUnauthenticated): closes the oldest of them when needed.
+  void evictForNewcomer();
   double now() const;
+  static constexpr double kClosingGrace = 1.0;  // [s] a closing client gets to take its last frames
 
   asio::io_context& io_;
   RobotServerConfig config_;
@@ -176,7 +200,7 @@ class RobotServer {
   std::string lastHealth_;  // announced divergence, so it is announced once
   SequenceStatus lastSequence_;  // announced sequence state
   RobotServerStats stats_;
-  bool stopped_ = false;
+  bool stopped_ = false, shuttingDown_ = false;
 };
 
 }  // namespace sp::net

@@ -351,9 +351,31 @@ bool SessionLogWriter::writeBatch(std::deque<Item>& batch) {
 
 // Reader.
 
+int openSessionLogReadOnly(const std::string& path, sqlite3** db) {
+  // A log its writer closed has no -wal file (the writer checkpoints it
+  // away); a plain read-only connection would create -wal and -shm beside
+  // it and leave them there. Nobody writes such a log any more, so it is
+  // opened as immutable, which creates nothing. A log with a -wal (being
+  // written, or left by a killed writer) is opened read-only as it is.
+  std::error_code ec;
+  if (std::filesystem::exists(path + "-wal", ec) || ec) return sqlite3_open_v2(path.c_str(), db, SQLITE_OPEN_READONLY, nullptr);
+  std::string uri = "file:";
+  for (const char c : std::filesystem::absolute(path, ec).string()) {
+    if (c == '%' || c == '?' || c == '#') {
+      char hex[4];
+      std::snprintf(hex, sizeof hex, "%%%02X", static_cast<unsigned char>(c));
+      uri += hex;
+    } else {
+      uri += c;
+    }
+  }
+  uri += "?immutable=1";
+  return sqlite3_open_v2(uri.c_str(), db, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr);
+}
+
 std::unique_ptr<SessionLogReader> SessionLogReader::open(const std::string& path, std::string& error) {
   sqlite3* db = nullptr;
-  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+  if (openSessionLogReadOnly(path, &db) != SQLITE_OK) {
     error = path + ": cannot open the session log: " + (db ? sqlite3_errmsg(db) : "out of memory");
     sqlite3_close(db);
     return nullptr;

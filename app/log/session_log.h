@@ -203,6 +203,12 @@ class SessionLogWriter {
 };
 
 /// Reads a session log. Thread: one thread at a time.
+/// Opens the session log at `path` read-only without leaving files beside
+/// it: a log whose writer closed it (no -wal) is opened immutable, so no
+/// -wal or -shm is created; one with a -wal (live, or a killed writer's) as
+/// it is. Returns SQLite's result code; `*db` as sqlite3_open_v2 sets it.
+int openSessionLogReadOnly(const std::string& path, sqlite3** db);
+
 class SessionLogReader {
  public:
   /// Opens read-only. Returns nullptr and sets `error` to a message naming

@@ -72,8 +72,10 @@ uint64_t LineWriter::dropped() const {
 void LineWriter::run(State& s) {
   std::unique_lock lock(s.mutex);
   for (;;) {
-    s.wake.wait(lock, [&] { return s.stopping || !s.queue.empty(); });
-    if (s.queue.empty()) {
+    // Lines dropped while it was blocked are said as soon as it can write
+    // again, even when no new line comes (they were never said before).
+    s.wake.wait(lock, [&] { return s.stopping || !s.queue.empty() || s.dropped > s.droppedTold; });
+    if (s.queue.empty() && s.dropped == s.droppedTold) {
       s.drained.notify_all();
       if (s.stopping) return;
       continue;

@@ -2,6 +2,8 @@
 
 #include <asio.hpp>
 
+#include <algorithm>
+#include <chrono>
 #include <thread>
 
 #include "app/tools/headless_runner.h"
@@ -137,6 +139,29 @@ std::string StandInRobot::start() {
   s.thread = std::thread([&s] { s.io.run(); });
   server_ = std::move(server);
   return {};
+}
+
+bool StandInRobot::shutdown(const std::string& reason, double maxWait) {
+  using Clock = std::chrono::steady_clock;
+  if (!server_) return false;
+  host_->logEvent("shutdown", reason);
+  asio::post(server_->io, [s = server_.get(), reason] { s->server->shutdown(reason); });
+  // The stop is applied at the twin's next step; then it comes to rest. At
+  // rest: the base slower than 5 mm/s and 0.01 rad/s (what telemetry
+  // reports, so a real robot's adapter can wait the same way).
+  const Clock::time_point start = Clock::now();
+  const auto until = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(maxWait));
+  const auto settle = std::chrono::duration<double>(std::max(0.1, 3.0 / params_.logRate));
+  bool rest = false;
+  while (Clock::now() < until && !rest) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    const net::RobotState s = host_->state();
+    rest = Clock::now() - start >= settle && norm(s.baseLinearVelocity) < 0.005 && norm(s.baseAngularVelocity) < 0.01;
+  }
+  // Logged samples of it at rest (at the logging rate), then the end.
+  if (rest) std::this_thread::sleep_for(settle);
+  stop();
+  return rest;
 }
 
 void StandInRobot::stop() {

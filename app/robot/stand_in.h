@@ -106,6 +106,13 @@ class StandInRobot {
   /// the log: when it returns the log file is complete. Joins both threads
   /// (a few ms). Idempotent.
   void stop();
+  /// A shutdown that leaves the robot still (SIGTERM, SIGINT): every motor
+  /// is stopped first, as by an e-stop (latched); every client gets EVENT
+  /// estop and ERROR `reason` and is closed; the stop and `reason` are
+  /// logged; the twin runs on until the robot is at rest (at most
+  /// `maxWait` [s]) and its log has samples of it at rest; then stop().
+  /// Returns whether it came to rest in time.
+  bool shutdown(const std::string& reason, double maxWait = 3.0);
 
   /// The port listened on (the real one when 0 was asked); 0 before start().
   uint16_t port() const { return port_; }

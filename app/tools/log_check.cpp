@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
   const double birth = birthTime(path);
 
   sqlite3* db = nullptr;
-  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+  if (sp::openSessionLogReadOnly(path, &db) != SQLITE_OK) {
     std::printf("FAIL open: %s\n", db ? sqlite3_errmsg(db) : "out of memory");
     sqlite3_close(db);
     return 1;

@@ -36,8 +36,10 @@ constexpr const char* kUsage = R"(usage:
       --no-terrain-edits  refuse terrain edits as a real robot does (the
                         stand-in, a simulator, takes them by default)
   Prints `logging to PATH`, then `listening on ADDRESS:PORT` when ready;
-  connections, lease changes and e-stops go to stderr. Stops on SIGINT or
-  SIGTERM. The session log (docs/session-format.md) re-simulates with
+  connections, lease changes and e-stops go to stderr. On SIGINT or SIGTERM
+  it stops every motor (as an e-stop), tells every client why and closes
+  them, waits for the robot to come to rest (at most 3 s), then exits; the
+  log ends with the stop and the robot at rest. The session log (docs/session-format.md) re-simulates with
   `simpartner-sim resim PATH`.
 )";
 
@@ -138,13 +140,18 @@ int main(int argc, char** argv) {
   // failed log is told once and the twin runs on.
   bool toldLogFailure = false;
   const timespec poll{0, 200'000'000};
-  while (sigtimedwait(&stopSignals, nullptr, &poll) < 0) {
+  int signal = -1;
+  while ((signal = sigtimedwait(&stopSignals, nullptr, &poll)) < 0) {
     if (!toldLogFailure && robot->logFailed()) {
       toldLogFailure = true;
       lines.write("error: " + robot->logError() + "; the twin runs on without logging");
     }
   }
-  robot->stop();
+  // A signal stops the robot before the program ends: every motor first
+  // (as an e-stop), the clients told why, the log ending with the robot at rest.
+  const std::string reason = std::string("robot shutting down (") + (signal == SIGINT ? "SIGINT" : "SIGTERM") + ")";
+  lines.write(reason + ": stopping every motor");
+  if (!robot->shutdown(reason)) lines.write("warning: the robot was still moving 3 s after the stop");
   const sp::StandInStats stats = robot->stats();
   std::cout << "stopped: " << stats.clientsAccepted << " clients, " << stats.framesIn << " frames in, "
             << stats.badFrames << " closed for bad frames, " << stats.telemetryDropped

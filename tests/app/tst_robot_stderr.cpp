@@ -12,7 +12,6 @@
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
@@ -25,9 +24,9 @@
 #include <thread>
 
 #include "net/robot_client.h"
+#include "tests/app/robot_process.h"
 #include "tests/app/shared_state.h"
 
-extern char** environ;
 
 using namespace sp::net;
 using namespace std::chrono_literals;
@@ -51,35 +50,15 @@ class TestRobotStderr : public QObject {
   void deadmanWithBlockedStderr() {
     int out[2], err[2];
     QVERIFY(pipe(out) == 0 && pipe(err) == 0);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, out[1], 1);
-    posix_spawn_file_actions_adddup2(&actions, err[1], 2);
-    for (int fd : {out[0], out[1], err[0], err[1]}) posix_spawn_file_actions_addclose(&actions, fd);
     const std::string world = std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml";
-    std::vector<std::string> args = {SP_ROBOT_EXE, "--world", world, "--port", "0", "--token", kToken, "--no-log"};
-    std::vector<char*> argv;
-    for (std::string& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    pid_t pid = 0;
-    QCOMPARE(posix_spawn(&pid, SP_ROBOT_EXE, &actions, nullptr, argv.data(), environ), 0);
-    posix_spawn_file_actions_destroy(&actions);
+    const pid_t pid = sp::test::spawnRobot({"--world", world, "--port", "0", "--token", kToken, "--no-log"}, out[1], err[1]);
+    QVERIFY(pid != 0);
     close(out[1]);
     close(err[1]);  // err[0] stays open and unread: writes to it block once it is full
 
     // The port, from stdout's "listening on 127.0.0.1:PORT".
     std::string text;
-    uint16_t port = 0;
-    for (auto until = Clock::now() + 10s; port == 0 && Clock::now() < until;) {
-      pollfd p{out[0], POLLIN, 0};
-      if (poll(&p, 1, 100) <= 0) continue;
-      char buf[256];
-      const ssize_t n = read(out[0], buf, sizeof buf);
-      if (n <= 0) break;
-      text.append(buf, static_cast<size_t>(n));
-      if (const size_t at = text.find("listening on 127.0.0.1:"); at != std::string::npos && text.find('\n', at) != std::string::npos)
-        port = static_cast<uint16_t>(std::stoi(text.substr(at + 23)));
-    }
+    const uint16_t port = sp::test::listeningPort(out[0], text);
     QVERIFY2(port != 0, text.c_str());
 
     // Fill stderr's pipe: every connection writes two lines.

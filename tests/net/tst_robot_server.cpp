@@ -5,7 +5,13 @@
 #include <QProcess>
 #include <QtTest>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <sys/resource.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
 
 #include <filesystem>
 #include <functional>
@@ -394,6 +400,186 @@ class TestRobotServer : public QObject {
     while (seconds(t1) < 5.0 && !(reply && reply->seq == 2)) reply = holder.waitFor<ReplyMsg>(1.0);
     QVERIFY(reply && reply->seq == 2 && reply->status == ReplyStatus::Failed);
     QVERIFY(reply->reason.find("latched") != std::string::npos);
+  }
+
+  // Issue 36: a controller that sends keep-alives but never reads keeps
+  // the robot driving blind. Criterion: once the robot finds it not
+  // reading (its replies fill the control queue, or it has taken nothing
+  // for stallTimeout, 1 s), the robot latches the failsafe within
+  // deadman + 100 ms, saying why, the controller loses the lease and its
+  // connection, and the robot stops. Before, its keep-alives fed the
+  // deadman and it kept driving at 0.5 m/s with the connection open (the
+  // control these criteria fail).
+  void blindControllerLosesControl_data() {
+    QTest::addColumn<bool>("commands");
+    QTest::newRow("commanding at 50 Hz: its replies overflow") << true;
+    QTest::newRow("keep-alives only: it takes nothing") << false;
+  }
+  void blindControllerLosesControl() {
+    QFETCH(bool, commands);
+    Robot robot({}, {}, [commands](RobotServerConfig& c) {
+      if (commands) c.maxQueuedControl = 64;  // fills in seconds, not a minute
+    });
+    Client monitor(robot.server->port());
+    monitor.hello(Role::Monitor, "monitor");
+    Client blind(robot.server->port());
+    blind.socket.set_option(asio::socket_base::receive_buffer_size(4096));
+    // As any controller: with Nagle, its second small frame would wait for
+    // an ACK the robot delays (its data cannot go out to a full window).
+    blind.socket.set_option(asio::ip::tcp::no_delay(true));
+    blind.hello(Role::Control, "blind");
+    blind.send(LeaseAcquireMsg{});
+    std::optional<EventMsg> event;
+    uint64_t seq = 1;
+    const auto t0 = Clock::now();
+    // Drive and keep the lease alive at 50 Hz, reading nothing: every
+    // command's REPLY piles up.
+    std::thread driver([&] {
+      while (seconds(t0) < 20 && !blind.eof) {
+        if (commands || seq == 1) blind.send(CommandMsg{seq++, 1000, "drive 0.5 0"});
+        blind.send(LeaseKeepaliveMsg{});
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    });
+    while (seconds(t0) < 20 && !(event && event->kind == EventKind::Failsafe)) event = monitor.waitFor<EventMsg>(1.0);
+    const double seenAt = std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
+    blind.eof = true;  // stop the driver
+    driver.join();
+    QVERIFY2(event && event->kind == EventKind::Failsafe, "no failsafe while the controller drove blind for 20 s");
+    QVERIFY2(event->text.find("stopped reading") != std::string::npos, event->text.c_str());
+    const RobotServerStats stats = robot.server->stats();
+    QCOMPARE(stats.stalledClients, uint64_t{1});
+    const double after = seenAt - stats.lastStallAt;  // includes the EVENT's way to the monitor
+    qInfo("found not reading %.1f s after the controller stopped reading; failsafe seen %.1f ms after that: %s",
+          stats.lastStallAt - std::chrono::duration<double>(t0.time_since_epoch()).count(), after * 1000,
+          event->text.c_str());
+    QVERIFY2(after <= RobotLinkConfig{}.deadman + 0.1, qPrintable(QString::number(after)));
+    const auto lease = monitor.waitFor<LeaseStateMsg>(2.0);
+    QVERIFY(lease && lease->holder.empty());
+    // The robot stops: telemetry a second later shows the wheels still.
+    std::optional<TelemetryMsg> t;
+    const auto t1 = Clock::now();
+    while (seconds(t1) < 3.0) t = monitor.waitFor<TelemetryMsg>(1.0);
+    QVERIFY(t && t->failsafe);
+    QVERIFY2(std::hypot(t->baseVelocity.size() == 6 ? t->baseVelocity[0] : 1, t->baseVelocity.size() == 6 ? t->baseVelocity[1] : 1) < 0.05,
+             "the robot still moves");
+  }
+
+  // Issue 36: 500 connections dribbling a HELLO at 1 byte/s, each back 1 s
+  // after it is closed, must not lock the operator out. Criteria: with the
+  // flood running, a client connects and authenticates within 1 s in 10 of
+  // 10 tries, and the controller's telemetry stays at 45 Hz or more. The
+  // control (no pool for connections without HELLO, as before) fails the
+  // first criterion.
+  void helloFloodKeepsTheOperatorsWayIn_data() {
+    QTest::addColumn<bool>("pool");
+    QTest::newRow("unauthenticated pool") << true;
+    QTest::newRow("control: no pool") << false;
+  }
+  void helloFloodKeepsTheOperatorsWayIn() {
+    QFETCH(bool, pool);
+    rlimit old{};
+    QVERIFY(getrlimit(RLIMIT_NOFILE, &old) == 0);
+    rlimit more = old;
+    more.rlim_cur = std::min<rlim_t>(old.rlim_max, 4096);
+    QVERIFY(setrlimit(RLIMIT_NOFILE, &more) == 0);
+    QVERIFY2(more.rlim_cur >= 1200, "needs 1200 descriptors for a 500-connection flood");
+    Robot robot({}, {}, [pool](RobotServerConfig& c) {
+      if (!pool) c.maxUnauthenticated = c.maxConnections + 1;
+    });
+    const uint16_t port = robot.server->port();
+    Client controller(port);
+    controller.hello(Role::Control, "operator");
+    controller.send(LeaseAcquireMsg{});
+
+    std::atomic<bool> stop{false};
+    std::thread flood([&] {
+      struct Attacker {
+        int fd = -1;
+        double next = 0;  // [s] when to send its next byte, or to reconnect
+      };
+      constexpr int kAttackers = 500;
+      std::vector<Attacker> attackers(kAttackers);
+      const std::string hello = [] {
+        std::string error;
+        return *encodeMessage(HelloMsg{"flood", {}, Role::Monitor, std::string(64, '0')}, error);
+      }();
+      const auto open = [&](Attacker& a) {
+        a.fd = ::socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK, 0);
+        sockaddr_in addr{};
+        addr.sin_family = AF_INET;
+        addr.sin_port = htons(port);
+        addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        ::connect(a.fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
+      };
+      const auto t0 = Clock::now();
+      for (Attacker& a : attackers) open(a);
+      size_t sent = 0;
+      while (!stop) {
+        const double t = seconds(t0);
+        for (Attacker& a : attackers) {
+          if (a.fd < 0) {
+            if (t >= a.next) open(a), a.next = t + 1;
+            continue;
+          }
+          char buf[512];
+          const ssize_t n = ::recv(a.fd, buf, sizeof buf, MSG_DONTWAIT);
+          if (n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINPROGRESS && errno != ENOTCONN)) {
+            ::close(a.fd);  // closed by the robot: back in a second
+            a.fd = -1;
+            a.next = t + 1;
+            continue;
+          }
+          if (t >= a.next) {
+            ::send(a.fd, hello.data() + (sent++ % hello.size()), 1, MSG_NOSIGNAL | MSG_DONTWAIT);
+            a.next = t + 1;
+          }
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+      for (Attacker& a : attackers)
+        if (a.fd >= 0) ::close(a.fd);
+    });
+    // Every slot taken by now; the controller reads meanwhile (its backlog
+    // must not count in the rate below).
+    for (auto until = Clock::now() + std::chrono::milliseconds(2500); Clock::now() < until;)
+      controller.waitFor<TelemetryMsg>(0.005);
+
+    int telemetry = 0, admitted = 0;
+    double slowest = 0;
+    const auto t0 = Clock::now();
+    for (int i = 0; i < 10; ++i) {
+      const auto start = Clock::now();
+      bool in = false;
+      {
+        Client operatorClient(port);
+        const std::optional<ChallengeMsg> challenge = operatorClient.waitFor<ChallengeMsg>(1.0);
+        if (challenge) {
+          operatorClient.send(HelloMsg{"reconnecting", {}, Role::Monitor,
+                                       helloProof(kToken, challenge->nonce, "reconnecting", Role::Monitor)});
+          in = operatorClient.waitFor<WelcomeMsg>(std::max(0.0, 1.0 - seconds(start))).has_value();
+        }
+      }
+      if (in) ++admitted, slowest = std::max(slowest, seconds(start));
+      // The controller's telemetry meanwhile (what came; a short wait each).
+      for (auto until = Clock::now() + std::chrono::milliseconds(200); Clock::now() < until;)
+        if (controller.waitFor<TelemetryMsg>(0.005)) ++telemetry;
+    }
+    const double rate = telemetry / seconds(t0);
+    stop = true;
+    flood.join();
+    QVERIFY(setrlimit(RLIMIT_NOFILE, &old) == 0);
+    const RobotServerStats stats = robot.server->stats();
+    qInfo("%s: %d of 10 admitted within 1 s (slowest %.0f ms); controller telemetry %.1f Hz; %llu refused, "
+          "%llu evicted without HELLO",
+          pool ? "pool" : "control", admitted, slowest * 1000, rate, static_cast<unsigned long long>(stats.refusedConnections),
+          static_cast<unsigned long long>(stats.evictedUnauthenticated));
+    if (pool) {
+      QCOMPARE(admitted, 10);
+      QVERIFY2(rate >= 45, qPrintable(QString::number(rate)));
+    } else {
+      QVERIFY2(admitted < 10, "the control admitted every try: the flood did not fill the slots");
+    }
   }
 
   // An emulated 250 ms link each way: a command's round trip takes at least
