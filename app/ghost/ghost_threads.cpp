@@ -1,0 +1,293 @@
+// The predictive ghost's three threads (app/ghost/ghost.h): anchor,
+// present, trail. Each owns one World; they meet the GUI thread's calls
+// only under the Ghost's mutex, copying values in and out.
+
+#include <pthread.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "app/ghost/ghost_impl.h"
+#include "app/ghost/hold_policy.h"
+#include "sim/kinematics.h"
+#include "sim/readout.h"
+
+namespace sp {
+
+namespace {
+
+constexpr double kTrailPeriod = 0.25; // [s] between trails while nothing changes
+
+// Seconds as the steady clock's duration (Ghost::now() counts from its epoch).
+std::chrono::steady_clock::duration steady(double seconds) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+}
+
+// The calling thread yields to the rest of the process: re-anchoring and
+// the trail are best effort, and must not take the cores the robot's twin
+// and the window's frames need (Linux: a thread's nice value is its own).
+void yieldToOthers() { setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10); }
+// Names the calling thread (top -H, gdb): at most 15 characters.
+void nameThread(const char* name) { pthread_setname_np(pthread_self(), name); }
+
+}  // namespace
+
+void Ghost::anchorLoop() {
+  nameThread("ghost-anchor");
+  yieldToOthers();
+  std::shared_ptr<const Twin> twin;
+  std::unique_ptr<World> world;
+  Snapshot anchored;  // the last anchored state, commands in effect included
+  uint64_t seen = 0, applied = 0, epoch = 0;
+  HoldPolicy policy(held_, model_.robots[0].model);
+  double lastStart = -1e9;
+  for (;;) {
+    RobotFrame frame;
+    std::vector<SentCommand> effective, pending;
+    double target = 0;
+    {
+      std::unique_lock lock(mutex_);
+      anchorWake_.wait(lock, [&] { return stop_ || frameVersion_ != seen; });
+      // At most ghost.anchor_rate re-anchorings a second: the newest frame
+      // when the time comes.
+      anchorWake_.wait_until(lock, std::chrono::steady_clock::time_point(steady(lastStart + 1 / params_.ghostAnchorRate)),
+                             [&] { return stop_; });
+      if (stop_) return;
+      seen = frameVersion_;
+      frame = *frame_;
+      if (epoch != epoch_) {  // the robot restarted: weld and build anew
+        epoch = epoch_;
+        world.reset();
+        policy.reset();
+        applied = commands_.sent();
+      }
+      for (SentCommand& c : commands_.from(applied)) (c.time <= frame.time ? effective : pending).push_back(std::move(c));
+      target = options_.runAhead ? clock_.ghostTime(now()) : frame.time;
+    }
+    lastStart = now();
+    const size_t joints = model_.robots[0].model.joints.size();
+    if (frame.jointPositions.size() != joints || frame.jointRates.size() != joints) {
+      setProblem("telemetry at " + std::to_string(frame.time) + " s has " +
+                 std::to_string(frame.jointPositions.size()) + " joint positions and " +
+                 std::to_string(frame.jointRates.size()) + " rates; the robot has " + std::to_string(joints) +
+                 " joints");
+      continue;
+    }
+    const bool latched = frame.estop || frame.failsafe;
+    const HoldDecision decision =
+        policy.decide(frame, effective, pending, world && twin->rigid ? &*twin->rigid : nullptr, world != nullptr);
+    const bool hold = decision.hold;
+    if (decision.rebuild) {
+      std::string error;
+      std::shared_ptr<const Twin> next = makeTwin(frame.jointPositions, hold, error);
+      std::unique_ptr<World> built = next ? buildWorld(*next, &error) : nullptr;
+      if (!built) {
+        setProblem(error);
+        continue;
+      }
+      // The set-points of the commands in effect carry over.
+      if (world) carryControl(*world, *twin, *built, *next, frame.jointPositions);
+      twin = std::move(next);
+      world = std::move(built);
+      anchored = world->snapshot();
+      std::lock_guard lock(mutex_);
+      ++stats_.twins;
+      stats_.held = hold;
+    }
+    World& w = *world;
+    if (!effective.empty()) applied = effective.back().seq + 1;
+    if (latched) {
+      // The robot holds still and refuses what it is sent meanwhile.
+      if (!pending.empty()) applied = pending.back().seq + 1;
+      effective.assign(1, SentCommand{0, frame.time, StopCmd{}});
+      pending.clear();
+    }
+    if (!options_.inFlight) pending.clear();
+    for (const SentCommand& c : effective) w.submit(c.command);
+    if (!effective.empty() && !w.step()) {
+      w.restore(anchored);
+      setProblem("the ghost diverged applying the commands in effect: " + w.health().message());
+      continue;
+    }
+    std::vector<std::pair<std::string, Pose>> objects;
+    for (const ObjectReadout& o : frame.objects) objects.emplace_back(o.name, o.pose);
+    const std::vector<double> positions = twin->rigid ? rigidJoints(*twin->rigid, frame.jointPositions) : frame.jointPositions;
+    const std::vector<double> rates = twin->rigid ? rigidJoints(*twin->rigid, frame.jointRates) : frame.jointRates;
+    const std::string error = w.setRobotMotion(
+        0,
+        linkMotions(w.robotModel(0), frame.base, frame.hasBaseVelocity ? frame.baseLinearVelocity : Vec3{},
+                    frame.hasBaseVelocity ? frame.baseAngularVelocity : Vec3{}, positions, rates),
+        objects);
+    if (!error.empty()) {
+      w.restore(anchored);
+      setProblem("telemetry at " + std::to_string(frame.time) + " s does not fit the robot: " + error);
+      continue;
+    }
+    anchored = w.snapshot();
+    double t = frame.time;
+    size_t next = 0;
+    const bool ok = advance(w, t, target, pending, next);
+    auto base = std::make_shared<Base>();
+    base->twin = twin;
+    base->time = t;
+    base->nextSeq = next < pending.size() ? pending[next].seq : (pending.empty() ? applied : pending.back().seq + 1);
+    base->made = frame.time;
+    base->latched = latched;
+    if (ok) base->snapshot = w.snapshot();
+    const std::string health = ok ? "" : w.health().message();
+    w.restore(anchored);
+    if (!ok) {
+      setProblem("the ghost diverged predicting from " + std::to_string(frame.time) + " s: " + health);
+      continue;
+    }
+    {
+      std::lock_guard lock(mutex_);
+      if (epoch != epoch_) continue;  // a reset came meanwhile
+      base_ = std::move(base);
+      ++baseVersion_;
+      ++stats_.anchors;
+      stats_.anchorMs = (now() - lastStart) * 1000;
+      stats_.anchorSpan = t - frame.time;
+    }
+    presentWake_.notify_one();
+  }
+}
+
+void Ghost::presentLoop() {
+  nameThread("ghost-present");
+  std::shared_ptr<const Twin> twin;
+  std::unique_ptr<World> world;
+  std::shared_ptr<const Base> base;
+  uint64_t seenBase = 0, seenCommands = 0, next = 0;
+  double t = 0, lastTrail = -1e9;
+  const auto period = steady(options_.frameInterval);
+  for (;;) {
+    std::vector<SentCommand> commands;
+    double target = 0;
+    bool newBase = false, newCommands = false;
+    {
+      std::unique_lock lock(mutex_);
+      presentWake_.wait_for(lock, period,
+                            [&] { return stop_ || baseVersion_ != seenBase || commands_.sent() != seenCommands; });
+      if (stop_) return;
+      if (baseVersion_ != seenBase) {
+        seenBase = baseVersion_;
+        base = base_;
+        newBase = true;
+        next = base->nextSeq;
+      }
+      newCommands = commands_.sent() != seenCommands;
+      seenCommands = commands_.sent();
+      if (!base) continue;
+      if (!base->latched && options_.inFlight) commands = commands_.from(next);
+      target = options_.runAhead ? clock_.ghostTime(now()) : clock_.newest();
+    }
+    if (newBase && base->twin != twin) {
+      twin = base->twin;
+      world = buildWorld(*twin);  // the anchor thread built one from it: it builds
+    }
+    if (!world) continue;
+    if (newBase) {
+      world->restore(base->snapshot);
+      t = base->time;
+    }
+    World& w = *world;
+    size_t applied = 0;
+    if (!advance(w, t, target, commands, applied)) {
+      const std::string health = w.health().message();
+      w.restore(base->snapshot);
+      t = base->time;
+      next = base->nextSeq;
+      setProblem("the ghost diverged: " + health);
+      continue;
+    }
+    if (applied > 0) next = commands[applied - 1].seq + 1;
+    const RobotReadout r = readRobot(w);
+    const double wall = now();
+    std::shared_ptr<TrailRequest> trail;
+    if (newCommands || wall - lastTrail >= kTrailPeriod) {
+      trail = std::make_shared<TrailRequest>(TrailRequest{twin, w.snapshot(), t, next, base->latched, newCommands});
+      lastTrail = wall;
+    }
+    {
+      std::lock_guard lock(mutex_);
+      GhostView& v = view_;
+      ++v.version;
+      v.time = t;
+      v.span = t - clock_.newest();
+      v.base = r.base;
+      v.jointPositions = fullPositions(*twin, r.jointPositions, frame_ ? &frame_->jointPositions : nullptr);
+      v.objects = r.objects;
+      v.problem.clear();
+      v.commands = next;
+      ++stats_.views;
+      record_.shown(t, base->made, r.base);
+      if (trail) {
+        trailRequest_ = trail;
+        ++trailVersion_;
+      }
+    }
+    if (trail) trailWake_.notify_one();
+  }
+}
+
+void Ghost::trailLoop() {
+  nameThread("ghost-trail");
+  yieldToOthers();
+  std::shared_ptr<const Twin> twin;
+  std::unique_ptr<World> world;
+  uint64_t seen = 0;
+  for (;;) {
+    std::shared_ptr<const TrailRequest> request;
+    std::vector<SentCommand> commands;
+    {
+      std::unique_lock lock(mutex_);
+      trailWake_.wait(lock, [&] { return stop_ || trailVersion_ != seen; });
+      if (stop_) return;
+      seen = trailVersion_;
+      request = trailRequest_;
+      if (!request->latched && options_.inFlight) commands = commands_.from(request->nextSeq);
+    }
+    const double start = now();
+    if (request->twin != twin) {
+      twin = request->twin;
+      world = buildWorld(*twin);
+    }
+    if (!world) continue;
+    World& w = *world;
+    w.restore(request->snapshot);
+    double t = request->time;
+    size_t next = 0;
+    // The base's path on the ground: seen from behind the robot, a line at
+    // base height would run straight away from the eye and shrink to a dot.
+    const auto groundPoint = [&w] {
+      const Vec3 p = w.linkPose(0, 0).p;
+      return Vec3{p.x, p.y, w.terrainHeight(p.x, p.y)};
+    };
+    std::vector<Vec3> points{groundPoint()};
+    // Given up when the commands changed meanwhile; a newer request that
+    // only starts from a fresher state waits for this one to finish.
+    const auto superseded = [&] {
+      std::lock_guard lock(mutex_);
+      return stop_ || (trailVersion_ != seen && trailRequest_->urgent);
+    };
+    const int count = static_cast<int>(std::floor(params_.ghostHorizon / options_.trailSpacing + 1e-9));
+    bool complete = true;
+    for (int k = 1; k <= count && complete; ++k) {
+      complete = advance(w, t, request->time + k * options_.trailSpacing, commands, next, superseded);
+      if (complete) points.push_back(groundPoint());
+    }
+    if (!complete && superseded()) continue;
+    std::lock_guard lock(mutex_);
+    view_.trail = std::move(points);  // up to where it diverged, if it did
+    view_.trailTime = request->time;
+    ++view_.version;
+    ++stats_.trails;
+    stats_.trailMs = (now() - start) * 1000;
+  }
+}
+
+}  // namespace sp
