@@ -23,7 +23,7 @@ ActuatorOutput updateActuator(const ActuatorSpec& spec, ActuatorState& state, do
   ActuatorOutput out;
   switch (state.mode) {
     case JointMode::Velocity:
-      out.motorVelocity = std::clamp(state.velocity, -spec.maxVelocity, spec.maxVelocity);
+      out.motorVelocity = std::clamp(state.velocity * spec.velocityScale, -spec.maxVelocity, spec.maxVelocity);
       out.motorMaxForce = spec.maxTorque;
       break;
     case JointMode::Position: {

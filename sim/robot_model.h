@@ -49,6 +49,9 @@ struct LinkSpec {
   double mass = 0;  ///< [kg], distributed over the geoms by volume
   Pose pose;
   std::vector<GeomSpec> geoms;
+  /// [m] the centre of mass moved off where the geoms put it, link frame
+  /// (not in files: a perturbed robot's, sim/perturbation.h).
+  Vec3 centreOfMassShift;
   int line = 0;
 };
 
@@ -82,6 +85,9 @@ struct ActuatorSpec {
   double integralLimit = 0;       ///< clamp of the integral term [rad s]
   bool continuous = false;        ///< wrap angle errors to (-pi, pi]
   double initialTarget = 0;       ///< initial set-point of Position mode [rad]
+  /// The motor reaches this times the commanded speed in Velocity mode (not
+  /// in files: a perturbed robot's mis-calibrated speed loop, sim/perturbation.h).
+  double velocityScale = 1;
   int line = 0;
 };
 

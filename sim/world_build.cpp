@@ -252,6 +252,8 @@ bool World::build(Diagnostics& diag) {
     for (size_t li = 0; li < robot.links.size(); ++li) {
       const LinkSpec& link = robot.links[li];
       dMass mass = massOf(link.geoms, link.mass);
+      const Vec3& shift = link.centreOfMassShift;
+      if (shift.x != 0 || shift.y != 0 || shift.z != 0) dMassTranslate(&mass, shift.x, shift.y, shift.z);
       const Vec3 com{mass.c[0], mass.c[1], mass.c[2]};
       // ODE wants the centre of mass at the body origin.
       dMassTranslate(&mass, -com.x, -com.y, -com.z);

@@ -77,12 +77,13 @@ int main(int argc, char** argv) {
   const QCommandLineOption screenshot(QStringLiteral("screenshot"), QStringLiteral("Save a picture of the window after --quit-after seconds, then quit."), QStringLiteral("PNG"));
   const QCommandLineOption quitAfter(QStringLiteral("quit-after"), QStringLiteral("Quit after S seconds, printing the frame rate (for measurements)."), QStringLiteral("S"));
   const QCommandLineOption delay(QStringLiteral("delay"), QStringLiteral("The stand-in's link delays every frame by S seconds each way (rehearse a slow link; the ghost spans it)."), QStringLiteral("S"));
+  const QCommandLineOption perturb(QStringLiteral("perturb"), QStringLiteral("The stand-in is a robot that is not its twin: hidden deviations from the files drawn from SEED (simpartner-robot --help lists them)."), QStringLiteral("SEED"));
   const QCommandLineOption noGhost(QStringLiteral("no-ghost"), QStringLiteral("Do not run the predictive ghost."));
   const QCommandLineOption rules(QStringLiteral("rules"), QStringLiteral("Flight rules for rehearsals (default: built-in, see config/flight.rules)."), QStringLiteral("FILE"));
   const QCommandLineOption sequenceFile(QStringLiteral("sequence"), QStringLiteral("Open this command sequence in the Sequence dock."), QStringLiteral("FILE"));
   const QCommandLineOption replay(QStringLiteral("replay"), QStringLiteral("Open this session log in the Replay dock."), QStringLiteral("LOG"));
   const QCommandLineOption drive(QStringLiteral("drive"), QStringLiteral("Drive at SPEED m/s once in control (for demonstrations)."), QStringLiteral("SPEED"));
-  parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, delay, noGhost, monitor, screenshot, quitAfter, drive, rules,
+  parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, delay, perturb, noGhost, monitor, screenshot, quitAfter, drive, rules,
                      sequenceFile, replay});
   if (!parser.parse(QCoreApplication::arguments())) {
     std::cerr << "<command line>: error: " << parser.errorText().toStdString() << "\n";
@@ -131,6 +132,20 @@ int main(int argc, char** argv) {
     const std::optional<double> s = numberOption(parser, delay, 0, 60);
     if (!s) return 2;
     options.delay = *s;
+  }
+  if (parser.isSet(perturb)) {
+    bool ok = false;
+    const qulonglong seed = parser.value(perturb).toULongLong(&ok);
+    if (!ok) {
+      std::cerr << "<command line>: error: --perturb: expected a seed (an unsigned integer), got '"
+                << parser.value(perturb).toStdString() << "'\n";
+      return 2;
+    }
+    options.perturbSeed = seed;
+    if (!options.connectTo.isEmpty()) {
+      std::cerr << "<command line>: error: --perturb changes the built-in stand-in; it does not go with --connect\n";
+      return 2;
+    }
   }
   options.ghost = !parser.isSet(noGhost);
   if (parser.isSet(drive) && !(driveSpeed = numberOption(parser, drive, -10, 10))) return 2;

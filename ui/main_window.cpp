@@ -58,6 +58,7 @@ ConsoleSessionOptions toSessionOptions(const ConsoleOptions& o, const QString& l
   s.logDir = logDir.toStdString();
   s.rtf = o.rtf;
   s.delay = o.delay;
+  s.perturbSeed = o.perturbSeed;
   s.ghost = o.ghost;
   return s;
 }

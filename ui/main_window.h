@@ -73,6 +73,7 @@ struct ConsoleOptions {
   QString logDir;             ///< where logs go; "" = the user's data folder, `sessions/`
   double rtf = -1;            ///< stand-in real-time factor; < 0 = the parameters'
   double delay = 0;           ///< [s] one-way delay the stand-in's link emulates (each way)
+  std::optional<uint64_t> perturbSeed;  ///< the stand-in is a robot that is not its twin (sim/perturbation.h)
   bool ghost = true;          ///< run and show the predictive ghost
   bool takeControl = true;    ///< ask for the lease as soon as connected
   QString rules;              ///< flight rules file for rehearsals; "" = the built-in defaults

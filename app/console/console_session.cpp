@@ -138,6 +138,7 @@ std::string ConsoleSession::startStandIn(const std::string& worldFile, const std
   if (options_.rtf >= 0) o.realTimeFactor = options_.rtf;
   o.log = options_.log;
   o.logDir = options_.logDir;
+  o.perturbSeed = options_.perturbSeed;
   o.emulation.delay = options_.delay;
   Diagnostics diag;
   std::unique_ptr<StandInRobot> standIn = StandInRobot::create(o, diag);

@@ -45,6 +45,10 @@ struct ConsoleSessionOptions {
   std::string logDir = "sessions";     ///< where new logs go
   double rtf = -1;                     ///< stand-in real-time factor; < 0 = the parameters'
   double delay = 0;                    ///< [s] the stand-in's link emulates this one-way delay (each way)
+  /// The stand-in is a robot that is not its twin: hidden deviations drawn
+  /// from this seed (sim/perturbation.h); the console's twin, ghost and
+  /// rehearsals keep the files. nullopt = the stand-in runs the files.
+  std::optional<uint64_t> perturbSeed;
   bool ghost = true;                   ///< run the predictive ghost (app/ghost/ghost.h)
   Ghost::Options ghostOptions;         ///< its options (tests' controls)
 };

@@ -1,6 +1,7 @@
 #include "app/log/resimulation.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -69,7 +70,17 @@ std::optional<LoggedWorld> loggedWorld(const SessionLogReader& reader, const std
       error = path + ": cannot apply the logged override '" + e.text + "':\n" + diag.format();
       return std::nullopt;
     }
-  return LoggedWorld{std::move(*model), params};
+  LoggedWorld logged{std::move(*model), params, std::nullopt};
+  if (const std::string seed = get(meta, "perturbation_seed"); !seed.empty()) {
+    char* end = nullptr;
+    const unsigned long long value = std::strtoull(seed.c_str(), &end, 10);
+    if (end == seed.c_str() || *end != '\0') {
+      error = path + ": meta perturbation_seed: expected an unsigned integer, got '" + seed + "'";
+      return std::nullopt;
+    }
+    logged.perturbation = drawPerturbation(value, logged.world.robots[0].model);
+  }
+  return logged;
 }
 
 namespace {
@@ -93,7 +104,7 @@ std::optional<Replay> openReplay(const std::string& path, double from, std::stri
   if (!logged) return std::nullopt;
   r.logged = std::move(*logged);
   Diagnostics diag;
-  r.world = World::create(r.logged.world, r.logged.params, diag);
+  r.world = World::create(r.logged.physicsWorld(), r.logged.params, diag);
   if (!r.world) {
     error = path + ": cannot build the logged world:\n" + diag.format();
     return std::nullopt;

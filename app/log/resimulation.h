@@ -19,6 +19,7 @@
 #include <map>
 
 #include "sim/params.h"
+#include "sim/perturbation.h"
 #include "sim/robot_model.h"
 #include "sim/world.h"
 
@@ -29,8 +30,13 @@ class SessionLogReader;
 /// The world and parameters a log was recorded with, rebuilt from the files
 /// it stores (see above) and its parameter overrides.
 struct LoggedWorld {
-  WorldModel world;
+  WorldModel world;   ///< as the files say
   SimParams params;
+  /// The logged robot's hidden deviations (meta `perturbation_seed`), if it
+  /// was a robot that is not its twin: its physics is physicsWorld().
+  std::optional<Perturbation> perturbation;
+  /// The world the logged robot's physics ran: world, perturbed if it was.
+  WorldModel physicsWorld() const { return perturbation ? perturbWorld(world, *perturbation) : world; }
 };
 /// nullopt and `error` (naming `path`) when the log holds no files or they
 /// do not load.

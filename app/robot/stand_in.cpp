@@ -12,6 +12,7 @@
 #include "net/auth.h"
 #include "net/robot_server.h"
 #include "sim/model_loader.h"
+#include "sim/perturbation.h"
 
 namespace sp {
 
@@ -48,7 +49,12 @@ std::unique_ptr<StandInRobot> StandInRobot::create(const StandInOptions& options
   }
   if (diag.hasErrors() || !params || !model) return nullptr;
   if (options.realTimeFactor) params->realTimeFactor = *options.realTimeFactor;
-  std::unique_ptr<World> world = World::create(*model, *params, diag);
+  // A robot that is not its twin runs perturbed physics; what it announces
+  // and logs as its files stays the files.
+  std::optional<Perturbation> perturbation;
+  if (options.perturbSeed) perturbation = drawPerturbation(*options.perturbSeed, model->robots[0].model);
+  std::unique_ptr<World> world =
+      World::create(perturbation ? perturbWorld(*model, *perturbation) : *model, *params, diag);
   if (!world) return nullptr;
   if (options.startState) {
     if (std::string why = world->restore(*options.startState); !why.empty()) {
@@ -57,6 +63,7 @@ std::unique_ptr<StandInRobot> StandInRobot::create(const StandInOptions& options
     }
   }
   auto host = std::make_unique<TwinHost>(std::move(world), params->realTimeFactor);
+  if (perturbation) host->setDeviations(perturbation->delay, perturbation->rollBias, perturbation->pitchBias);
   return std::unique_ptr<StandInRobot>(new StandInRobot(options, std::move(*model), std::move(host), *params, std::move(replacedRobotFile)));
 }
 
@@ -70,6 +77,15 @@ StandInRobot::StandInRobot(StandInOptions options, WorldModel world, std::unique
       host_(std::move(host)) {}
 
 StandInRobot::~StandInRobot() { stop(); }
+
+std::map<std::string, std::string> StandInRobot::logMeta() const {
+  std::map<std::string, std::string> meta = options_.logMeta;
+  if (options_.perturbSeed) {
+    meta["perturbation_seed"] = std::to_string(*options_.perturbSeed);
+    meta["perturbation"] = drawPerturbation(*options_.perturbSeed, world_.robots[0].model).report(world_.robots[0].model);
+  }
+  return meta;
+}
 
 std::string StandInRobot::chooseLogPath(std::string& error) const {
   if (!options_.logPath.empty()) return options_.logPath;
@@ -123,7 +139,7 @@ std::string StandInRobot::start() {
                                .commandsFile = {},
                                .overrides = options_.overrides,
                                .replacedRobotFile = replacedRobotFile_,
-                               .extraMeta = options_.logMeta},
+                               .extraMeta = logMeta()},
                               error);
     if (!writer) {
       server->server->stop();

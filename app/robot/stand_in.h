@@ -68,6 +68,11 @@ struct StandInOptions {
   /// Take terrain edits over the link (a simulator's capability, announced
   /// in WELCOME as `terrain_edit`); false behaves as a real robot: refused.
   bool terrainEdits = true;
+  /// A robot that is not its twin: hidden deviations from the files drawn
+  /// from this seed (sim/perturbation.h); none when unset. WELCOME's file
+  /// hashes stay the files'; the session log records the deviations (meta
+  /// `perturbation_seed` and `perturbation`), and re-simulation applies them.
+  std::optional<uint64_t> perturbSeed;
   /// Further meta for the session log (`parent_log`, `parent_time`).
   std::map<std::string, std::string> logMeta;
   /// Lines for the operator (no newline): connections, refusals, lease
@@ -148,6 +153,8 @@ class StandInRobot {
                std::string replacedRobotFile);
   // The log file for this start; "" and `error` set if none can be made.
   std::string chooseLogPath(std::string& error) const;
+  /// The session log's extra meta: the options' and the perturbation's.
+  std::map<std::string, std::string> logMeta() const;
 
   StandInOptions options_;
   std::string replacedRobotFile_;  // the world's own robot file, when options_.robotFile replaced it

@@ -180,6 +180,9 @@ void TwinHost::publish() {
   const World& w = *world_;
   const RobotReadout r = readRobot(w, 0);
   net::RobotState s = stateFromReadout(r, jointNames_);
+  // What the robot's IMU reports, its bias included (the log keeps the truth).
+  s.roll += rollBias_;
+  s.pitch += pitchBias_;
   int laser = -1;
   for (size_t i = 0; i < model_.sensors.size() && laser < 0; ++i)
     if (model_.sensors[i].type == SensorType::Laser) laser = static_cast<int>(i);
@@ -217,10 +220,20 @@ void TwinHost::takeCommands() {
     // (An ABORT or a stop of the link's came through takeSequence() first.)
     abortRunning("an operator command took over");
   }
-  for (const Command& c : commands) {
+  // A robot with an actuator delay acts on a command that long after it
+  // arrived (0 s: at once, in arrival order as always).
+  for (Command& c : commands) delayed_.emplace_back(w.time() + delay_, std::move(c));
+  submitDue(false);
+}
+
+void TwinHost::submitDue(bool all) {
+  World& w = *world_;
+  while (!delayed_.empty() && (all || delayed_.front().first <= w.time() + 1e-9)) {
+    const Command& c = delayed_.front().second;
     // Checked by the server already; a command the World still refuses was
     // not applied, so it is not logged either.
     if (w.submit(c).empty() && log_) log_->writer().logCommand(w.stepCount(), w.time(), "operator", c, &model_);
+    delayed_.pop_front();
   }
 }
 
@@ -236,6 +249,7 @@ void TwinHost::run() {
   runner.setSubmitHook([this](const ScheduledCommand& c, const std::string& why) { sequenceCommand(c, why); });
   runner.setMonitor([&](const World& w) {
     if (log_) log_->stepped(w);
+    if (!delayed_.empty()) submitDue(false);  // a delayed command acts at its step
     if (w.stepCount() % publishEvery == 0) publish();
     return true;
   });
@@ -263,14 +277,15 @@ void TwinHost::run() {
   }
   // One more step for commands queued since the last pass: a command the
   // server accepted (an e-stop's stop, say) is applied and logged, not lost.
-  bool queued = false;
+  bool queued = !delayed_.empty();
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    queued = !pending_.empty();
+    queued = queued || !pending_.empty();
   }
   if (queued) {
     takeSequence();
     takeCommands();
+    submitDue(true);  // a delayed one too: nothing is left unapplied
     runner.advanceBy(1);
     logHealth();
     publish();

@@ -11,6 +11,7 @@
 // start() and stop() belong to the owner's thread.
 
 #include <atomic>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -44,6 +45,14 @@ class TwinHost : public net::RobotPort {
   /// heightfield) over the link: a simulator's capability, announced in
   /// WELCOME as `terrain_edit`. Off by default: a robot refuses them.
   void acceptTerrainEdits(bool on) { terrainEdits_ = on; }
+  /// A robot that is not its twin (sim/perturbation.h): commands take
+  /// effect `delay` [s] after they arrive, and the reported roll and pitch
+  /// carry these biases [rad]. Before start().
+  void setDeviations(double delay, double rollBias, double pitchBias) {
+    delay_ = delay;
+    rollBias_ = rollBias;
+    pitchBias_ = pitchBias;
+  }
   bool acceptsTerrainEdits() const { return terrainEdits_; }
   /// Starts the physics thread. Once only.
   void start();
@@ -91,6 +100,8 @@ class TwinHost : public net::RobotPort {
   // Logs the queued events, then submits the queued commands and logs those
   // the World took. Physics thread.
   void takeCommands();
+  /// Submits the delayed commands due by now (all of them when `all`).
+  void submitDue(bool all);
   // The "health" event, once, when the World has diverged. Physics thread.
   void logHealth();
   // Starts an accepted sequence, then aborts it for the queued reasons.
@@ -119,6 +130,8 @@ class TwinHost : public net::RobotPort {
   Runner* runner_ = nullptr;     // physics thread: run()'s step loop
   mutable std::mutex mutex_;  // guards the seven below
   std::vector<Command> pending_;
+  double delay_ = 0, rollBias_ = 0, pitchBias_ = 0;  // setDeviations()
+  std::deque<std::pair<double, Command>> delayed_;    // (sim time due, command); physics thread
   std::vector<PendingEvent> events_;
   net::RobotState state_;
   net::LaserScanState laser_;

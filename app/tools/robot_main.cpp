@@ -13,6 +13,8 @@
 
 #include "app/robot/line_writer.h"
 #include "app/robot/stand_in.h"
+#include "sim/model_loader.h"
+#include "sim/perturbation.h"
 
 namespace {
 
@@ -35,6 +37,13 @@ constexpr const char* kUsage = R"(usage:
       --no-log          write no session log
       --no-terrain-edits  refuse terrain edits as a real robot does (the
                         stand-in, a simulator, takes them by default)
+      --perturb SEED    a robot that is not its twin: hidden deviations from
+                        the files drawn from SEED (wheel radius +-3 %, link
+                        masses +-15 % and centres of mass +-2 cm, friction
+                        +-30 %, wheel torque limit and speed gain +-20 %,
+                        actuator delay 0-60 ms, IMU roll/pitch bias +-1 deg);
+                        WELCOME and telemetry do not tell them, the log does
+      --perturb-report  print the deviations (with --perturb) and exit
   Prints `logging to PATH`, then `listening on ADDRESS:PORT` when ready;
   connections, lease changes and e-stops go to stderr. On SIGINT or SIGTERM
   it stops every motor (as an e-stop), tells every client why and closes
@@ -48,6 +57,7 @@ constexpr const char* kUsage = R"(usage:
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   sp::StandInOptions options;
+  bool perturbReport = false;
   // The link's lines go through their own thread: the link thread (which
   // runs the deadman) never waits for a stderr nobody reads.
   sp::LineWriter lines(STDERR_FILENO, "simpartner-robot: ");
@@ -66,6 +76,10 @@ int main(int argc, char** argv) {
       options.terrainEdits = false;
       continue;
     }
+    if (a == "--perturb-report") {
+      perturbReport = true;
+      continue;
+    }
     if (i + 1 >= args.size()) {
       std::cerr << "<command line>: error: unknown option or missing value '" << a << "'\n" << kUsage;
       return 2;
@@ -80,6 +94,15 @@ int main(int argc, char** argv) {
     else if (a == "--rtf") options.realTimeFactor = v == "max" ? 0.0 : std::atof(v.c_str());
     else if (a == "--log") options.logPath = v;
     else if (a == "--log-dir") options.logDir = v;
+    else if (a == "--perturb") {
+      char* end = nullptr;
+      const unsigned long long seed = std::strtoull(v.c_str(), &end, 10);
+      if (v.empty() || v[0] == '-' || end == v.c_str() || *end != '\0') {
+        std::cerr << "<command line>: error: --perturb: expected a seed (an unsigned integer), got '" << v << "'\n";
+        return 2;
+      }
+      options.perturbSeed = seed;
+    }
     else if (a == "--delay" || a == "--jitter" || a == "--loss") {
       char* end = nullptr;
       const double x = std::strtod(v.c_str(), &end);
@@ -99,6 +122,18 @@ int main(int argc, char** argv) {
   if (options.worldFile.empty()) {
     std::cerr << "<command line>: error: --world FILE is required\n" << kUsage;
     return 2;
+  }
+  if (perturbReport) {
+    if (!options.perturbSeed) {
+      std::cerr << "<command line>: error: --perturb-report needs --perturb SEED\n";
+      return 2;
+    }
+    sp::Diagnostics diag;
+    const std::optional<sp::WorldModel> world = sp::loadWorld(options.worldFile, diag);
+    std::cerr << diag.format();
+    if (!world || world->robots.empty()) return 1;
+    std::cout << sp::drawPerturbation(*options.perturbSeed, world->robots[0].model).report(world->robots[0].model);
+    return 0;
   }
   const std::string& bind = options.bind;
   if (options.token.empty() && !(bind == "127.0.0.1" || bind == "::1" || bind == "localhost")) {

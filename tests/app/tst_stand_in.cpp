@@ -25,6 +25,10 @@
 #include "app/robot/stand_in.h"
 #include "net/robot_client.h"
 #include "tests/app/shared_state.h"
+#include "sim/model_loader.h"
+#include "sim/perturbation.h"
+
+#include <sqlite3.h>
 
 using namespace sp;
 using namespace sp::net;
@@ -328,6 +332,89 @@ class TestStandIn : public QObject {
     QCOMPARE(robot->logPath(), std::string());
     QVERIFY(!robot->logFailed());
     QVERIFY(!std::filesystem::exists(o.logDir));
+  }
+
+  // A robot that is not its twin (--perturb SEED): it tells nothing of its
+  // deviations (WELCOME's file hashes are the files'), it reports its IMU
+  // bias (roll at rest on flat ground is the drawn bias), its log records
+  // the deviations and re-simulates hash for hash with them; the same log
+  // re-simulated as if unperturbed diverges (the control).
+  void perturbedRobotHidesItsDeviations() {
+    QTemporaryDir dir;
+    const std::string plainLog = dir.filePath("plain.splog").toStdString();
+    const std::string path = dir.filePath("perturbed.splog").toStdString();
+    const auto welcomeAndRoll = [&](const std::string& log, std::optional<uint64_t> seed, std::string& worldHash,
+                                    std::string& robotHash, double& roll) {
+      StandInOptions o = options(log);
+      o.perturbSeed = seed;
+      Diagnostics diag;
+      auto robot = StandInRobot::create(o, diag);
+      QVERIFY2(robot, diag.format().c_str());
+      QCOMPARE(robot->start(), std::string());
+      struct Latest : sp::test::SharedState {
+        bool ready = false, lease = false;
+        std::optional<TelemetryMsg> telemetry;
+      } seen;
+      RobotClientConfig config;
+      config.port = robot->port();
+      config.token = robot->token();
+      config.name = "tester";
+      RobotClientCallbacks cb;
+      cb.connection = [&](ConnectionState s, const std::string&) { seen.add([&] { seen.ready = s == ConnectionState::Ready; }); };
+      cb.lease = [&](const LeaseStateMsg& m) { seen.add([&] { seen.lease = m.yours; }); };
+      cb.telemetry = [&](const TelemetryMsg& t) { seen.add([&] { seen.telemetry = t; }); };
+      RobotClient client(config, cb);
+      client.start();
+      QVERIFY(seen.waitFor([&] { return seen.ready; }));
+      std::this_thread::sleep_for(1500ms);  // settled on the ground
+      double settled = 0;
+      seen.add([&] { settled = seen.telemetry ? seen.telemetry->roll : 1e9; });
+      roll = settled;
+      worldHash = client.stats().robotWorldHash;
+      robotHash = client.stats().robotRobotHash;
+      client.acquireLease();
+      QVERIFY(seen.waitFor([&] { return seen.lease; }));
+      client.sendCommandText("drive 0.5 10");
+      std::this_thread::sleep_for(1500ms);  // past a periodic snapshot, turning
+      client.stop();
+      robot->stop();
+    };
+    std::string plainWorld, plainRobot, world, robotHash;
+    double plainRoll = 0, roll = 0;
+    welcomeAndRoll(plainLog, std::nullopt, plainWorld, plainRobot, plainRoll);
+    welcomeAndRoll(path, 11, world, robotHash, roll);
+    QVERIFY(!world.empty());
+    QCOMPARE(world, plainWorld);
+    QCOMPARE(robotHash, plainRobot);
+    Diagnostics diag;
+    const RobotModel robot = loadWorld(sourcePath("terrains/flat.world.xml"), diag)->robots[0].model;
+    const Perturbation p = drawPerturbation(11, robot);
+    qInfo("roll at rest: %.5f rad unperturbed, %.5f perturbed (drawn bias %.5f)", plainRoll, roll, p.rollBias);
+    QVERIFY(std::abs((roll - plainRoll) - p.rollBias) < 0.002);
+
+    std::string error;
+    auto reader = SessionLogReader::open(path, error);
+    QVERIFY2(reader, error.c_str());
+    const auto meta = reader->meta();
+    QCOMPARE(meta.at("perturbation_seed"), std::string("11"));
+    QCOMPARE(meta.at("perturbation"), p.report(robot));
+    reader.reset();
+    const std::optional<ResimReport> r = resimulate(path, {}, error);
+    QVERIFY2(r, error.c_str());
+    QVERIFY2(!r->divergence, "the perturbed log does not re-simulate with its deviations");
+    QVERIFY(r->hashesCompared >= 2);
+    // Control: the same log as if the robot were its twin.
+    const std::string copy = dir.filePath("unperturbed.splog").toStdString();
+    std::filesystem::copy_file(path, copy);
+    {
+      sqlite3* db = nullptr;
+      QCOMPARE(sqlite3_open(copy.c_str(), &db), SQLITE_OK);
+      QCOMPARE(sqlite3_exec(db, "DELETE FROM meta WHERE key LIKE 'perturbation%'", nullptr, nullptr, nullptr), SQLITE_OK);
+      sqlite3_close(db);
+    }
+    const std::optional<ResimReport> control = resimulate(copy, {}, error);
+    QVERIFY2(control, error.c_str());
+    QVERIFY2(control->divergence, "re-simulated without its deviations, the log still matched: they change nothing");
   }
 
   // start() refuses a log file that exists, and then runs nothing; create()

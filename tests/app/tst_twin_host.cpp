@@ -102,6 +102,46 @@ class TestTwinHost : public QObject {
     QVERIFY(reader->hashes().size() >= 2);
   }
 
+  // A robot with an actuator delay (sim/perturbation.h) acts on a command
+  // that long after it arrives: the logged step of a command handed over
+  // at sim time t is at t + 50 ms (one pacing pass of slack); without a
+  // delay, at t (the control). A command still delayed at stop() is applied.
+  void actuatorDelay_data() {
+    QTest::addColumn<double>("delay");
+    QTest::newRow("50 ms") << 0.05;
+    QTest::newRow("control: none") << 0.0;
+  }
+  void actuatorDelay() {
+    QFETCH(double, delay);
+    QTemporaryDir dir;
+    const std::string logPath = dir.filePath("delay.splog").toStdString();
+    auto world = flatWorld();
+    QVERIFY(world);
+    SessionSources sources;
+    sources.worldFile = world->model().file;
+    sources.robotFile = world->robotModel(0).file;
+    TwinHost host(std::move(world), 1.0);
+    host.setDeviations(delay, 0, 0);
+    std::string error;
+    host.logTo(openSessionLog(logPath, sources, error));
+    QVERIFY2(host.log(), error.c_str());
+    host.start();
+    QVERIFY(waitFor([&] { return host.state().time > 0.3; }));
+    const double handed = host.state().time;  // published at 100 Hz: at most 10 ms old
+    host.apply({DriveCmd{0.3, 0}});
+    QVERIFY(waitFor([&] { return host.state().time > handed + 0.3; }));
+    host.apply({StopCmd{}});
+    host.stop();
+    auto reader = SessionLogReader::open(logPath, error);
+    QVERIFY2(reader, error.c_str());
+    const std::vector<LogCommand> commands = reader->commands();
+    QCOMPARE(commands.size(), size_t{2});
+    const double lag = commands[0].time - handed;
+    qInfo("delay %.3f s: the command acted %.1f ms after it was handed over", delay, lag * 1000);
+    QVERIFY2(lag >= delay - 0.002 && lag <= delay + 0.025, qPrintable(QString::number(lag)));
+    QCOMPARE(QString::fromStdString(commands[1].text), QString("stop"));
+  }
+
   // A diverging twin stops, says why in its state, and logs a health event.
   void divergenceReported() {
     QTemporaryDir dir;

@@ -1,0 +1,71 @@
+#pragma once
+// A robot that is not its twin: hidden deviations of a real robot from its
+// model files, drawn from a seed within documented ranges, so that what
+// predicts or rehearses (the console's twin) can be tested against a robot
+// whose physics differs from the files (`simpartner-robot --perturb SEED`).
+//
+//   sp::Perturbation p = sp::drawPerturbation(seed, world.robots[0].model);
+//   sp::WorldModel robotsWorld = sp::perturbWorld(world, p);  // the robot's physics
+//   // p.delay and p.rollBias / p.pitchBias are the robot's own (app/robot/twin_host.h)
+//
+// What is drawn (each uniform in its range, from the seed alone):
+//   wheel radius      per wheel (FL FR RL RR), ± 3 %: the tyres' effective radius; the
+//                     robot's controller keeps the nominal one (it does not know)
+//   link mass         per link, ± 15 %
+//   centre of mass    per link, ± 2 cm on each axis (link frame)
+//   friction          every contact's mu, ± 30 % (one factor: the ground)
+//   torque limit      the wheel motors' torque limit, ± 20 %
+//   velocity gain     the wheel motors reach gain x the commanded speed, ± 20 %
+//   actuator delay    0 – 60 ms between a command's arrival and its effect
+//   IMU bias          roll and pitch each ± 1°, in what the robot reports
+//
+// Thread: pure functions of their arguments.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sim/math.h"
+#include "sim/robot_model.h"
+
+namespace sp {
+
+/// The ranges a perturbation is drawn from (the issue's; tests may narrow them).
+struct PerturbationRanges {
+  double wheelRadius = 0.03;          ///< relative, ±
+  double mass = 0.15;                 ///< relative, ±
+  double centreOfMass = 0.02;         ///< [m], ± per axis
+  double friction = 0.30;             ///< relative, ±
+  double torqueLimit = 0.20;          ///< relative, ±
+  double velocityGain = 0.20;         ///< relative, ±
+  double maxDelay = 0.060;            ///< [s], from 0
+  double imuBias = degToRad(1.0);     ///< [rad], ±
+};
+
+/// The deviations of one robot from its files.
+struct Perturbation {
+  uint64_t seed = 0;
+  std::array<double, 4> wheelRadius{1, 1, 1, 1};  ///< factor per wheel (FL FR RL RR)
+  std::vector<double> linkMass;        ///< factor per link (model order)
+  std::vector<Vec3> centreOfMass;      ///< [m] shift per link, link frame
+  double friction = 1;                 ///< factor on every contact's mu
+  double torqueLimit = 1;              ///< factor on the wheel motors' torque limit
+  double velocityGain = 1;             ///< factor on the wheel motors' speed
+  double delay = 0;                    ///< [s] actuator delay
+  double rollBias = 0, pitchBias = 0;  ///< [rad] added to the reported roll and pitch
+
+  /// One `key = value` line per deviation (links by name), for reports and
+  /// the session log's meta.
+  std::string report(const RobotModel& robot) const;
+};
+
+/// The deviations of `robot` drawn from `seed` within `ranges`.
+Perturbation drawPerturbation(uint64_t seed, const RobotModel& robot, const PerturbationRanges& ranges = {});
+
+/// `world` with its first robot's physics perturbed by `p` (wheel geoms'
+/// radius, link masses and centres of mass, contact friction, wheel
+/// motors); the delay and the IMU bias are applied by the robot's host.
+WorldModel perturbWorld(WorldModel world, const Perturbation& p);
+
+}  // namespace sp
