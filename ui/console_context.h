@@ -61,7 +61,8 @@ class ConsoleHost {
   virtual ~ConsoleHost() = default;
   /// Opens `path` as the console's world: "" or why not (shown unless `quiet`).
   virtual QString openWorld(const QString& path, bool quiet) = 0;
-  /// Restarts the stand-in from a replayed log's state: "" or why not.
+  /// Restarts the stand-in from a replayed log's state: "" or why not
+  /// (shown unless `quiet`). The caller closes its replay.
   virtual QString startBranch(const QString& logPath, const BranchPoint& point, bool quiet) = 0;
   /// The session switched robots (connected elsewhere, reset, ...): the
   /// views follow its world (forgetting the old robot's frames when

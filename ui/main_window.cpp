@@ -479,7 +479,6 @@ QString MainWindow::startBranch(const QString& logPath, const BranchPoint& point
     if (!quiet) context_->showError(tr("Simulate from here"), qs(error));
     return qs(error);
   }
-  replayPanel()->close();
   const double time = static_cast<double>(point.step) * point.logged.params.step;
   context_->event(QStringLiteral("note"), tr("branch of %1 at t = %2 s%3")
                                         .arg(logPath)
@@ -516,8 +515,7 @@ void MainWindow::onFeedSwitched(RobotFeed* feed) {
     }
     scene_->setGhostVisible(false);
     wheelPlot_->clear();
-    const auto* player = replayPanel() ? replayPanel()->player() : nullptr;
-    monitor_->state().replay(player ? QFileInfo(qs(player->path())).fileName().toStdString() : feed->sourceName().toStdString());
+    monitor_->state().replay(feed->label().toStdString());
   } else if (state().replaying()) {
     monitor_->state().replay({});
     showWorld(*session_->world(), false);

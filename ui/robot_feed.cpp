@@ -1,5 +1,7 @@
 #include "ui/robot_feed.h"
 
+#include <QFileInfo>
+
 #include <chrono>
 
 #include "app/console/console_session.h"
@@ -80,6 +82,11 @@ const WorldModel* ReplayFeed::shownWorld() const {
 }
 
 void ReplayFeed::seek(double time) { panel_->seek(time); }
+
+QString ReplayFeed::label() const {
+  const LogPlayer* player = panel_->player();
+  return player ? QFileInfo(QString::fromStdString(player->path())).fileName() : sourceName();
+}
 
 GhostFeed::GhostFeed(ConsoleSession* session, QObject* parent) : RobotFeed(parent), session_(session) {}
 

@@ -38,6 +38,8 @@ class RobotFeed : public QObject {
   using QObject::QObject;
   /// What the operator calls this source ("live link", "replay", "ghost").
   virtual QString sourceName() const = 0;
+  /// What exactly is shown, for the banner ("demo.splog"); sourceName() by default.
+  virtual QString label() const { return sourceName(); }
   /// The world this feed's frames move in (drawn when the feed is shown),
   /// or null before it has one.
   virtual const WorldModel* shownWorld() const = 0;
@@ -97,6 +99,8 @@ class ReplayFeed : public RobotFeed {
   /// `panel` must outlive the feed.
   explicit ReplayFeed(ReplayPanel* panel, QObject* parent = nullptr);
   QString sourceName() const override { return tr("replay"); }
+  /// The log's file name ("replay" before one is open).
+  QString label() const override;
   const WorldModel* shownWorld() const override;
   /// Moves the replay's cursor to `time` [s]; the frame there follows.
   void seek(double time);

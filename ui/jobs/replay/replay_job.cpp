@@ -26,7 +26,8 @@ void ReplayJob::install(ConsoleContext& context) {
   connect(panel_, &ReplayPanel::opened, this, &ReplayJob::opened);
   connect(panel_, &ReplayPanel::closed, this, &ReplayJob::closed);
   connect(panel_, &ReplayPanel::branchReady, this, [this](const QString& log, std::shared_ptr<const BranchPoint> point) {
-    context_->host().startBranch(log, *point, false);
+    // The branch runs live now: the replay it came from closes.
+    if (context_->host().startBranch(log, *point, false).isEmpty()) panel_->close();
   });
   connect(panel_, &ReplayPanel::failed, this, [this](const QString& message) {
     if (!panel_->isOpen()) dock_->hide();  // a log that did not open
