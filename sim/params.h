@@ -51,6 +51,20 @@ struct SimParams {
   /// still (comma-separated names, or "none"; the wheels and articulation
   /// keep turning): fewer bodies, faster predictions (sim/rigid.h).
   std::string ghostHold = "waist_yaw,hip_fl,hip_fr,hip_rl,hip_rr";
+  // The twin calibrated to a robot (app/calibration/calibration.h): what
+  // the twins the console starts (ghost, rehearsals, sweeps, run) differ
+  // from the files by. Factors on the files' values; identity by default.
+  double calWheelRadius = 1;       ///< tyres' effective radius, both axles
+  double calWheelRadiusSplit = 0;  ///< front minus rear radius, relative (front x (1 + s/2), rear x (1 - s/2))
+  double calFriction = 1;          ///< every contact's mu
+  double calMotorGain = 1;         ///< wheel motors reach gain x the commanded speed
+  double calDelay = 0;             ///< [s] between a command's arrival and its effect
+  double calMass = 1;              ///< every link's mass
+  /// Whether any calibration.* key differs from the files (identity).
+  bool calibrated() const {
+    return calWheelRadius != 1 || calWheelRadiusSplit != 0 || calFriction != 1 || calMotorGain != 1 ||
+           calDelay != 0 || calMass != 1;
+  }
   // Gaits (sim/gait.h); swings in degrees about the stance pose
   double caterpillarHipSwing = 12;   ///< [deg]
   double caterpillarPhaseTime = 1.0; ///< [s] per half cycle

@@ -62,6 +62,20 @@ WorldModel perturbWorld(WorldModel world, const Perturbation& p) {
   return world;
 }
 
+WorldModel calibratedWorld(const WorldModel& world, const SimParams& params) {
+  if (!params.calibrated() || world.robots.empty()) return world;
+  Perturbation p;
+  const double front = params.calWheelRadius * (1 + params.calWheelRadiusSplit / 2);
+  const double rear = params.calWheelRadius * (1 - params.calWheelRadiusSplit / 2);
+  p.wheelRadius = {front, front, rear, rear};
+  const size_t links = world.robots[0].model.links.size();
+  p.linkMass.assign(links, params.calMass);
+  p.centreOfMass.assign(links, Vec3{});
+  p.friction = params.calFriction;
+  p.velocityGain = params.calMotorGain;
+  return perturbWorld(world, p);
+}
+
 std::string Perturbation::report(const RobotModel& robot) const {
   std::string out = "seed = " + std::to_string(seed) + "\n";
   static const char* kWheels[] = {"fl", "fr", "rl", "rr"};

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "sim/math.h"
+#include "sim/params.h"
 #include "sim/robot_model.h"
 
 namespace sp {
@@ -67,5 +68,11 @@ Perturbation drawPerturbation(uint64_t seed, const RobotModel& robot, const Pert
 /// radius, link masses and centres of mass, contact friction, wheel
 /// motors); the delay and the IMU bias are applied by the robot's host.
 WorldModel perturbWorld(WorldModel world, const Perturbation& p);
+
+/// `world` as a twin calibrated by `params`' calibration.* keys sees it:
+/// the first robot's tyres, link masses, contact friction and wheel motors
+/// scaled (the delay is the caller's: it schedules the commands). `world`
+/// itself when the keys are the files' (identity).
+WorldModel calibratedWorld(const WorldModel& world, const SimParams& params);
 
 }  // namespace sp

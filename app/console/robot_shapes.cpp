@@ -92,6 +92,22 @@ RobotFrame frameFromSample(const LogSample& s, size_t joints) {
   return f;
 }
 
+RobotFrame frameFromReadout(const RobotReadout& r) {
+  RobotFrame f;
+  f.time = r.time;
+  f.base = r.base;
+  f.hasBaseVelocity = true;
+  f.baseLinearVelocity = r.baseLinearVelocity;
+  f.baseAngularVelocity = r.baseAngularVelocity;
+  f.jointPositions = r.jointPositions;
+  f.jointRates = r.jointRates;
+  f.wheelNormal = r.wheelNormal;
+  f.roll = r.roll;
+  f.pitch = r.pitch;
+  f.health = r.health;
+  return f;
+}
+
 RobotFrame frameFromGhost(const GhostView& v) {
   RobotFrame f;
   f.time = v.time;

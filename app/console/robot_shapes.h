@@ -13,7 +13,7 @@
 //   RobotReadout ──stateFromReadout──► RobotState ──(link)──► TelemetryMsg
 //   RobotReadout ──sampleFromReadout─► LogSample ◄──sampleFromTelemetry── TelemetryMsg
 //   TelemetryMsg ──frameFromTelemetry─► RobotFrame ◄──frameFromSample── LogSample
-//   GhostView ──frameFromGhost──► RobotFrame
+//   GhostView ──frameFromGhost──► RobotFrame ◄──frameFromReadout── RobotReadout
 //
 // Joints travel by name over the link and in the model's order everywhere
 // else; JointNameMap (robot_frame.h) maps them.
@@ -47,6 +47,9 @@ RobotFrame frameFromTelemetry(const net::TelemetryMsg& t, const RobotModel* robo
 /// The frame to draw of log row `s` of a robot with `joints` joints (a row
 /// of another robot, with fewer values, reads 0 beyond them).
 RobotFrame frameFromSample(const LogSample& s, size_t joints);
+/// What telemetry reports of a robot read out of a twin (tests, benchmarks:
+/// a robot without the link).
+RobotFrame frameFromReadout(const RobotReadout& r);
 /// The frame to draw of the ghost's view.
 RobotFrame frameFromGhost(const GhostView& v);
 

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "app/ghost/ghost_impl.h"
+#include "app/ghost/hold_policy.h"
 #include "sim/runner.h"
 
 namespace sp {
@@ -30,27 +31,9 @@ std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& p
   profile.iterations = params.ghostIterations;
   std::unique_ptr<Ghost> g(new Ghost(world, profile, options));
   const RobotModel& robot = world.robots[0].model;
-  std::vector<int> drive;  // the wheels and the articulation keep turning in a held subtree
-  if (robot.drive) {
-    drive.assign(robot.drive->wheels.begin(), robot.drive->wheels.end());
-    drive.push_back(robot.drive->articulation);
-  }
-  for (const std::string& name : splitNames(params.ghostHold)) {
-    const std::vector<int> subtree = subtreeJoints(robot, name);
-    if (subtree.empty()) {
-      error = "ghost.hold: the robot has no joint '" + name + "'";
-      return nullptr;
-    }
-    if (std::find(drive.begin(), drive.end(), robot.findJoint(name)) != drive.end()) {
-      error = "ghost.hold: joint '" + name + "' drives the robot and cannot be held";
-      return nullptr;
-    }
-    for (int j : subtree)
-      if (std::find(drive.begin(), drive.end(), j) == drive.end() &&
-          std::find(g->held_.begin(), g->held_.end(), j) == g->held_.end())
-        g->held_.push_back(j);
-  }
-  std::sort(g->held_.begin(), g->held_.end());
+  std::optional<std::vector<int>> held = holdableJoints(robot, params.ghostHold, error);
+  if (!held) return nullptr;
+  g->held_ = std::move(*held);
   // The worlds are built on the first telemetry (the pose to weld at);
   // what could fail is checked now, in the robot's initial pose.
   const std::shared_ptr<const Twin> twin =

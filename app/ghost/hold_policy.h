@@ -10,6 +10,9 @@
 // Thread: the ghost's anchor thread's own.
 
 #include <deque>
+#include <optional>
+#include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -19,6 +22,12 @@
 #include "sim/robot_model.h"
 
 namespace sp {
+
+/// The joints a twin of `robot` may hold rigid for the joint names of
+/// `holdList` (ghost.hold): their subtrees, but the drive's wheels and
+/// articulation, which keep turning; sorted. nullopt and `error` for a name
+/// the robot lacks or one that drives it.
+std::optional<std::vector<int>> holdableJoints(const RobotModel& robot, std::string_view holdList, std::string& error);
 
 /// What the anchor thread does with the next frame.
 struct HoldDecision {

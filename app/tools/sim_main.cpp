@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/calibration/calibration.h"
 #include "app/tools/headless_runner.h"
 #include "app/log/log_export.h"
 #include "app/validation/plot_svg.h"
@@ -89,6 +90,18 @@ constexpr const char* kUsage = R"(usage:
       Gathers DIR's results into results.csv and report.md (pass/fail, end
       pose, minimum stability margin, health, end hash per sample), naming
       failed and missing tasks. Exits 0 when every task ran, 4 otherwise.
+  simpartner-sim calibrate LOG [--out FILE] [--window S] [--profile ghost|robot]
+      Fits the twin to the robot that made LOG (a robot's own log or a
+      console's telemetry log): wheel radius and its front-rear split, tyre
+      friction, wheel motor gain, command delay (fitting the twin's
+      predictions) and total mass (from the wheel loads). Prints each with
+      its deviation, or "unobserved" when the motion cannot tell, and writes
+      the calibration.* keys to FILE (a parameters file; default: none).
+      --window S        fit the last S seconds (default: the whole log)
+      --profile P       the twin fitted: ghost (the console's ghost's
+                        physics, default) or robot (the log's own physics)
+      Exits 0 with a fit, 1 when the log is unusable, 7 when the fit was
+      refused (not enough motion, a diverging fit; the reason is printed).
   simpartner-sim export LOG --csv DIR
       Writes one CSV per stream of a session log into DIR (samples.csv,
       laser.csv, commands.csv, events.csv), headers naming columns and units.
@@ -417,6 +430,76 @@ int exportLog(const std::vector<std::string>& args) {
   return 0;
 }
 
+int calibrate(const std::vector<std::string>& args) {
+  std::string log, out, profileName = "ghost";
+  double window = 0;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if ((a == "--out" || a == "--window" || a == "--profile") && i + 1 < args.size()) {
+      const std::string& v = args[++i];
+      if (a == "--out") out = v;
+      else if (a == "--profile") profileName = v;
+      else {
+        char* end = nullptr;
+        window = std::strtod(v.c_str(), &end);
+        if (end == v.c_str() || *end != '\0' || !(window > 0)) {
+          std::cerr << "<command line>: error: --window: expected seconds > 0, got '" << v << "'\n";
+          return 2;
+        }
+      }
+    } else if (log.empty() && !a.empty() && a[0] != '-') {
+      log = a;
+    } else {
+      std::cerr << "<command line>: error: unknown or incomplete option '" << a << "'\n" << kUsage;
+      return 2;
+    }
+  }
+  if (log.empty() || (profileName != "ghost" && profileName != "robot")) {
+    std::cerr << "<command line>: error: calibrate needs a LOG file (and --profile ghost or robot)\n";
+    return 2;
+  }
+  std::string error;
+  std::optional<sp::CalibrationInput> in = sp::calibrationInput(log, error);
+  if (!in) {
+    std::cerr << error << "\n";
+    return 1;
+  }
+  sp::SimParams profile = in->params;
+  if (profileName == "ghost") {
+    profile.step = in->params.ghostStep;
+    profile.iterations = in->params.ghostIterations;
+  }
+  sp::CalibrationOptions options;
+  options.window = window;
+  options.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options.iterations = 5;
+  const sp::CalibrationFit fit =
+      sp::fitCalibration(in->world, profile, in->frames, in->commands, sp::calValues(in->params), options);
+  if (!fit.refused.empty()) {
+    std::cerr << log << ": calibration refused: " << fit.refused << "\n";
+    return 7;
+  }
+  std::printf("%s: %d segments over %.1f - %.1f s, %d twin runs, %.0f ms; cost %.3g -> %.3g\n", log.c_str(),
+              fit.segments, fit.from, fit.to, fit.twinRuns, fit.wallMs, fit.costBefore, fit.costAfter);
+  for (size_t i = 0; i < sp::kCalParams; ++i) {
+    const sp::CalParamInfo& p = sp::calParams()[i];
+    if (fit.observed[i])
+      std::printf("%-32s %.5f +- %.5f%s\n", p.key, fit.value[i], fit.sigma[i], *p.unit ? (std::string(" ") + p.unit).c_str() : "");
+    else
+      std::printf("%-32s %.5f unobserved\n", p.key, fit.value[i]);
+  }
+  if (!out.empty()) {
+    std::ofstream f(out);
+    f << sp::calibrationParamsText(fit);
+    if (!f.flush()) {
+      std::cerr << out << ": error: cannot write the parameters file\n";
+      return 1;
+    }
+    std::printf("wrote %s\n", out.c_str());
+  }
+  return 0;
+}
+
 int collectCommand(const std::vector<std::string>& args);
 
 int sweepCommand(const std::vector<std::string>& args, const char* argv0) {
@@ -573,6 +656,7 @@ int main(int argc, char** argv) {
   if (cmd == "resim") return resim(args);
   if (cmd == "rehearse") return rehearseCommand(args);
   if (cmd == "export") return exportLog(args);
+  if (cmd == "calibrate") return calibrate(args);
   if (cmd == "sweep") return sweepCommand(args, argv[0]);
   if (cmd == "sweep-task") return sweepTaskCommand(args);
   if (cmd == "collect") return collectCommand(args);

@@ -22,6 +22,7 @@
 #include <thread>
 
 #include "app/console/console_session.h"
+#include "app/console/robot_shapes.h"
 #include "app/log/session_log.h"
 #include "net/robot_client.h"
 #include "sim/model_loader.h"
@@ -50,18 +51,7 @@ struct Seen : sp::test::SharedState {
 };
 
 // What telemetry reports of the robot in `w`.
-RobotFrame frameOf(const World& w) {
-  const RobotReadout r = readRobot(w);
-  RobotFrame f;
-  f.time = r.time;
-  f.base = r.base;
-  f.hasBaseVelocity = true;
-  f.baseLinearVelocity = r.baseLinearVelocity;
-  f.baseAngularVelocity = r.baseAngularVelocity;
-  f.jointPositions = r.jointPositions;
-  f.jointRates = r.jointRates;
-  return f;
-}
+RobotFrame frameOf(const World& w) { return frameFromReadout(readRobot(w)); }
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());

@@ -1,0 +1,632 @@
+// Calibration from telemetry (app/calibration/calibration.h): the segments,
+// the candidate twins, Levenberg-Marquardt and the load-cell mass.
+#include "app/calibration/calibration.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <thread>
+
+#include "app/console/robot_shapes.h"
+#include "app/ghost/hold_policy.h"
+#include "app/log/resimulation.h"
+#include "app/log/session_log.h"
+#include "sim/command_file.h"
+#include "sim/kinematics.h"
+#include "sim/perturbation.h"
+#include "sim/rigid.h"
+#include "sim/runner.h"
+#include "sim/text.h"
+#include "sim/world.h"
+
+namespace sp {
+
+const std::array<CalParamInfo, kCalParams>& calParams() {
+  // Bounds are calibration.*'s in sim/params.cpp; scales the ranges
+  // of a real robot's deviations (sim/perturbation.h), so that "observed"
+  // means "pinned well inside what a robot may differ by".
+  static const std::array<CalParamInfo, kCalParams> table{{
+      {"calibration.wheel_radius", "wheel radius", "", 1, 0.8, 1.2, 0.03, 0.005},
+      {"calibration.wheel_radius_split", "radius front - rear", "", 0, -0.1, 0.1, 0.03, 0.01},
+      {"calibration.friction", "tyre friction", "", 1, 0.3, 3, 0.3, 0.1},
+      {"calibration.motor_gain", "wheel motor gain", "", 1, 0.5, 1.5, 0.2, 0.02},
+      {"calibration.delay", "command delay", "s", 0, 0, 0.5, 0.06, 0.012},
+      {"calibration.mass", "total mass", "", 1, 0.5, 2, 0.15, 0},
+  }};
+  return table;
+}
+
+CalValues calValues(const SimParams& p) {
+  return {p.calWheelRadius, p.calWheelRadiusSplit, p.calFriction, p.calMotorGain, p.calDelay, p.calMass};
+}
+
+SimParams withCalValues(SimParams p, const CalValues& v) {
+  p.calWheelRadius = v[0];
+  p.calWheelRadiusSplit = v[1];
+  p.calFriction = v[2];
+  p.calMotorGain = v[3];
+  p.calDelay = v[4];
+  p.calMass = v[5];
+  return p;
+}
+
+CalValues filesCalValues() { return calValues(SimParams{}); }
+
+namespace {
+
+constexpr int kMass = static_cast<int>(CalParam::Mass);
+constexpr int kFitted = kMass;  // the parameters fitted through the twin: all but the mass
+constexpr double kUnobserved = 0.25;  // sigma above this share of a parameter's scale: unobserved
+
+// What one scaled residual is: a deviation of this size counts 1.
+struct ResidualScale {
+  double position = 0.01;   // [m]
+  double heading = 0.01;    // [rad]
+  double wheelTurn = 0.2;   // [rad] a wheel's turn since the anchor (contacts make it chatter by ~0.05)
+  double articulation = 0.01;  // [rad]
+};
+constexpr ResidualScale kResidualScale;
+constexpr int kPerCheckpoint = 8;  // x, y, heading, 4 wheel rates, articulation
+
+double wrapAngle(double a) { return std::remainder(a, 2 * M_PI); }
+
+// One stretch of telemetry the twin predicts from its first frame.
+struct Segment {
+  size_t anchor = 0;                // frame index
+  std::vector<size_t> checkpoints;  // frame indices compared
+};
+
+struct Problem {
+  const WorldModel* files = nullptr;
+  SimParams profile;
+  const std::vector<RobotFrame>* frames = nullptr;
+  std::vector<TimedCommand> commands;  // arrival times, in order
+  std::vector<Segment> segments;
+  std::vector<int> held;     // the full robot's joints held rigid
+  std::vector<double> weld;  // where (full robot's joint positions)
+  std::array<int, 4> wheels{-1, -1, -1, -1};
+  int articulation = -1;
+};
+
+// The robot's frames for calibration: the healthy, unlatched ones, with a
+// base twist from their neighbours where the source did not report one (a
+// session log's samples carry none).
+std::vector<RobotFrame> usableFrames(const std::vector<RobotFrame>& in, double window) {
+  std::vector<RobotFrame> f;
+  const double from = in.empty() || window <= 0 ? -1e300 : in.back().time - window;
+  for (const RobotFrame& r : in)
+    if (r.time >= from && r.health.empty() && !r.estop && !r.failsafe && (f.empty() || r.time > f.back().time))
+      f.push_back(r);
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (f[i].hasBaseVelocity) continue;
+    const RobotFrame& a = f[i == 0 ? 0 : i - 1];
+    const RobotFrame& b = f[i + 1 < f.size() ? i + 1 : i];
+    const double dt = b.time - a.time;
+    if (dt <= 0) continue;
+    f[i].baseLinearVelocity = (1 / dt) * (b.base.p - a.base.p);
+    // Rotation vector of a -> b, world frame.
+    Quat d = b.base.q * conjugate(a.base.q);
+    if (d.w < 0) d = Quat{-d.w, -d.x, -d.y, -d.z};
+    const double s = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    const double angle = 2 * std::atan2(s, d.w);
+    f[i].baseAngularVelocity = s > 1e-12 ? (angle / dt / s) * Vec3{d.x, d.y, d.z} : Vec3{};
+    f[i].hasBaseVelocity = true;
+  }
+  return f;
+}
+
+// The frame nearest robot time `t`, if one lies within `tolerance`.
+std::optional<size_t> frameAt(const std::vector<RobotFrame>& f, double t, double tolerance) {
+  const auto it = std::lower_bound(f.begin(), f.end(), t, [](const RobotFrame& r, double x) { return r.time < x; });
+  std::optional<size_t> best;
+  for (auto c : {it, it == f.begin() ? it : it - 1})
+    if (c != f.end() && std::abs(c->time - t) <= tolerance &&
+        (!best || std::abs(c->time - t) < std::abs(f[*best].time - t)))
+      best = static_cast<size_t>(c - f.begin());
+  return best;
+}
+
+// Cuts the frames into driving segments whose held joints stay at the weld.
+std::vector<Segment> cutSegments(const Problem& pb, const CalibrationOptions& o) {
+  const std::vector<RobotFrame>& f = *pb.frames;
+  std::vector<Segment> out;
+  if (f.size() < 2) return out;
+  const double tolerance = 0.6 * std::min(o.checkpoint, 0.05);
+  for (double a = f.front().time; a + o.horizon <= f.back().time + 1e-9; a += o.spacing) {
+    const std::optional<size_t> anchor = frameAt(f, a, o.spacing / 2);
+    if (!anchor) continue;
+    Segment s;
+    s.anchor = *anchor;
+    const double t0 = f[*anchor].time;
+    bool ok = true;
+    double turning = 0;
+    for (double t = t0 + o.checkpoint; t <= t0 + o.horizon + 1e-9; t += o.checkpoint) {
+      const std::optional<size_t> c = frameAt(f, t, tolerance);
+      if (c) s.checkpoints.push_back(*c);
+    }
+    for (size_t i = s.anchor; i < f.size() && f[i].time <= t0 + o.horizon + 1e-9 && ok; ++i) {
+      for (int j : pb.held)
+        if (std::abs(f[i].jointPositions[static_cast<size_t>(j)] - pb.weld[static_cast<size_t>(j)]) > 0.03) ok = false;
+      for (int w : pb.wheels)
+        if (w >= 0) turning = std::max(turning, std::abs(f[i].jointRates[static_cast<size_t>(w)]));
+    }
+    // A segment where the wheels stand still teaches nothing of wheels.
+    if (ok && turning > 0.2 && s.checkpoints.size() >= 2) out.push_back(std::move(s));
+  }
+  return out;
+}
+
+// The model joint index (in `rigid`'s robot, or the full one) of the full robot's joint `full`.
+int modelJoint(const std::optional<RigidRobot>& rigid, int full) {
+  if (!rigid || full < 0) return full;
+  const auto it = std::find(rigid->jointOf.begin(), rigid->jointOf.end(), full);
+  return it == rigid->jointOf.end() ? -1 : static_cast<int>(it - rigid->jointOf.begin());
+}
+
+// The scaled residuals of the twin calibrated by `v` over every segment, or
+// nullopt and `why` when the twin cannot be built or diverges.
+// `turns`, when given, receives each checkpoint's wheel turns since its
+// anchor, (twin, robot), for the motor gain's closed form.
+std::optional<std::vector<double>> residuals(const Problem& pb, const CalValues& v, std::string& why,
+                                             std::vector<std::pair<double, double>>* turns = nullptr) {
+  WorldModel model = calibratedWorld(*pb.files, withCalValues(pb.profile, v));
+  std::optional<RigidRobot> rigid;
+  if (!pb.held.empty()) {
+    rigid = holdRigid(model.robots[0].model, pb.weld, pb.held, why);
+    if (!rigid) return std::nullopt;
+    model.robots[0].model = rigid->model;
+  }
+  WorldOptions options;
+  options.sensors = false;
+  Diagnostics diag;
+  std::unique_ptr<World> world = World::create(model, pb.profile, diag, options);
+  if (!world) {
+    why = "the twin cannot be built: " + diag.format();
+    return std::nullopt;
+  }
+  const Snapshot pristine = world->snapshot();
+  const RobotModel& robot = world->robotModel(0);
+  std::array<int, 4> wheels{};
+  for (size_t w = 0; w < 4; ++w) wheels[w] = modelJoint(rigid, pb.wheels[w]);
+  const int articulation = modelJoint(rigid, pb.articulation);
+  const double delay = v[static_cast<size_t>(CalParam::Delay)];
+  const double h = pb.profile.step;
+  const std::vector<RobotFrame>& f = *pb.frames;
+  std::vector<double> r;
+  for (const Segment& s : pb.segments) {
+    world->restore(pristine);
+    const RobotFrame& a = f[s.anchor];
+    // The commands in effect by the anchor set the controllers; the rest
+    // fall due during the segment.
+    size_t next = 0;
+    bool submitted = false;
+    for (; next < pb.commands.size() && pb.commands[next].time + delay <= a.time; ++next)
+      submitted |= world->submit(pb.commands[next].command).empty();
+    if (submitted && !world->step()) {
+      why = "the twin diverged applying the commands in effect at " + shortestText(a.time) + " s";
+      return std::nullopt;
+    }
+    const std::vector<double> positions = rigid ? rigidJoints(*rigid, a.jointPositions) : a.jointPositions;
+    const std::vector<double> rates = rigid ? rigidJoints(*rigid, a.jointRates) : a.jointRates;
+    why = world->setRobotMotion(0, linkMotions(robot, a.base, a.baseLinearVelocity, a.baseAngularVelocity, positions, rates));
+    if (!why.empty()) return std::nullopt;
+    Runner runner(*world);
+    const int64_t start = world->stepCount();
+    for (size_t i = next; i < pb.commands.size(); ++i) {
+      const double due = pb.commands[i].time + delay - a.time;
+      if (due > f[s.checkpoints.back()].time - a.time) break;  // after the segment
+      runner.schedule(ScheduledCommand{pb.commands[i].command, 0, start + static_cast<int64_t>(std::ceil(due / h - 1e-9))});
+    }
+    // How far each wheel turned since the anchor, by the twin and by the
+    // robot: rates chatter with the contacts, turns are their integral.
+    // Hinge angles wrap: increments between checkpoints (< pi) are summed.
+    std::array<double, 4> twinTurn{}, robotTurn{}, twinLast{}, robotLast{};
+    for (size_t w = 0; w < 4; ++w)
+      if (wheels[w] >= 0) twinLast[w] = robotLast[w] = a.jointPositions[static_cast<size_t>(pb.wheels[w])];
+    for (size_t c : s.checkpoints) {
+      const int64_t target = start + static_cast<int64_t>(std::floor((f[c].time - a.time) / h + 0.5));
+      if (target > world->stepCount() && runner.advanceBy(target - world->stepCount()).stop != RunOutcome::Stop::Reached) {
+        why = "the twin diverged at " + shortestText(f[c].time) + " s: " + world->health().message();
+        return std::nullopt;
+      }
+      const Pose base = world->linkPose(0, 0);
+      r.push_back((base.p.x - f[c].base.p.x) / kResidualScale.position);
+      r.push_back((base.p.y - f[c].base.p.y) / kResidualScale.position);
+      r.push_back(wrapAngle(heading(base.q) - heading(f[c].base.q)) / kResidualScale.heading);
+      for (size_t w = 0; w < 4; ++w) {
+        if (wheels[w] < 0) {
+          r.push_back(0);
+          continue;
+        }
+        const double twinNow = world->jointPosition(0, wheels[w]);
+        const double robotNow = f[c].jointPositions[static_cast<size_t>(pb.wheels[w])];
+        twinTurn[w] += wrapAngle(twinNow - twinLast[w]);
+        robotTurn[w] += wrapAngle(robotNow - robotLast[w]);
+        twinLast[w] = twinNow;
+        robotLast[w] = robotNow;
+        r.push_back((twinTurn[w] - robotTurn[w]) / kResidualScale.wheelTurn);
+        if (turns) turns->emplace_back(twinTurn[w], robotTurn[w]);
+      }
+      r.push_back(articulation < 0 ? 0
+                                   : (world->jointPosition(0, articulation) -
+                                      f[c].jointPositions[static_cast<size_t>(pb.articulation)]) /
+                                         kResidualScale.articulation);
+    }
+  }
+  if (getenv("SP_CAL_DEBUG")) {
+    double c[kPerCheckpoint] = {};
+    for (size_t i = 0; i < r.size(); ++i) c[i % kPerCheckpoint] += r[i] * r[i] * kPerCheckpoint / static_cast<double>(r.size());
+    fprintf(stderr, "v %.4f %.4f %.4f %.4f %.4f:", v[0], v[1], v[2], v[3], v[4]);
+    for (double x : c) fprintf(stderr, " %.3f", x);
+    fprintf(stderr, "\n");
+  }
+  for (double x : r)
+    if (!std::isfinite(x)) {
+      why = "the twin's prediction is not finite";
+      return std::nullopt;
+    }
+  return r;
+}
+
+double meanSquare(const std::vector<double>& r) {
+  double s = 0;
+  for (double x : r) s += x * x;
+  return r.empty() ? 0 : s / static_cast<double>(r.size());
+}
+
+// Runs the candidates on up to `threads` threads; a failed one is nullopt.
+std::vector<std::optional<std::vector<double>>> runAll(const Problem& pb, const std::vector<CalValues>& candidates,
+                                                       int threads, std::string& why) {
+  std::vector<std::optional<std::vector<double>>> out(candidates.size());
+  std::vector<std::string> whys(candidates.size());
+  std::atomic<size_t> next{0};
+  const auto work = [&] {
+    for (size_t i; (i = next++) < candidates.size();) out[i] = residuals(pb, candidates[i], whys[i]);
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::min<int>(threads, static_cast<int>(candidates.size())); ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  for (size_t i = 0; i < out.size(); ++i)
+    if (!out[i]) {
+      why = whys[i];
+      break;
+    }
+  return out;
+}
+
+// Solves A x = b (n <= kFitted) by Gaussian elimination with partial
+// pivoting; false when A is singular.
+bool solve(std::vector<std::vector<double>> a, std::vector<double> b, std::vector<double>& x) {
+  const size_t n = b.size();
+  for (size_t c = 0; c < n; ++c) {
+    size_t p = c;
+    for (size_t r = c + 1; r < n; ++r)
+      if (std::abs(a[r][c]) > std::abs(a[p][c])) p = r;
+    if (std::abs(a[p][c]) < 1e-12) return false;
+    std::swap(a[p], a[c]);
+    std::swap(b[p], b[c]);
+    for (size_t r = c + 1; r < n; ++r) {
+      const double k = a[r][c] / a[c][c];
+      for (size_t k2 = c; k2 < n; ++k2) a[r][k2] -= k * a[c][k2];
+      b[r] -= k * b[c];
+    }
+  }
+  x.assign(n, 0);
+  for (size_t c = n; c-- > 0;) {
+    double s = b[c];
+    for (size_t k = c + 1; k < n; ++k) s -= a[c][k] * x[k];
+    x[c] = s / a[c][c];
+  }
+  return true;
+}
+
+// The normal matrix J'J and J'r over the parameters `on` (indices into J's columns).
+struct Normal {
+  std::vector<std::vector<double>> h;
+  std::vector<double> g;
+};
+Normal normalEquations(const std::vector<std::vector<double>>& jac, const std::vector<double>& r, const std::vector<int>& on) {
+  Normal n{std::vector<std::vector<double>>(on.size(), std::vector<double>(on.size(), 0)), std::vector<double>(on.size(), 0)};
+  for (size_t a = 0; a < on.size(); ++a) {
+    const std::vector<double>& ja = jac[static_cast<size_t>(on[a])];
+    for (size_t i = 0; i < r.size(); ++i) n.g[a] += ja[i] * r[i];
+    for (size_t b = 0; b < on.size(); ++b) {
+      const std::vector<double>& jb = jac[static_cast<size_t>(on[b])];
+      for (size_t i = 0; i < r.size(); ++i) n.h[a][b] += ja[i] * jb[i];
+    }
+  }
+  return n;
+}
+
+// Each parameter's standard deviation (in its own units) given the scaled
+// Jacobian columns `jac` (d residual / d (value / scale)); parameters the
+// data cannot pin are dropped from `on` one at a time, worst first.
+std::vector<int> observable(const std::vector<std::vector<double>>& jac, const std::vector<double>& r,
+                            std::vector<int> on, CalValues& sigma) {
+  const double dof = std::max<double>(1, static_cast<double>(r.size()) - static_cast<double>(on.size()));
+  const double inflate = std::max(1.0, meanSquare(r) * static_cast<double>(r.size()) / dof);
+  while (!on.empty()) {
+    const Normal n = normalEquations(jac, r, on);
+    // The covariance's diagonal: one solve per unit vector.
+    std::vector<double> var(on.size(), INFINITY);
+    bool singular = false;
+    for (size_t k = 0; k < on.size() && !singular; ++k) {
+      std::vector<double> e(on.size(), 0), x;
+      e[k] = 1;
+      if (!solve(n.h, e, x)) singular = true;
+      else var[k] = x[k] * inflate;
+    }
+    size_t worst = 0;
+    for (size_t k = 0; k < on.size(); ++k)
+      if (singular ? n.h[k][k] < n.h[worst][worst] : var[k] > var[worst]) worst = k;
+    if (!singular && std::sqrt(var[worst]) <= kUnobserved) {
+      for (size_t k = 0; k < on.size(); ++k)
+        sigma[static_cast<size_t>(on[k])] = std::sqrt(var[k]) * calParams()[static_cast<size_t>(on[k])].scale;
+      return on;
+    }
+    on.erase(on.begin() + static_cast<long>(worst));
+  }
+  return on;
+}
+
+// Total mass from the load cells: the mean of sum N / (g cos roll cos pitch)
+// over the frames against the files' mass; nullopt without loads.
+std::optional<std::pair<double, double>> massFromLoads(const WorldModel& files, const std::vector<RobotFrame>& f) {
+  double filesMass = 0;
+  for (const LinkSpec& l : files.robots[0].model.links) filesMass += l.mass;
+  const double g = norm(files.gravity);
+  std::vector<double> x;
+  for (const RobotFrame& r : f) {
+    const double sum = r.wheelNormal[0] + r.wheelNormal[1] + r.wheelNormal[2] + r.wheelNormal[3];
+    if (sum > 0) x.push_back(sum / (g * std::cos(r.roll) * std::cos(r.pitch)) / filesMass);
+  }
+  if (x.size() < 50 || filesMass <= 0 || g <= 0) return std::nullopt;
+  double mean = 0, var = 0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(x.size());
+  for (double v : x) var += (v - mean) * (v - mean);
+  var /= static_cast<double>(x.size() - 1);
+  // Neighbouring frames are not independent (the body rocks over ~0.2 s):
+  // count one sample per 10 frames.
+  return std::make_pair(mean, std::sqrt(var / (static_cast<double>(x.size()) / 10)));
+}
+
+}  // namespace
+
+CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& in,
+                              const std::vector<TimedCommand>& commands, const CalValues& start,
+                              const CalibrationOptions& o, const std::function<bool()>& abort) {
+  const auto began = std::chrono::steady_clock::now();
+  CalibrationFit fit;
+  fit.value = start;
+  const auto done = [&](std::string refused) {
+    if (!refused.empty()) {
+      fit.value = start;
+      fit.sigma = {};
+      fit.observed = {};
+    }
+    fit.refused = std::move(refused);
+    fit.wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - began).count();
+    return fit;
+  };
+  if (files.robots.empty() || !files.robots[0].model.drive) return done("the world has no robot with a drive to calibrate");
+  const RobotModel& robot = files.robots[0].model;
+  const std::vector<RobotFrame> frames = usableFrames(in, o.window);
+  for (const RobotFrame& r : frames)
+    if (r.jointPositions.size() != robot.joints.size() || r.jointRates.size() != robot.joints.size())
+      return done("telemetry at " + shortestText(r.time) + " s has " + std::to_string(r.jointPositions.size()) +
+                  " joints; the robot has " + std::to_string(robot.joints.size()));
+  if (frames.size() < 2) return done("not enough telemetry: " + std::to_string(frames.size()) + " usable frames");
+  fit.from = frames.front().time;
+  fit.to = frames.back().time;
+
+  // The mass: from the loads, whatever the motion.
+  if (!o.fixed[kMass])
+    if (const auto mass = massFromLoads(files, frames); mass && mass->second / calParam(CalParam::Mass).scale <= kUnobserved) {
+      if (mass->first < calParam(CalParam::Mass).lower || mass->first > calParam(CalParam::Mass).upper)
+        return done("the loads say the mass is " + shortestText(mass->first) + " x the files', outside [" +
+                    shortestText(calParam(CalParam::Mass).lower) + ", " + shortestText(calParam(CalParam::Mass).upper) + "]");
+      fit.value[kMass] = mass->first;
+      fit.sigma[kMass] = mass->second;
+      fit.observed[kMass] = true;
+    }
+
+  Problem pb;
+  pb.files = &files;
+  pb.profile = profile;
+  pb.frames = &frames;
+  std::string why;
+  const std::optional<std::vector<int>> held = holdableJoints(robot, profile.ghostHold, why);
+  if (!held) return done(why);
+  pb.held = *held;
+  pb.weld = frames.back().jointPositions;
+  pb.wheels = robot.drive->wheels;
+  pb.articulation = robot.drive->articulation;
+  for (const TimedCommand& c : commands) pb.commands.push_back(c);
+  std::stable_sort(pb.commands.begin(), pb.commands.end(), [](const TimedCommand& a, const TimedCommand& b) { return a.time < b.time; });
+  pb.segments = cutSegments(pb, o);
+  fit.segments = static_cast<int>(pb.segments.size());
+  if (fit.segments < o.minSegments)
+    return done("not enough driving: " + std::to_string(fit.segments) + " segments of " + shortestText(o.horizon) +
+                " s with the wheels turning and the legs still in " + shortestText(fit.to - fit.from) +
+                " s of telemetry (need " + std::to_string(o.minSegments) + ")");
+
+  // The motor gain in closed form, the rest by Levenberg-Marquardt: the
+  // wheels' turns are the motors' own output, so the robot's over the
+  // twin's is the gain (least squares through the origin). Left in the fit
+  // it shares a valley with the radius (their product sets the speed) that
+  // the contacts' noise keeps the finite differences from finding.
+  constexpr size_t kGain = static_cast<size_t>(CalParam::MotorGain);
+  std::vector<int> free;
+  for (int p = 0; p < kFitted; ++p)
+    if (!o.fixed[static_cast<size_t>(p)] && p != static_cast<int>(kGain)) free.push_back(p);
+  CalValues v = fit.value;
+  std::optional<std::vector<double>> r = residuals(pb, v, why);
+  ++fit.twinRuns;
+  if (!r) return done("the twin cannot follow the telemetry with the current values: " + why);
+  fit.residuals = static_cast<int>(r->size());
+  fit.costBefore = fit.costAfter = meanSquare(*r);
+  const double perSegment = std::max(1.0, o.horizon / o.checkpoint);
+  const auto updateGain = [&]() -> bool {
+    std::vector<std::pair<double, double>> turns;
+    if (!residuals(pb, v, why, &turns)) return false;
+    ++fit.twinRuns;
+    double tr = 0, tt = 0;
+    for (const auto& [twin, real] : turns) {
+      tr += twin * real;
+      tt += twin * twin;
+    }
+    if (!(tt > 0)) return true;
+    const double k = tr / tt;
+    double e2 = 0;
+    for (const auto& [twin, real] : turns) e2 += (real - k * twin) * (real - k * twin);
+    // Four wheels at each checkpoint of a segment move together: count
+    // one sample per segment's worth of checkpoints.
+    const double n = static_cast<double>(turns.size());
+    v[kGain] *= k;
+    fit.sigma[kGain] = v[kGain] * std::sqrt(e2 / std::max(1.0, n - 1) / tt * 4 * perSegment);
+    fit.observed[kGain] = fit.sigma[kGain] <= kUnobserved * calParams()[kGain].scale;
+    if (!fit.observed[kGain]) v[kGain] = start[kGain];
+    r = residuals(pb, v, why);
+    ++fit.twinRuns;
+    if (r) fit.costAfter = meanSquare(*r);
+    return r.has_value();
+  };
+  double lambda = 1e-3;
+  std::vector<std::vector<double>> jac(kFitted);
+  std::vector<int> on;
+  for (int it = 0; it < o.iterations; ++it) {
+    if (!o.fixed[kGain] && !updateGain()) return done("the twin diverged fitting the motor gain: " + why);
+    if (free.empty()) break;
+    // Central differences, two candidates per free parameter, in parallel.
+    // Contacts make a twin's response partly chaotic: a parameter whose
+    // two one-sided differences disagree more than they move (curvature
+    // over slope) only stirs noise at this scale and is left out.
+    std::vector<CalValues> probes;
+    for (int p : free)
+      for (double sign : {1.0, -1.0}) {
+        CalValues c = v;
+        c[static_cast<size_t>(p)] += sign * calParams()[static_cast<size_t>(p)].probe;
+        probes.push_back(c);
+      }
+    if (abort && abort()) return done("cancelled");
+    const auto runs = runAll(pb, probes, o.threads, why);
+    fit.twinRuns += static_cast<int>(probes.size());
+    std::vector<int> smooth;
+    for (size_t k = 0; k < free.size(); ++k) {
+      const CalParamInfo& info = calParams()[static_cast<size_t>(free[k])];
+      const auto& up = runs[2 * k];
+      const auto& down = runs[2 * k + 1];
+      if (!up || !down) return done("the twin diverged probing " + std::string(info.key) + ": " + why);
+      std::vector<double>& col = jac[static_cast<size_t>(free[k])];
+      col.resize(r->size());
+      double slope = 0, curve = 0;
+      for (size_t i = 0; i < r->size(); ++i) {
+        const double half = ((*up)[i] - (*down)[i]) / 2;
+        const double bend = ((*up)[i] + (*down)[i]) / 2 - (*r)[i];
+        col[i] = half / info.probe * info.scale;
+        slope += half * half;
+        curve += bend * bend;
+      }
+      if (curve < slope) smooth.push_back(free[k]);
+    }
+    CalValues sigma{};
+    on = observable(jac, *r, smooth, sigma);
+    for (int p : free) fit.sigma[static_cast<size_t>(p)] = sigma[static_cast<size_t>(p)];
+    if (on.empty()) break;
+    const Normal n = normalEquations(jac, *r, on);
+    bool stepped = false;
+    for (int attempt = 0; attempt < 4 && !stepped; ++attempt) {
+      std::vector<std::vector<double>> a = n.h;
+      for (size_t k = 0; k < on.size(); ++k) a[k][k] *= 1 + lambda;
+      std::vector<double> minusG(n.g.size()), dx;
+      for (size_t k = 0; k < n.g.size(); ++k) minusG[k] = -n.g[k];
+      if (!solve(a, minusG, dx)) break;
+      CalValues c = v;
+      for (size_t k = 0; k < on.size(); ++k)
+        c[static_cast<size_t>(on[k])] += dx[k] * calParams()[static_cast<size_t>(on[k])].scale;
+      if (abort && abort()) return done("cancelled");
+      std::string cwhy;
+      std::optional<std::vector<double>> cr = residuals(pb, c, cwhy);
+      ++fit.twinRuns;
+      if (getenv("SP_CAL_DEBUG"))
+        fprintf(stderr, "it %d try %d lambda %g: r %.4f s %.4f f %.3f g %.4f d %.4f cost %.4f (was %.4f) on %zu\n", it, attempt,
+                lambda, c[0], c[1], c[2], c[3], c[4], cr ? meanSquare(*cr) : -1.0, fit.costAfter, on.size());
+      if (cr && meanSquare(*cr) < fit.costAfter) {
+        v = c;
+        r = std::move(cr);
+        const double gain = (fit.costAfter - meanSquare(*r)) / fit.costAfter;
+        fit.costAfter = meanSquare(*r);
+        lambda = std::max(1e-6, lambda / 3);
+        stepped = true;
+        ++fit.iterations;
+        if (gain < 1e-3) it = o.iterations;  // converged
+      } else {
+        lambda *= 8;
+      }
+    }
+    if (!stepped) break;
+  }
+  for (int p : on) fit.observed[static_cast<size_t>(p)] = true;
+  for (int p = 0; p < kFitted; ++p) {
+    const size_t i = static_cast<size_t>(p);
+    if (i != kGain && std::find(on.begin(), on.end(), p) == on.end()) fit.observed[i] = false;
+    if (!fit.observed[i]) {
+      fit.sigma[i] = 0;
+      v[i] = start[i];  // unobserved: left alone
+      continue;
+    }
+    // Beyond a bound by less than three deviations is the bound (a delay
+    // of 0 fits to -2 +- 3 ms); further is a fit the physics refuses.
+    const CalParamInfo& info = calParams()[i];
+    const double bounded = std::clamp(v[i], info.lower, info.upper);
+    if (!std::isfinite(v[i]) || std::abs(v[i] - bounded) > 3 * fit.sigma[i])
+      return done(std::string(info.key) + " = " + shortestText(v[i]) + " is outside its physical bounds [" +
+                  shortestText(info.lower) + ", " + shortestText(info.upper) + "]");
+    v[i] = bounded;
+  }
+  for (int p = 0; p < kFitted; ++p) fit.value[static_cast<size_t>(p)] = v[static_cast<size_t>(p)];
+  return done("");
+}
+
+std::optional<CalibrationInput> calibrationInput(const std::string& path, std::string& error) {
+  std::unique_ptr<SessionLogReader> reader = SessionLogReader::open(path, error);
+  if (!reader) return std::nullopt;
+  std::optional<LoggedWorld> logged = loggedWorld(*reader, path, error);
+  if (!logged) return std::nullopt;
+  CalibrationInput in;
+  in.world = std::move(logged->world);
+  in.params = logged->params;
+  const std::map<std::string, std::string> meta = reader->meta();
+  if (const auto it = meta.find("log_source"); it != meta.end()) in.source = it->second;
+  const RobotModel& robot = in.world.robots[0].model;
+  for (const LogSample& s : reader->samplesBetween(-1e300, 1e300)) in.frames.push_back(frameFromSample(s, robot.joints.size()));
+  for (const LogCommand& c : reader->commands()) {
+    std::string why;
+    std::optional<Command> command = parseCommand(c.text, why, &robot);
+    if (!command) {
+      error = path + ": command at " + shortestText(c.time) + " s ('" + c.text + "'): " + why;
+      return std::nullopt;
+    }
+    in.commands.push_back(TimedCommand{c.time, std::move(*command), 0});
+  }
+  return in;
+}
+
+std::string calibrationParamsText(const CalibrationFit& fit) {
+  std::string out = "# Calibration fitted from telemetry " + shortestText(fit.from) + " - " + shortestText(fit.to) +
+                    " s (" + std::to_string(fit.segments) + " segments; app/calibration/calibration.h)\n";
+  for (size_t i = 0; i < kCalParams; ++i) {
+    const CalParamInfo& info = calParams()[i];
+    out += "# " + std::string(info.label) + ": " +
+           (fit.observed[i] ? "+- " + shortestText(fit.sigma[i]) : std::string("unobserved, the files' or the previous value")) + "\n";
+    out += std::string(info.key) + " = " + shortestText(fit.value[i]) + "\n";
+  }
+  return out;
+}
+
+}  // namespace sp

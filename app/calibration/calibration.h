@@ -1,0 +1,135 @@
+#pragma once
+// Calibration from telemetry: the few parameters by which the robot differs
+// from its files, fitted to what the robot reported, so that the twins the
+// console runs (ghost, rehearsals, sweeps) predict this robot rather than
+// the files' one. Qt-free; the console's live fitter is live_calibrator.h,
+// `simpartner-sim calibrate LOG` the offline one.
+//
+// Method (docs/architecture.md, "Calibration"). Two estimators, each where
+// the data speaks to it:
+//   - Total mass from the wheels' load cells (telemetry `wheel_normal`):
+//     the mean of sum N / (g cos roll cos pitch) over the window, against
+//     the files' total mass. A velocity-controlled drive hides mass from
+//     the motion (the loop supplies the torque), so predictions cannot see
+//     it; the loads see it directly.
+//   - Wheel radius (mean and front-rear split), tyre friction, wheel-motor
+//     gain and command delay by fitting the twin's own predictions: the
+//     window is cut into segments (an anchor frame every `spacing` s, each
+//     predicting `horizon` s, as the ghost does: the anchor's state through
+//     linkMotions + setRobotMotion, the commands at their arrival times plus
+//     the delay), compared with the frames every `checkpoint` s (base x, y,
+//     heading, the four wheel rates, the articulation), each residual
+//     divided by its scale (kResidualScale). Levenberg-Marquardt on
+//     forward differences: one candidate twin per parameter, run from the
+//     same anchors, in parallel on `threads`. Why this and not a recursive
+//     filter: the twin is the model, with its contacts and its controller;
+//     nothing linearised by hand has to agree with it, and a new parameter
+//     is one more column.
+//
+// Observability. From J'J, each parameter's standard deviation (inflated by
+// the residuals' own scatter when they exceed their scales); a parameter
+// whose deviation exceeds a quarter of its prior range (CalParamInfo::
+// scale) is unobserved: it is taken out of the fit, keeps its previous
+// value and is reported as such (friction while driving straight on grip).
+//
+// Refusals: a window without enough driving, a twin that diverges, a fit
+// that lands outside a parameter's physical bounds: the previous values are
+// kept and CalibrationFit::refused says why.
+//
+// Thread: pure functions of their arguments; the worlds they build are
+// their own (one per candidate and thread).
+
+#include <array>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/console/robot_frame.h"
+#include "sim/command.h"
+#include "sim/params.h"
+#include "sim/robot_model.h"
+
+namespace sp {
+
+/// The fitted parameters, in the order of calParams().
+enum class CalParam : int { WheelRadius, WheelRadiusSplit, Friction, MotorGain, Delay, Mass };
+constexpr int kCalParams = 6;
+using CalValues = std::array<double, kCalParams>;
+using CalFlags = std::array<bool, kCalParams>;
+
+struct CalParamInfo {
+  const char* key;    ///< its SimParams key (calibration.wheel_radius)
+  const char* label;  ///< for people ("wheel radius")
+  const char* unit;   ///< "" for a factor, else the unit ("s")
+  double files;       ///< the files' value (identity)
+  double lower, upper;  ///< physical bounds: a fit beyond is refused
+  double scale;       ///< prior half range: what "observed" is judged against
+  double probe;       ///< finite-difference step
+};
+const std::array<CalParamInfo, kCalParams>& calParams();
+inline const CalParamInfo& calParam(CalParam p) { return calParams()[static_cast<size_t>(p)]; }
+
+/// The calibration.* values of `params`, and `params` with `values` set.
+CalValues calValues(const SimParams& params);
+SimParams withCalValues(SimParams params, const CalValues& values);
+/// The files' values (identity).
+CalValues filesCalValues();
+
+struct CalibrationOptions {
+  double window = 10;        ///< [s] of the newest telemetry fitted; <= 0: all of it
+  double spacing = 1;        ///< [s] between segment anchors
+  double horizon = 2;        ///< [s] each segment predicts
+  double checkpoint = 0.25;  ///< [s] between compared frames
+  int iterations = 5;        ///< Levenberg-Marquardt iterations per fit
+  int threads = 1;           ///< candidate twins run at once
+  int minSegments = 3;       ///< fewer driving segments: refused (not enough motion)
+  /// Parameters held at their start values whatever the data says (the
+  /// operator's choice, or a test fitting one).
+  CalFlags fixed{};
+};
+
+/// One fit over a window of telemetry.
+struct CalibrationFit {
+  CalValues value{};      ///< the fitted values (the start's where unobserved, fixed or refused)
+  CalValues sigma{};      ///< one standard deviation; 0 where unobserved
+  CalFlags observed{};    ///< the data pinned it (else it kept its start value)
+  double from = 0, to = 0;  ///< [s] robot time fitted
+  int segments = 0;       ///< driving segments used
+  int residuals = 0;
+  int iterations = 0;     ///< Levenberg-Marquardt steps taken
+  int twinRuns = 0;       ///< candidate twins run (each over every segment)
+  double costBefore = 0;  ///< mean squared scaled residual at the start values
+  double costAfter = 0;   ///< ... at the fitted ones
+  double wallMs = 0;
+  /// "" when accepted; else why it was refused (value = the start's).
+  std::string refused;
+};
+
+/// Fits the calibration of the robot that reported `frames` (oldest first;
+/// joints in `files`' first robot's order) under `commands` (each at the
+/// robot time it arrived), starting from `start`. `profile` is the twin's
+/// physics (step, iterations, ghost.hold: the ghost's own profile for the
+/// console); its calibration.* keys are ignored. `abort` is asked between
+/// twin runs: true stops the fit (refused "cancelled").
+CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& frames,
+                              const std::vector<TimedCommand>& commands, const CalValues& start,
+                              const CalibrationOptions& options = {}, const std::function<bool()>& abort = {});
+
+/// What a session log (a robot's own, or a console's telemetry log) holds
+/// for calibration: the files' world, the frames and the commands.
+struct CalibrationInput {
+  WorldModel world;  ///< as the files say (not a perturbed robot's physics)
+  SimParams params;  ///< the log's
+  std::vector<RobotFrame> frames;
+  std::vector<TimedCommand> commands;
+  std::string source;  ///< the log's meta log_source ("" for a robot's own)
+};
+/// nullopt and `error` (naming `path`) when the log cannot be read.
+std::optional<CalibrationInput> calibrationInput(const std::string& path, std::string& error);
+
+/// `values` as a parameters file (calibration.* keys, with a comment line
+/// per parameter: its deviation, or "unobserved").
+std::string calibrationParamsText(const CalibrationFit& fit);
+
+}  // namespace sp
