@@ -29,11 +29,12 @@ const std::array<CalParamInfo, kCalParams>& calParams() {
   // of a real robot's deviations (sim/perturbation.h), so that "observed"
   // means "pinned well inside what a robot may differ by".
   static const std::array<CalParamInfo, kCalParams> table{{
-      {"calibration.wheel_radius", "wheel radius", "", 1, 0.8, 1.2, 0.03, 0.005},
-      {"calibration.wheel_radius_split", "radius front - rear", "", 0, -0.1, 0.1, 0.03, 0.01},
-      {"calibration.friction", "tyre friction", "", 1, 0.3, 3, 0.3, 0.1},
-      {"calibration.motor_gain", "wheel motor gain", "", 1, 0.5, 1.5, 0.2, 0.02},
-      {"calibration.delay", "command delay", "s", 0, 0, 0.5, 0.06, 0.012},
+      // Probes of half a scale: a smaller one drowns in the contacts' noise.
+      {"calibration.wheel_radius", "wheel radius", "", 1, 0.8, 1.2, 0.03, 0.015},
+      {"calibration.wheel_radius_split", "radius front - rear", "", 0, -0.1, 0.1, 0.03, 0.015},
+      {"calibration.friction", "tyre friction", "", 1, 0.3, 3, 0.3, 0.15},
+      {"calibration.motor_gain", "wheel motor gain", "", 1, 0.5, 1.5, 0.2, 0.1},
+      {"calibration.delay", "command delay", "s", 0, 0, 0.5, 0.06, 0.03},
       {"calibration.mass", "total mass", "", 1, 0.5, 2, 0.15, 0},
   }};
   return table;
@@ -256,13 +257,6 @@ std::optional<std::vector<double>> residuals(const Problem& pb, const CalValues&
                                          kResidualScale.articulation);
     }
   }
-  if (getenv("SP_CAL_DEBUG")) {
-    double c[kPerCheckpoint] = {};
-    for (size_t i = 0; i < r.size(); ++i) c[i % kPerCheckpoint] += r[i] * r[i] * kPerCheckpoint / static_cast<double>(r.size());
-    fprintf(stderr, "v %.4f %.4f %.4f %.4f %.4f:", v[0], v[1], v[2], v[3], v[4]);
-    for (double x : c) fprintf(stderr, " %.3f", x);
-    fprintf(stderr, "\n");
-  }
   for (double x : r)
     if (!std::isfinite(x)) {
       why = "the twin's prediction is not finite";
@@ -345,10 +339,12 @@ Normal normalEquations(const std::vector<std::vector<double>>& jac, const std::v
 // Each parameter's standard deviation (in its own units) given the scaled
 // Jacobian columns `jac` (d residual / d (value / scale)); parameters the
 // data cannot pin are dropped from `on` one at a time, worst first.
+// While stepping (`scatter` false) the residuals' scales are taken as
+// given: far from the fit they are large for want of fitting, not noise.
 std::vector<int> observable(const std::vector<std::vector<double>>& jac, const std::vector<double>& r,
-                            std::vector<int> on, CalValues& sigma) {
+                            std::vector<int> on, CalValues& sigma, bool scatter) {
   const double dof = std::max<double>(1, static_cast<double>(r.size()) - static_cast<double>(on.size()));
-  const double inflate = std::max(1.0, meanSquare(r) * static_cast<double>(r.size()) / dof);
+  const double inflate = scatter ? std::max(1.0, meanSquare(r) * static_cast<double>(r.size()) / dof) : 1.0;
   while (!on.empty()) {
     const Normal n = normalEquations(jac, r, on);
     // The covariance's diagonal: one solve per unit vector.
@@ -498,7 +494,7 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   };
   double lambda = 1e-3;
   std::vector<std::vector<double>> jac(kFitted);
-  std::vector<int> on;
+  std::vector<int> on, everSmooth;  // everSmooth: moved the twin more than its noise at some iteration
   for (int it = 0; it < o.iterations; ++it) {
     if (!o.fixed[kGain] && !updateGain()) return done("the twin diverged fitting the motor gain: " + why);
     if (free.empty()) break;
@@ -533,9 +529,11 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
         curve += bend * bend;
       }
       if (curve < slope) smooth.push_back(free[k]);
+      if (curve < slope && std::find(everSmooth.begin(), everSmooth.end(), free[k]) == everSmooth.end())
+        everSmooth.push_back(free[k]);
     }
     CalValues sigma{};
-    on = observable(jac, *r, smooth, sigma);
+    on = observable(jac, *r, smooth, sigma, false);
     for (int p : free) fit.sigma[static_cast<size_t>(p)] = sigma[static_cast<size_t>(p)];
     if (on.empty()) break;
     const Normal n = normalEquations(jac, *r, on);
@@ -553,9 +551,6 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       std::string cwhy;
       std::optional<std::vector<double>> cr = residuals(pb, c, cwhy);
       ++fit.twinRuns;
-      if (getenv("SP_CAL_DEBUG"))
-        fprintf(stderr, "it %d try %d lambda %g: r %.4f s %.4f f %.3f g %.4f d %.4f cost %.4f (was %.4f) on %zu\n", it, attempt,
-                lambda, c[0], c[1], c[2], c[3], c[4], cr ? meanSquare(*cr) : -1.0, fit.costAfter, on.size());
       if (cr && meanSquare(*cr) < fit.costAfter) {
         v = c;
         r = std::move(cr);
@@ -570,6 +565,13 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       }
     }
     if (!stepped) break;
+  }
+  // The deviations at the fit, inflated by the residuals' own scatter.
+  std::sort(everSmooth.begin(), everSmooth.end());
+  if (!everSmooth.empty()) {
+    CalValues sigma{};
+    on = observable(jac, *r, everSmooth, sigma, true);
+    for (int p : free) fit.sigma[static_cast<size_t>(p)] = sigma[static_cast<size_t>(p)];
   }
   for (int p : on) fit.observed[static_cast<size_t>(p)] = true;
   for (int p = 0; p < kFitted; ++p) {

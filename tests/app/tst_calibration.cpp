@@ -24,6 +24,7 @@
 #include "app/calibration/recorded_drive.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
+#include "tests/test_files.h"
 
 using namespace sp;
 
@@ -91,21 +92,96 @@ class TestCalibration : public QObject {
     QVERIFY(fit.observed[0]);
     QVERIFY2(std::abs(fit.value[0] - 0.98) <= 0.003 * 0.98, qPrintable(QString::number(fit.value[0], 'f', 5)));
   }
-  void debugCost() {
+  void straightDriveLeavesFrictionUnobserved() {
     const WorldModel world = loadWorldFile("flat.world.xml");
     Perturbation p = none(world);
-    p.wheelRadius = {0.98, 0.98, 0.98, 0.98};
-    const RecordedDrive d = recordDrive(world, SimParams{}, p, commands(world, kDriveAndTurn), 10.0);
-    for (double r : {0.96, 0.97, 0.98, 0.99, 1.0}) {
-      CalValues v = filesCalValues();
-      v[0] = r;
-      CalibrationOptions o;
-      o.iterations = 0;
-      for (SimParams prof : {ghostProfile(), SimParams{}}) {
-        const CalibrationFit fit = fitCalibration(world, prof, d.frames, d.commands, v, o);
-        qInfo("r %.3f step %.3f cost %.4f", r, prof.step, fit.costBefore);
-      }
+    p.friction = 0.7;  // hidden, and nothing in the motion can show it
+    const RecordedDrive d = recordDrive(world, SimParams{}, p, commands(world, kStraight), 10.0);
+    QVERIFY2(d.problem.empty(), d.problem.c_str());
+    CalValues start = filesCalValues();
+    start[static_cast<size_t>(CalParam::Friction)] = 1.1;  // a previous fit's: kept
+    const CalibrationFit fit = fitCalibration(world, ghostProfile(), d.frames, d.commands, start);
+    print(fit);
+    QVERIFY2(fit.refused.empty(), fit.refused.c_str());
+    QVERIFY(!fit.observed[static_cast<size_t>(CalParam::Friction)]);
+    QCOMPARE(fit.value[static_cast<size_t>(CalParam::Friction)], 1.1);
+    QVERIFY(fit.observed[static_cast<size_t>(CalParam::WheelRadius)]);  // what straight driving does show
+  }
+
+  // Telemetry that covers `stretch` x the ground its wheels roll (a robot
+  // towed, or a localisation that scales distance): at 1.3 no calibration
+  // within bounds explains it (wheel_radius <= 1.2), so the fit is refused
+  // and the start kept. Control: at 1.08 it is accepted, as a radius.
+  void fitBeyondBoundsIsRefused_data() {
+    QTest::addColumn<double>("stretch");
+    QTest::addColumn<bool>("refused");
+    QTest::newRow("ground x1.3: refused") << 1.3 << true;
+    QTest::newRow("control: ground x1.08 accepted") << 1.08 << false;
+  }
+  void fitBeyondBoundsIsRefused() {
+    QFETCH(double, stretch);
+    QFETCH(bool, refused);
+    const WorldModel world = loadWorldFile("flat.world.xml");
+    RecordedDrive d = recordDrive(world, SimParams{}, none(world), commands(world, kStraight), 8.0);
+    QVERIFY2(d.problem.empty(), d.problem.c_str());
+    const Vec3 origin = d.frames.front().base.p;
+    for (RobotFrame& f : d.frames) {
+      f.base.p = origin + stretch * (f.base.p - origin);
+      f.baseLinearVelocity = stretch * f.baseLinearVelocity;
     }
+    CalValues start = filesCalValues();
+    start[static_cast<size_t>(CalParam::Delay)] = 0.02;
+    const CalibrationFit fit = fitCalibration(world, ghostProfile(), d.frames, d.commands, start);
+    print(fit);
+    QCOMPARE(!fit.refused.empty(), refused);
+    if (refused) {
+      QVERIFY2(fit.refused.find("calibration.wheel_radius") != std::string::npos, fit.refused.c_str());
+      QVERIFY(fit.value == start);
+    } else {
+      QVERIFY(std::abs(fit.value[0] - stretch) < 0.01);
+    }
+  }
+
+  void standingStillIsRefused() {
+    const WorldModel world = loadWorldFile("flat.world.xml");
+    const RecordedDrive d = recordDrive(world, SimParams{}, none(world), commands(world, "0.5 stop\n"), 6.0);
+    QVERIFY2(d.problem.empty(), d.problem.c_str());
+    const CalibrationFit fit = fitCalibration(world, ghostProfile(), d.frames, d.commands, filesCalValues());
+    QVERIFY2(fit.refused.find("not enough driving: 0 segments") != std::string::npos, fit.refused.c_str());
+  }
+  // The offline tool on a robot's own log of a straight drive: friction is
+  // printed unobserved, the parameters file it writes loads; a log of a
+  // robot standing still exits 7 and says what is missing.
+  void calibrateCommandOnALog() {
+    QTemporaryDir dir;
+    QVERIFY(dir.isValid());
+    const auto runSim = [&](const QStringList& args, QString& out) {
+      QProcess p;
+      p.start(SP_SIM_EXE, args);
+      if (!p.waitForFinished(120000)) return -1;
+      out = QString::fromUtf8(p.readAllStandardOutput() + p.readAllStandardError());
+      return p.exitCode();
+    };
+    const QString world = QString(SP_SOURCE_DIR) + "/terrains/flat.world.xml";
+    const QString seq = QString::fromStdString(test::writeFile(dir, "straight.seq", kStraight));
+    const QString still = QString::fromStdString(test::writeFile(dir, "still.seq", "0.5 stop\n"));
+    QString out;
+    for (const auto& [name, commands] : {std::pair{"straight.db", seq}, std::pair{"still.db", still}})
+      QCOMPARE(runSim({"run", "--world", world, "--commands", commands, "--duration", "10", "--rtf", "max", "--quiet",
+                       "--log", dir.filePath(name)},
+                      out),
+               0);
+    const QString params = dir.filePath("fitted.params");
+    QCOMPARE(runSim({"calibrate", dir.filePath("straight.db"), "--out", params}, out), 0);
+    qInfo("%s", qPrintable(out));
+    QVERIFY2(QRegularExpression("calibration.friction +1\\.0+ unobserved").match(out).hasMatch(), qPrintable(out));
+    QVERIFY2(QRegularExpression("calibration.wheel_radius +[01]\\.[0-9]+ \\+- ").match(out).hasMatch(), qPrintable(out));
+    SimParams loaded;
+    Diagnostics diag;
+    QVERIFY2(loadParams(params.toStdString(), loaded, diag), diag.format().c_str());
+    QVERIFY(std::abs(loaded.calWheelRadius - 1) < 0.01);
+    QCOMPARE(runSim({"calibrate", dir.filePath("still.db")}, out), 7);
+    QVERIFY2(out.contains("not enough driving"), qPrintable(out));
   }
 };
 
