@@ -14,6 +14,7 @@
 #include "app/robot/stand_in.h"
 #include "app/log/telemetry_recorder.h"
 #include "sim/model_loader.h"
+#include "sim/perturbation.h"
 #include "sim/terrain_brush.h"
 #include "sim/text.h"
 
@@ -48,10 +49,45 @@ void ConsoleSession::setWorld(WorldModel world) {
   positions_.reset();
   rates_.reset();
   rate_.reset();
+  calibrator_.reset();
   ghost_.reset();
   lastPrediction_.reset();
   ghostError_.clear();
-  if (options_.ghost) ghost_ = Ghost::create(*world_, params_, options_.ghostOptions, ghostError_);
+  calibrationSeen_ = calibrationFitsLogged_ = 0;
+  if (options_.ghost) ghost_ = Ghost::create(calibratedWorld(*world_, params_), params_, options_.ghostOptions, ghostError_);
+  if (ghost_) {
+    if (params_.calDelay > 0) ghost_->setCalibration(calibratedWorld(*world_, params_), params_.calDelay);
+    if (options_.calibrate) {
+      SimParams profile = params_;  // the ghost's physics: the twin it calibrates
+      profile.step = params_.ghostStep;
+      profile.iterations = params_.ghostIterations;
+      calibrator_ = std::make_unique<LiveCalibrator>(*world_, profile, calValues(params_), options_.calibration);
+    }
+  }
+}
+
+SimParams ConsoleSession::twinParams() const {
+  return calibrator_ ? withCalValues(params_, calibrator_->state().applied) : params_;
+}
+
+void ConsoleSession::takeCalibration() {
+  if (!calibrator_ || calibrator_->version() == calibrationSeen_) return;
+  const CalibrationState s = calibrator_->state();
+  const SimParams calibrated = withCalValues(params_, s.applied);
+  if (ghost_) ghost_->setCalibration(calibratedWorld(*world_, calibrated), calibrated.calDelay);
+  calibrationSeen_ = s.version;
+  // The fits since the last call, one row per parameter (the history keeps the newest).
+  const int fresh = std::min<int>(s.fits - calibrationFitsLogged_, static_cast<int>(s.history.size()));
+  for (size_t k = s.history.size() - static_cast<size_t>(fresh); k < s.history.size(); ++k) {
+    const CalibrationFit& fit = s.history[k];
+    const std::string status = !fit.refused.empty() ? "refused: " + fit.refused : s.frozen ? "frozen" : "applied";
+    for (size_t i = 0; i < kCalParams; ++i) {
+      const LogCalibration row{fit.to, calParams()[i].key, fit.value[i], fit.sigma[i], fit.observed[i], status};
+      if (standIn_) standIn_->logCalibration(row);
+      if (recorder_) recorder_->calibration(row);
+    }
+  }
+  calibrationFitsLogged_ = s.fits;
 }
 
 std::string ConsoleSession::start() {
@@ -215,6 +251,10 @@ RobotFrame ConsoleSession::telemetry(const net::TelemetryMsg& t, double wall, do
       lastPrediction_ = ghost_->anchor(f, roundTrip > 0 ? roundTrip : t.rttMs / 1000);
       if (lastPrediction_) logPrediction(*lastPrediction_);
     }
+    if (calibrator_) {
+      calibrator_->frame(f);
+      takeCalibration();
+    }
   }
   rate_.add(wall, t.time);
   return f;
@@ -232,7 +272,11 @@ std::string ConsoleSession::commandRefusal(bool leaseHeld) const {
 
 void ConsoleSession::commandSent(const Command& command) {
   if (recorder_) recorder_->command(command, robot());
-  if (ghost_) ghost_->commandSent(command);
+  if (ghost_) {
+    // Dated before the ghost adds the calibrated delay: the fit adds its own.
+    if (calibrator_) calibrator_->command(command, ghost_->ghostTime(Ghost::now()));
+    ghost_->commandSent(command);
+  }
 }
 
 bool ConsoleSession::terrainEdited(const TerrainPatchCmd& patch) {

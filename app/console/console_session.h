@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "app/calibration/live_calibrator.h"
 #include "app/ghost/ghost.h"
 #include "app/log/resimulation.h"
 #include "app/console/robot_frame.h"
@@ -50,6 +51,10 @@ struct ConsoleSessionOptions {
   /// rehearsals keep the files. nullopt = the stand-in runs the files.
   std::optional<uint64_t> perturbSeed;
   bool ghost = true;                   ///< run the predictive ghost (app/ghost/ghost.h)
+  /// Calibrate the twin from telemetry while driving (app/calibration/
+  /// live_calibrator.h; needs the ghost: its clock dates the commands).
+  bool calibrate = true;
+  LiveCalibrator::Options calibration;  ///< its options
   Ghost::Options ghostOptions;         ///< its options (tests' controls)
 };
 
@@ -145,6 +150,14 @@ class ConsoleSession {
   /// (options.ghost false, or it could not be built: ghostError()).
   const Ghost* ghost() const { return ghost_.get(); }
   const std::string& ghostError() const { return ghostError_; }
+  /// The calibration from telemetry; null without a ghost (or with
+  /// options.calibrate false). Its applied values reach the ghost at the
+  /// next telemetry frame and twinParams() at once.
+  LiveCalibrator* calibrator() { return calibrator_.get(); }
+  const LiveCalibrator* calibrator() const { return calibrator_.get(); }
+  /// The parameters with the calibration applied now: what the twins the
+  /// console starts (rehearsals, robustness runs, sweeps) are built with.
+  SimParams twinParams() const;
   /// The last telemetry frame against the ghost's prediction for its time;
   /// nullopt when the ghost had shown nothing for that time.
   const std::optional<GhostError>& lastPrediction() const { return lastPrediction_; }
@@ -186,6 +199,8 @@ class ConsoleSession {
   /// Deletes logs beyond log.keep in the log folder (never the current one).
   void pruneLogs();
   void logPrediction(const GhostError& error);
+  /// Hands a new calibration to the ghost and logs the fits made since the last call.
+  void takeCalibration();
 
   ConsoleSessionOptions options_;
   SimParams params_;
@@ -199,6 +214,9 @@ class ConsoleSession {
   std::string recorderError_;
   RobotEndpoint endpoint_;
   std::unique_ptr<Ghost> ghost_;
+  std::unique_ptr<LiveCalibrator> calibrator_;
+  int64_t calibrationSeen_ = 0;  // the calibrator's version the ghost and the log have
+  int calibrationFitsLogged_ = 0;
   std::string ghostError_;
   std::optional<GhostError> lastPrediction_;
   JointNameMap positions_, rates_;

@@ -151,9 +151,18 @@ std::optional<GhostError> Ghost::anchor(const RobotFrame& frame, double roundTri
 void Ghost::commandSent(const Command& command) {
   {
     std::lock_guard lock(mutex_);
-    commands_.add(command, clock_.ghostTime(now()));
+    commands_.add(command, clock_.ghostTime(now()) + delay_);
   }
   presentWake_.notify_one();
+}
+
+void Ghost::setCalibration(WorldModel world, double delay) {
+  {
+    std::lock_guard lock(mutex_);
+    nextModel_ = std::move(world);
+    delay_ = delay;
+  }
+  anchorWake_.notify_one();
 }
 
 GhostView Ghost::view() const {

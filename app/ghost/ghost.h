@@ -133,6 +133,11 @@ class Ghost {
   std::optional<GhostError> anchor(const RobotFrame& frame, double roundTrip);
   /// The operator sent `command` now; it is taken to arrive at ghost(now).
   void commandSent(const Command& command);
+  /// The robot as calibrated (app/calibration): `world` (the files'
+  /// calibratedWorld()) is what the ghost's twins are built from from the
+  /// next re-anchoring on (its step boundary), and commands sent from now
+  /// on act `delay` seconds after they arrive.
+  void setCalibration(WorldModel world, double delay);
   /// Commands sent so far (commandSent() calls).
   uint64_t commandsSent() const;
   /// The ghost as it is now (a copy).
@@ -186,7 +191,7 @@ class Ghost {
                const std::function<bool()>& abort = {}) const;
   void setProblem(const std::string& problem);
 
-  WorldModel model_;  // the full world
+  WorldModel model_;  // the full world, as calibrated: the anchor thread's once it runs
   SimParams params_;  // the ghost profile
   Options options_;
   std::vector<int> held_;  // joints the ghost may hold rigid (ghost.hold's subtrees but the drive's), sorted
@@ -199,6 +204,8 @@ class Ghost {
   GhostClock clock_;
   InFlightCommands commands_;  // the last 10 s of robot time
   uint64_t epoch_ = 0;  // counts robot resets (its clock went back)
+  std::optional<WorldModel> nextModel_;  // a calibration for the anchor thread to take
+  double delay_ = 0;  // [s] calibration.delay: commands act this long after they arrive
   std::shared_ptr<const Base> base_;
   uint64_t baseVersion_ = 0;
   std::shared_ptr<const TrailRequest> trailRequest_;

@@ -42,12 +42,14 @@ void Ghost::anchorLoop() {
   std::unique_ptr<World> world;
   Snapshot anchored;  // the last anchored state, commands in effect included
   uint64_t seen = 0, applied = 0, epoch = 0;
-  HoldPolicy policy(held_, model_.robots[0].model);
+  const RobotModel robot = model_.robots[0].model;  // its joints; model_ may be recalibrated
+  HoldPolicy policy(held_, robot);
   double lastStart = -1e9;
   for (;;) {
     RobotFrame frame;
     std::vector<SentCommand> effective, pending;
     double target = 0;
+    bool recalibrated = false;
     {
       std::unique_lock lock(mutex_);
       anchorWake_.wait(lock, [&] { return stop_ || frameVersion_ != seen; });
@@ -58,6 +60,11 @@ void Ghost::anchorLoop() {
       if (stop_) return;
       seen = frameVersion_;
       frame = *frame_;
+      if (nextModel_) {  // a calibration: the twin is rebuilt at this anchor's step boundary
+        model_ = std::move(*nextModel_);
+        nextModel_.reset();
+        recalibrated = true;
+      }
       if (epoch != epoch_) {  // the robot restarted: weld and build anew
         epoch = epoch_;
         world.reset();
@@ -68,7 +75,7 @@ void Ghost::anchorLoop() {
       target = options_.runAhead ? clock_.ghostTime(now()) : frame.time;
     }
     lastStart = now();
-    const size_t joints = model_.robots[0].model.joints.size();
+    const size_t joints = robot.joints.size();
     if (frame.jointPositions.size() != joints || frame.jointRates.size() != joints) {
       setProblem("telemetry at " + std::to_string(frame.time) + " s has " +
                  std::to_string(frame.jointPositions.size()) + " joint positions and " +
@@ -80,7 +87,7 @@ void Ghost::anchorLoop() {
     const HoldDecision decision =
         policy.decide(frame, effective, pending, world && twin->rigid ? &*twin->rigid : nullptr, world != nullptr);
     const bool hold = decision.hold;
-    if (decision.rebuild) {
+    if (decision.rebuild || (recalibrated && world)) {
       std::string error;
       std::shared_ptr<const Twin> next = makeTwin(frame.jointPositions, hold, error);
       std::unique_ptr<World> built = next ? buildWorld(*next, &error) : nullptr;

@@ -35,8 +35,12 @@ struct LoggedWorld {
   /// The logged robot's hidden deviations (meta `perturbation_seed`), if it
   /// was a robot that is not its twin: its physics is physicsWorld().
   std::optional<Perturbation> perturbation;
-  /// The world the logged robot's physics ran: world, perturbed if it was.
-  WorldModel physicsWorld() const { return perturbation ? perturbWorld(world, *perturbation) : world; }
+  /// The world the logged robot's physics ran: world calibrated by the
+  /// parameters' calibration.* keys, perturbed if it was.
+  WorldModel physicsWorld() const {
+    const WorldModel calibrated = calibratedWorld(world, params);
+    return perturbation ? perturbWorld(calibrated, *perturbation) : calibrated;
+  }
 };
 /// nullopt and `error` (naming `path`) when the log holds no files or they
 /// do not load.

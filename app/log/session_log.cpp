@@ -30,9 +30,11 @@ CREATE TABLE hashes(step INTEGER PRIMARY KEY, hash INTEGER);
 CREATE TABLE predictions(time REAL, made REAL, base_x REAL, base_y REAL, base_z REAL,
                          qw REAL, qx REAL, qy REAL, qz REAL, error_position REAL, error_heading REAL);
 CREATE INDEX predictions_time ON predictions(time);
+CREATE TABLE calibration(time REAL, param TEXT, value REAL, sigma REAL, observed INTEGER, status TEXT);
 )sql";
 
-const char* const kStreams[] = {"meta", "commands", "samples", "laser", "events", "snapshots", "hashes", "predictions"};
+const char* const kStreams[] = {"meta",   "commands", "samples",     "laser",      "events",
+                                 "snapshots", "hashes", "predictions", "calibration"};
 
 // Doubles as little-endian bytes, and back.
 std::vector<uint8_t> packDoubles(const double* values, std::size_t n) {
@@ -141,9 +143,10 @@ struct SessionLogWriter::Statements {
         event(db, "INSERT INTO events VALUES(?,?,?,?)"),
         snapshot(db, "INSERT OR REPLACE INTO snapshots VALUES(?,?,?,?)"),
         hash(db, "INSERT OR REPLACE INTO hashes VALUES(?,?)"),
-        prediction(db, "INSERT INTO predictions VALUES(?,?,?,?,?,?,?,?,?,?,?)") {}
-  bool ok() const { return command && sample && laser && event && snapshot && hash && prediction; }
-  Stmt command, sample, laser, event, snapshot, hash, prediction;
+        prediction(db, "INSERT INTO predictions VALUES(?,?,?,?,?,?,?,?,?,?,?)"),
+        calibration(db, "INSERT INTO calibration VALUES(?,?,?,?,?,?)") {}
+  bool ok() const { return command && sample && laser && event && snapshot && hash && prediction && calibration; }
+  Stmt command, sample, laser, event, snapshot, hash, prediction, calibration;
 };
 
 SessionLogWriter::SessionLogWriter(std::string path, const SessionLogOptions& options)
@@ -244,6 +247,8 @@ bool SessionLogWriter::logCommand(int64_t step, double time, const std::string& 
 bool SessionLogWriter::logSample(LogSample sample) { return push(std::move(sample)); }
 bool SessionLogWriter::logLaser(LogLaser scan) { return push(std::move(scan)); }
 bool SessionLogWriter::logPrediction(const LogPrediction& prediction) { return push(prediction); }
+
+bool SessionLogWriter::logCalibration(LogCalibration row) { return push(std::move(row)); }
 bool SessionLogWriter::logEvent(int64_t step, double time, std::string kind, std::string text) {
   return push(LogEvent{step, time, std::move(kind), std::move(text)});
 }
@@ -332,6 +337,11 @@ bool SessionLogWriter::writeBatch(std::deque<Item>& batch) {
       for (int i = 0; i < 3; ++i) st.bind(3 + i, p->base[static_cast<std::size_t>(i)]);
       for (int i = 0; i < 4; ++i) st.bind(6 + i, p->quat[static_cast<std::size_t>(i)]);
       st.bind(10, p->positionError); st.bind(11, p->headingError);
+      rc = st.exec();
+    } else if (const auto* k = std::get_if<LogCalibration>(&item)) {
+      Stmt& st = s.calibration;
+      st.bind(1, k->time); st.bind(2, k->param); st.bind(3, k->value); st.bind(4, k->sigma);
+      st.bind(5, static_cast<int64_t>(k->observed ? 1 : 0)); st.bind(6, k->status);
       rc = st.exec();
     }
     if (rc != SQLITE_DONE) break;
@@ -517,6 +527,14 @@ std::vector<LogPrediction> SessionLogReader::predictionsBetween(double t0, doubl
     p.headingError = q.f64(10);
     out.push_back(p);
   }
+  return out;
+}
+
+std::vector<LogCalibration> SessionLogReader::calibration() const {
+  std::vector<LogCalibration> out;
+  Stmt q(db_, "SELECT time, param, value, sigma, observed, status FROM calibration ORDER BY time, rowid");
+  // A log from before calibration was logged has no such table.
+  while (q && q.row()) out.push_back(LogCalibration{q.f64(0), q.text(1), q.f64(2), q.f64(3), q.i64(4) != 0, q.text(5)});
   return out;
 }
 

@@ -89,6 +89,18 @@ struct LogPrediction {
   friend bool operator==(const LogPrediction&, const LogPrediction&) = default;
 };
 
+/// One parameter of a calibration fit the console made (app/calibration):
+/// one row per parameter per fit.
+struct LogCalibration {
+  double time = 0;     ///< [s] robot time of the newest telemetry fitted
+  std::string param;   ///< its key (calibration.wheel_radius)
+  double value = 0;    ///< fitted (or kept, when unobserved or refused)
+  double sigma = 0;    ///< one standard deviation; 0 when unobserved
+  bool observed = false;
+  std::string status;  ///< "applied", "frozen" (fitted, not applied), "reset", or "refused: why"
+  friend bool operator==(const LogCalibration&, const LogCalibration&) = default;
+};
+
 /// A command as applied: its step, its source ("operator", "sequence",
 /// "rehearsal") and its sequence-file text (sp::toText).
 struct LogCommand {
@@ -151,6 +163,7 @@ class SessionLogWriter {
   bool logLaser(LogLaser scan);
   /// Safe from any thread (the console's, while the physics thread logs).
   bool logPrediction(const LogPrediction& prediction);
+  bool logCalibration(LogCalibration row);
   bool logEvent(int64_t step, double time, std::string kind, std::string text);
   /// A snapshot (encoded by the writer thread) with its World::stateHash().
   bool logSnapshot(Snapshot snapshot, double time, uint64_t hash);
@@ -178,7 +191,7 @@ class SessionLogWriter {
     int64_t step = 0;
     uint64_t hash = 0;
   };
-  using Item = std::variant<LogCommand, LogSample, LogLaser, LogEvent, SnapshotItem, HashItem, LogPrediction>;
+  using Item = std::variant<LogCommand, LogSample, LogLaser, LogEvent, SnapshotItem, HashItem, LogPrediction, LogCalibration>;
   struct Statements;
 
   SessionLogWriter(std::string path, const SessionLogOptions& options);
@@ -237,6 +250,8 @@ class SessionLogReader {
   /// written before they were logged.
   std::vector<LogPrediction> predictionsBetween(double t0, double t1) const;
   std::vector<LogCommand> commands() const;
+  /// The console's calibration fits, oldest first (none in older logs).
+  std::vector<LogCalibration> calibration() const;
   std::vector<LogEvent> events() const;
   /// (step, hash) of the periodic state hashes, in step order.
   std::vector<std::pair<int64_t, uint64_t>> hashes() const;

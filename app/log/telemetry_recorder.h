@@ -41,6 +41,8 @@ class TelemetryRecorder {
   void event(const std::string& kind, const std::string& text);
   /// What the console's ghost predicted for a frame (app/ghost/ghost.h).
   void prediction(const LogPrediction& prediction) { writer_->logPrediction(prediction); }
+  /// A calibration fit's row (app/calibration).
+  void calibration(const LogCalibration& row) { writer_->logCalibration(row); }
 
   const SessionLogWriter& writer() const { return *writer_; }
   const std::string& path() const { return writer_->path(); }

@@ -10,8 +10,10 @@
 
 #include "sim/hash.h"
 #include "sim/kinematics.h"
+#include "sim/perturbation.h"
 #include "sim/random.h"
 #include "sim/rigid.h"
+#include "sim/perturbation.h"
 #include "sim/runner.h"
 #include "sim/text.h"
 #include "sim/world.h"
@@ -135,7 +137,10 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
     result.error = "the world has no robot";
     return result;
   }
-  const RobotModel& full = plan.world.robots[0].model;
+  // A twin calibrated to the robot (calibration.* keys) has its physics
+  // and acts on each command its delay after it is due, as the robot does.
+  const WorldModel calibrated = calibratedWorld(plan.world, plan.params);
+  const RobotModel& full = calibrated.robots[0].model;
   if (plan.start && (plan.start->jointPositions.size() != full.joints.size() ||
                      plan.start->jointRates.size() != full.joints.size())) {
     result.error = "the start state has " + std::to_string(plan.start->jointPositions.size()) +
@@ -144,7 +149,7 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   }
   // The joints the sequence leaves alone, welded where the start has them.
   std::optional<RigidRobot> rigid;
-  WorldModel model = plan.world;
+  WorldModel model = calibrated;
   if (plan.holdUnmoved) {
     const std::vector<int> held = unmovedJoints(full, plan.commands);
     std::string why;
@@ -168,10 +173,12 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
       return result;
     }
   }
-  result.duration = (plan.commands.empty() ? 0.0 : plan.commands.back().time) + plan.rules.settle;
+  result.duration = (plan.commands.empty() ? 0.0 : plan.commands.back().time) + plan.params.calDelay + plan.rules.settle;
   RuleMonitor monitor(plan.rules, robot);
   Runner runner(*world);
-  runner.schedule(plan.commands);
+  std::vector<TimedCommand> acting = plan.commands;
+  for (TimedCommand& c : acting) c.time += plan.params.calDelay;
+  runner.schedule(acting);
   const int64_t total = std::max<int64_t>(1, std::llround(result.duration / plan.params.step));
   const int64_t sampleEvery = std::max<int64_t>(1, std::llround(RehearsalResult::kSampleInterval / plan.params.step));
   const int64_t progressEvery = std::max<int64_t>(1, total / 100);

@@ -53,8 +53,9 @@ std::unique_ptr<StandInRobot> StandInRobot::create(const StandInOptions& options
   // and logs as its files stays the files.
   std::optional<Perturbation> perturbation;
   if (options.perturbSeed) perturbation = drawPerturbation(*options.perturbSeed, model->robots[0].model);
-  std::unique_ptr<World> world =
-      World::create(perturbation ? perturbWorld(*model, *perturbation) : *model, *params, diag);
+  // A twin calibrated by the parameters (calibration.*) is calibrated here too.
+  const WorldModel physics = calibratedWorld(*model, *params);
+  std::unique_ptr<World> world = World::create(perturbation ? perturbWorld(physics, *perturbation) : physics, *params, diag);
   if (!world) return nullptr;
   if (options.startState) {
     if (std::string why = world->restore(*options.startState); !why.empty()) {
@@ -63,7 +64,9 @@ std::unique_ptr<StandInRobot> StandInRobot::create(const StandInOptions& options
     }
   }
   auto host = std::make_unique<TwinHost>(std::move(world), params->realTimeFactor);
-  if (perturbation) host->setDeviations(perturbation->delay, perturbation->rollBias, perturbation->pitchBias);
+  if (perturbation || params->calDelay > 0)
+    host->setDeviations((perturbation ? perturbation->delay : 0) + params->calDelay,
+                        perturbation ? perturbation->rollBias : 0, perturbation ? perturbation->pitchBias : 0);
   return std::unique_ptr<StandInRobot>(new StandInRobot(options, std::move(*model), std::move(host), *params, std::move(replacedRobotFile)));
 }
 
@@ -205,5 +208,7 @@ void StandInRobot::addNote(std::string text) { host_->logEvent("note", std::move
 void StandInRobot::logEvent(std::string kind, std::string text) { host_->logEvent(std::move(kind), std::move(text)); }
 
 void StandInRobot::logPrediction(const LogPrediction& prediction) { host_->logPrediction(prediction); }
+
+void StandInRobot::logCalibration(const LogCalibration& row) { host_->logCalibration(row); }
 
 }  // namespace sp

@@ -39,6 +39,7 @@ namespace sp {
 
 class TwinHost;
 struct LogPrediction;
+struct LogCalibration;
 class SessionLogWriter;
 
 /// How to run the stand-in robot. Defaults: loopback, the parameters'
@@ -146,6 +147,7 @@ class StandInRobot {
   void logEvent(std::string kind, std::string text);
   /// Logs a prediction of the console's ghost; dropped without a log.
   void logPrediction(const LogPrediction& prediction);
+  void logCalibration(const LogCalibration& row);
 
  private:
   struct Server;  // the io_context, RobotServer and its thread (Asio stays out of this header)

@@ -63,6 +63,10 @@ void TwinHost::logPrediction(const LogPrediction& prediction) {
   if (log_) log_->writer().logPrediction(prediction);
 }
 
+void TwinHost::logCalibration(const LogCalibration& row) {
+  if (log_) log_->writer().logCalibration(row);
+}
+
 CommandCheck TwinHost::check(const Command& command) const {
   // A terrain edit is the simulator's: a real robot could not carry it out.
   if (const auto* patch = std::get_if<TerrainPatchCmd>(&command)) {

@@ -73,6 +73,8 @@ class TwinHost : public net::RobotPort {
   /// Logs what the console's ghost predicted (app/ghost/ghost.h); dropped without
   /// a log. Thread: the owner's (not after stop()); never blocks on the disk.
   void logPrediction(const LogPrediction& prediction);
+  /// A calibration fit's row (app/calibration), from any thread.
+  void logCalibration(const LogCalibration& row);
 
   const RobotModel* model() const override { return &model_; }
   CommandCheck check(const Command& command) const override;

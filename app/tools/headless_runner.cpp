@@ -11,6 +11,7 @@
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/pacer.h"
+#include "sim/perturbation.h"
 #include "sim/runner.h"
 
 namespace sp {
@@ -81,7 +82,7 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
   err << diag.format();
   if (diag.hasErrors() || !params || !model) return std::nullopt;
 
-  std::unique_ptr<World> world = World::create(*model, *params, diag);
+  std::unique_ptr<World> world = World::create(calibratedWorld(*model, *params), *params, diag);
   if (!world) {
     err << diag.format();
     return std::nullopt;
@@ -142,6 +143,8 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
   RunReport report;
   report.requestedFactor = params->realTimeFactor;
   Runner runner(*world);
+  // A calibrated twin acts on each command its delay after it is due.
+  for (TimedCommand& c : commands) c.time += params->calDelay;
   runner.schedule(commands);
   runner.setSubmitHook([&](const ScheduledCommand& c, const std::string& why) {
     if (!why.empty()) err << options.commandsFile << ":" << c.line << ": error: " << why << "\n";

@@ -116,6 +116,10 @@ class TestSessionLog : public QObject {
     std::thread([&] {
       for (const LogPrediction& p : predictions) QVERIFY(log->logPrediction(p));
     }).join();
+    // A calibration fit's rows (app/calibration), one applied and one refused.
+    const std::vector<LogCalibration> calibration = {{4.0, "calibration.wheel_radius", 0.98, 0.002, true, "applied"},
+                                                     {7.0, "calibration.friction", 1.0, 0, false, "refused: not enough driving"}};
+    for (const LogCalibration& c : calibration) QVERIFY(log->logCalibration(c));
     log->close();
     QCOMPARE(log->dropped(), int64_t{0});
     QVERIFY(!log->failed());
@@ -136,8 +140,9 @@ class TestSessionLog : public QObject {
 
     const std::vector<std::pair<std::string, int64_t>> expected = {
         {"meta", static_cast<int64_t>(meta.size())}, {"commands", 1}, {"samples", 2000}, {"laser", 40},
-        {"events", 1}, {"snapshots", 3}, {"hashes", 2}, {"predictions", 2}};
+        {"events", 1}, {"snapshots", 3}, {"hashes", 2}, {"predictions", 2}, {"calibration", 2}};
     QCOMPARE(reader->streams(), expected);
+    QCOMPARE(reader->calibration(), calibration);
 
     QCOMPARE(reader->commands(), (std::vector<LogCommand>{{0, 0.0, "sequence", toText(drive)}}));
     QCOMPARE(reader->events(), (std::vector<LogEvent>{{0, 0.0, "note", "start"}}));

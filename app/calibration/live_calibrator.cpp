@@ -1,0 +1,122 @@
+#include "app/calibration/live_calibrator.h"
+
+#include <pthread.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <algorithm>
+
+namespace sp {
+
+namespace {
+constexpr double kCommandMemory = 120;  // [s] of robot time: the commands a window's anchors may need
+}  // namespace
+
+LiveCalibrator::LiveCalibrator(WorldModel files, const SimParams& profile, const CalValues& start, const Options& options)
+    : files_(std::move(files)), profile_(profile), files0_(filesCalValues()), options_(options) {
+  state_.applied = start;
+  worker_ = std::thread([this] { run(); });
+}
+
+LiveCalibrator::~LiveCalibrator() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  worker_.join();
+}
+
+void LiveCalibrator::frame(const RobotFrame& f) {
+  {
+    std::lock_guard lock(mutex_);
+    if (!frames_.empty() && f.time < frames_.back().time) {  // the robot restarted
+      frames_.clear();
+      commands_.clear();
+      lastFitAt_ = -1e300;
+    }
+    frames_.push_back(f);
+    const double keep = options_.fit.window > 0 ? options_.fit.window + 2 : 60;
+    while (frames_.front().time < f.time - keep) frames_.pop_front();
+    while (!commands_.empty() && commands_.front().time < f.time - kCommandMemory) commands_.pop_front();
+  }
+  wake_.notify_one();
+}
+
+void LiveCalibrator::command(const Command& c, double arrival) {
+  std::lock_guard lock(mutex_);
+  commands_.push_back(TimedCommand{arrival, c, 0});
+}
+
+CalibrationState LiveCalibrator::state() const {
+  std::lock_guard lock(mutex_);
+  return state_;
+}
+
+int64_t LiveCalibrator::version() const {
+  std::lock_guard lock(mutex_);
+  return state_.version;
+}
+
+void LiveCalibrator::freeze(bool frozen) {
+  std::lock_guard lock(mutex_);
+  if (state_.frozen == frozen) return;
+  state_.frozen = frozen;
+  ++state_.version;
+}
+
+void LiveCalibrator::reset() {
+  std::lock_guard lock(mutex_);
+  state_.applied = files0_;
+  state_.sigma = {};
+  state_.observed = {};
+  ++state_.version;
+}
+
+void LiveCalibrator::run() {
+  pthread_setname_np(pthread_self(), "calibrate");
+  // Best effort: never at the expense of the twin, the ghost's present
+  // thread or the window (Linux: a thread's nice value is its own).
+  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+  for (;;) {
+    std::vector<RobotFrame> frames;
+    std::vector<TimedCommand> commands;
+    CalValues start{};
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait(lock, [&] {
+        return stop_ || (!frames_.empty() && frames_.back().time - lastFitAt_ >= options_.period &&
+                         frames_.back().time - frames_.front().time >= options_.fit.horizon * 2);
+      });
+      if (stop_) return;
+      frames.assign(frames_.begin(), frames_.end());
+      commands.assign(commands_.begin(), commands_.end());
+      start = state_.applied;
+      lastFitAt_ = frames.back().time;
+    }
+    const CalibrationFit fit = fitCalibration(files_, profile_, frames, commands, start, options_.fit, [&] {
+      std::lock_guard lock(mutex_);
+      return stop_;
+    });
+    std::lock_guard lock(mutex_);
+    if (stop_) return;
+    ++state_.fits;
+    if (!fit.refused.empty()) {
+      ++state_.refusals;
+      state_.lastRefusal = fit.refused;
+    } else if (!state_.frozen && state_.applied == start) {  // not reset meanwhile
+      state_.applied = fit.value;
+      for (size_t i = 0; i < kCalParams; ++i)
+        if (fit.observed[i]) {
+          state_.sigma[i] = fit.sigma[i];
+          state_.observed[i] = true;
+        }
+    }
+    state_.history.push_back(fit);
+    if (state_.history.size() > CalibrationState::kHistory) state_.history.erase(state_.history.begin());
+    ++state_.version;
+  }
+}
+
+}  // namespace sp

@@ -1,0 +1,91 @@
+#pragma once
+// The console's calibration while the operator drives: telemetry frames and
+// the commands sent (at their estimated arrival) go in from the GUI thread,
+// a worker thread fits the newest window (app/calibration/calibration.h)
+// every `period` seconds of new telemetry, and the values it applies come
+// out as a version the console polls (ConsoleSession hands them to the
+// ghost and to the twins it starts).
+//
+// What the operator can do: freeze (fits go on and are shown, nothing new
+// is applied), reset to the files, save (calibrationParamsText). A refused
+// fit keeps the values applied and says why (lastRefusal, the history).
+//
+// Thread: frame(), command(), state(), freeze(), reset() from any thread
+// (the GUI's); they copy under a mutex and never wait for a fit. The worker
+// runs at nice 10, beside the ghost's threads.
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/calibration/calibration.h"
+#include "app/console/robot_frame.h"
+#include "sim/command.h"
+#include "sim/params.h"
+#include "sim/robot_model.h"
+
+namespace sp {
+
+/// What the console shows of its calibration.
+struct CalibrationState {
+  int64_t version = 0;      ///< counts changes of `applied` (and fits done)
+  CalValues applied{};      ///< what the twins use now
+  CalValues sigma{};        ///< of the fit that set each (0: the files', or unobserved so far)
+  CalFlags observed{};      ///< set by a fit (else the files' or kept)
+  bool frozen = false;
+  int fits = 0, refusals = 0;
+  std::string lastRefusal;  ///< "" or why the last refused fit was
+  std::vector<CalibrationFit> history;  ///< the fits, oldest first (at most kHistory)
+  static constexpr size_t kHistory = 600;
+};
+
+class LiveCalibrator {
+ public:
+  struct Options {
+    double period = 3;  ///< [s] of new telemetry between fits
+    CalibrationOptions fit;
+  };
+  /// Fits the robot of `files` (the console's world, its first robot) with
+  /// the physics `profile` (the ghost's: step, iterations, hold) from
+  /// `start` (the parameters' calibration.* values).
+  LiveCalibrator(WorldModel files, const SimParams& profile, const CalValues& start, const Options& options);
+  LiveCalibrator(WorldModel files, const SimParams& profile, const CalValues& start)
+      : LiveCalibrator(std::move(files), profile, start, Options{}) {}
+  ~LiveCalibrator();
+  LiveCalibrator(const LiveCalibrator&) = delete;
+  LiveCalibrator& operator=(const LiveCalibrator&) = delete;
+
+  /// A telemetry frame (joints in the model's order).
+  void frame(const RobotFrame& frame);
+  /// A command sent, taken to arrive at robot time `arrival`.
+  void command(const Command& command, double arrival);
+  CalibrationState state() const;
+  /// The version alone (cheap to poll).
+  int64_t version() const;
+  void freeze(bool frozen);
+  /// Back to the files' values; the fits start from them again.
+  void reset();
+
+ private:
+  void run();
+
+  const WorldModel files_;
+  const SimParams profile_;
+  const CalValues files0_;
+  const Options options_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
+  std::deque<RobotFrame> frames_;
+  std::deque<TimedCommand> commands_;
+  double lastFitAt_ = -1e300;  // robot time of the newest frame the last fit saw
+  CalibrationState state_;
+  std::thread worker_;
+};
+
+}  // namespace sp
