@@ -88,6 +88,11 @@ QString ReplayFeed::label() const {
   return player ? QFileInfo(QString::fromStdString(player->path())).fileName() : sourceName();
 }
 
+QString ReplayFeed::logPath() const {
+  const LogPlayer* player = panel_->player();
+  return player ? QString::fromStdString(player->path()) : QString();
+}
+
 GhostFeed::GhostFeed(ConsoleSession* session, QObject* parent) : RobotFeed(parent), session_(session) {}
 
 const WorldModel* GhostFeed::shownWorld() const { return session_->world(); }

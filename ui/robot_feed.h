@@ -40,6 +40,8 @@ class RobotFeed : public QObject {
   virtual QString sourceName() const = 0;
   /// What exactly is shown, for the banner ("demo.splog"); sourceName() by default.
   virtual QString label() const { return sourceName(); }
+  /// The session log the feed plays back ("" for a live or predicted feed).
+  virtual QString logPath() const { return {}; }
   /// The world this feed's frames move in (drawn when the feed is shown),
   /// or null before it has one.
   virtual const WorldModel* shownWorld() const = 0;
@@ -101,6 +103,7 @@ class ReplayFeed : public RobotFeed {
   QString sourceName() const override { return tr("replay"); }
   /// The log's file name ("replay" before one is open).
   QString label() const override;
+  QString logPath() const override;
   const WorldModel* shownWorld() const override;
   /// Moves the replay's cursor to `time` [s]; the frame there follows.
   void seek(double time);

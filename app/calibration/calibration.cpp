@@ -461,43 +461,41 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   for (int p = 0; p < kFitted; ++p)
     if (!o.fixed[static_cast<size_t>(p)] && p != static_cast<int>(kGain)) free.push_back(p);
   CalValues v = fit.value;
-  std::optional<std::vector<double>> r = residuals(pb, v, why);
+  std::vector<std::pair<double, double>> turns;
+  std::optional<std::vector<double>> r = residuals(pb, v, why, &turns);
   ++fit.twinRuns;
   if (!r) return done("the twin cannot follow the telemetry with the current values: " + why);
   fit.residuals = static_cast<int>(r->size());
   fit.costBefore = fit.costAfter = meanSquare(*r);
-  const double perSegment = std::max(1.0, o.horizon / o.checkpoint);
-  const auto updateGain = [&]() -> bool {
-    std::vector<std::pair<double, double>> turns;
-    if (!residuals(pb, v, why, &turns)) return false;
-    ++fit.twinRuns;
+  if (!o.fixed[kGain]) {
     double tr = 0, tt = 0;
     for (const auto& [twin, real] : turns) {
       tr += twin * real;
       tt += twin * twin;
     }
-    if (!(tt > 0)) return true;
-    const double k = tr / tt;
-    double e2 = 0;
-    for (const auto& [twin, real] : turns) e2 += (real - k * twin) * (real - k * twin);
-    // Four wheels at each checkpoint of a segment move together: count
-    // one sample per segment's worth of checkpoints.
-    const double n = static_cast<double>(turns.size());
-    v[kGain] *= k;
-    fit.sigma[kGain] = v[kGain] * std::sqrt(e2 / std::max(1.0, n - 1) / tt * 4 * perSegment);
-    fit.observed[kGain] = fit.sigma[kGain] <= kUnobserved * calParams()[kGain].scale;
-    if (!fit.observed[kGain]) v[kGain] = start[kGain];
-    r = residuals(pb, v, why);
-    ++fit.twinRuns;
-    if (r) fit.costAfter = meanSquare(*r);
-    return r.has_value();
-  };
+    if (tt > 0) {
+      const double k = tr / tt;
+      double e2 = 0;
+      for (const auto& [twin, real] : turns) e2 += (real - k * twin) * (real - k * twin);
+      // The four wheels at the checkpoints of one segment move together:
+      // count one sample per segment.
+      const double perSegment = 4 * std::max(1.0, o.horizon / o.checkpoint);
+      const double n = static_cast<double>(turns.size());
+      fit.sigma[kGain] = v[kGain] * k * std::sqrt(e2 / std::max(1.0, n - 1) / tt * perSegment);
+      fit.observed[kGain] = fit.sigma[kGain] <= kUnobserved * calParams()[kGain].scale;
+      if (fit.observed[kGain]) {
+        v[kGain] *= k;
+        r = residuals(pb, v, why);
+        ++fit.twinRuns;
+        if (!r) return done("the twin diverged with the motor gain fitted: " + why);
+        fit.costAfter = meanSquare(*r);
+      }
+    }
+  }
   double lambda = 1e-3;
   std::vector<std::vector<double>> jac(kFitted);
   std::vector<int> on, everSmooth;  // everSmooth: moved the twin more than its noise at some iteration
-  for (int it = 0; it < o.iterations; ++it) {
-    if (!o.fixed[kGain] && !updateGain()) return done("the twin diverged fitting the motor gain: " + why);
-    if (free.empty()) break;
+  for (int it = 0; it < o.iterations && !free.empty(); ++it) {
     // Central differences, two candidates per free parameter, in parallel.
     // Contacts make a twin's response partly chaotic: a parameter whose
     // two one-sided differences disagree more than they move (curvature

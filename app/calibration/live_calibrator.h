@@ -48,7 +48,16 @@ class LiveCalibrator {
  public:
   struct Options {
     double period = 3;  ///< [s] of new telemetry between fits
-    CalibrationOptions fit;
+    /// Each fit starts from the last one's values: two Levenberg-Marquardt
+    /// steps over the newest 8 s follow the robot (a recursive refinement),
+    /// on both cores at nice 10, so that a fit lands every few seconds.
+    CalibrationOptions fit = [] {
+      CalibrationOptions o;
+      o.window = 8;
+      o.iterations = 2;
+      o.threads = 2;
+      return o;
+    }();
   };
   /// Fits the robot of `files` (the console's world, its first robot) with
   /// the physics `profile` (the ghost's: step, iterations, hold) from

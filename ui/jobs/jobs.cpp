@@ -1,5 +1,6 @@
 #include "ui/jobs/jobs.h"
 
+#include "ui/jobs/calibration/calibration_job.h"
 #include "ui/jobs/drive/drive_job.h"
 #include "ui/jobs/link/link_job.h"
 #include "ui/jobs/replay/replay_job.h"
@@ -16,6 +17,7 @@ std::vector<std::unique_ptr<ConsoleJob>> builtInJobs(const ConsoleOptions& optio
   jobs.push_back(std::make_unique<SequenceJob>(options.rules, options.sequence));
   jobs.push_back(std::make_unique<TerrainJob>());
   jobs.push_back(std::make_unique<ReplayJob>(logDir, options.replay));
+  jobs.push_back(std::make_unique<CalibrationJob>());
   return jobs;
 }
 

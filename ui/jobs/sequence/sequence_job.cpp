@@ -58,7 +58,9 @@ void SequenceJob::install(ConsoleContext& context) {
   connect(&context, &ConsoleContext::stateChanged, this,
           [this] { panel_->setLinkReady(context_->state().controlsRefusal().empty()); });
   connect(&context, &ConsoleContext::worldChanged, this, [this](const WorldModel&, bool fresh) {
-    if (fresh) panel_->setWorld([this] { return context_->session().world(); }, context_->session().params());
+    // Rehearsals run the twin as calibrated when they start (app/calibration).
+    if (fresh)
+      panel_->setWorld([this] { return context_->session().world(); }, [this] { return context_->session().twinParams(); });
   });
   connect(&context, &ConsoleContext::terrainEdited, panel_, [this] { panel_->terrainEdited(); });
   connect(&context, &ConsoleContext::rehearseFrom, this,

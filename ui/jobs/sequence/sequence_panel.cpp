@@ -234,9 +234,9 @@ void SequencePanel::buildTemplateMenu(QToolButton* button) {
   button->setPopupMode(QToolButton::InstantPopup);
 }
 
-void SequencePanel::setWorld(std::function<const WorldModel*()> world, const SimParams& params) {
+void SequencePanel::setWorld(std::function<const WorldModel*()> world, std::function<SimParams()> params) {
   world_ = std::move(world);
-  params_ = params;
+  params_ = std::move(params);
   plan_.reset();
   result_.reset();
   robust_.reset();
@@ -358,7 +358,7 @@ bool SequencePanel::rehearse() {
     setStatus(tr("The sequence has no command."));
     return false;
   }
-  RehearsalPlan plan{*world, pinned_ ? pinned_->params : params_, rules_, std::move(*commands),
+  RehearsalPlan plan{*world, pinned_ ? pinned_->params : params_ ? params_() : SimParams{}, rules_, std::move(*commands),
                      pinned_                ? std::optional(pinned_->start)
                      : startProvider_ ? startProvider_()
                                       : std::nullopt};

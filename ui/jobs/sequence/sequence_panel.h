@@ -69,9 +69,10 @@ class SequencePanel : public QWidget {
 
   /// The world rehearsals run on, read when needed (robots[0] is the
   /// robot; its terrain as edited: the console's one terrain, no copy kept
-  /// here), null without one; and the parameters. Re-checks the text.
-  /// Drops the last rehearsal.
-  void setWorld(std::function<const WorldModel*()> world, const SimParams& params);
+  /// here), null without one; and the parameters, read at each rehearsal
+  /// (the console's calibration moves on). Re-checks the text. Drops the
+  /// last rehearsal.
+  void setWorld(std::function<const WorldModel*()> world, std::function<SimParams()> params);
   void setRules(const FlightRules& rules);
   const FlightRules& rules() const { return rules_; }
   /// Where a rehearsal starts: the robot's state now (nullopt = not known:
@@ -181,7 +182,7 @@ class SequencePanel : public QWidget {
   void setStatus(const QString& text);
 
   std::function<const WorldModel*()> world_;  // the console's world (and terrain) now
-  SimParams params_;
+  std::function<SimParams()> params_;
   FlightRules rules_;
   std::function<std::optional<RehearsalStart>()> startProvider_;
   bool linkReady_ = false;

@@ -1,0 +1,102 @@
+#include "ui/jobs/calibration/calibration_job.h"
+
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QSaveFile>
+
+#include "app/console/console_session.h"
+#include "app/log/session_log.h"
+#include "ui/jobs/calibration/calibration_panel.h"
+#include "ui/robot_feed.h"
+
+namespace sp {
+
+void CalibrationJob::install(ConsoleContext& context) {
+  context_ = &context;
+  panel_ = new CalibrationPanel;
+  context.host().addDock(tr("Calibration"), QStringLiteral("calibrationDock"), panel_, DockPlace::Side, true);
+  connect(panel_, &CalibrationPanel::freezeToggled, this, [this](bool frozen) {
+    if (LiveCalibrator* c = context_->session().calibrator()) {
+      c->freeze(frozen);
+      context_->logEvent(QStringLiteral("calibration"), frozen ? tr("frozen") : tr("unfrozen"));
+    }
+  });
+  connect(panel_, &CalibrationPanel::resetRequested, this, [this] {
+    if (LiveCalibrator* c = context_->session().calibrator()) {
+      c->reset();
+      context_->event(QStringLiteral("calibration"), tr("Calibration reset to the files' values"));
+    }
+  });
+  connect(panel_, &CalibrationPanel::saveRequested, this, [this] {
+    const QString path = QFileDialog::getSaveFileName(panel_, tr("Save the calibration"), QStringLiteral("calibrated.params"),
+                                                      tr("Parameters (*.params)"));
+    if (path.isEmpty()) return;
+    const QString error = save(path);
+    if (error.isEmpty()) context_->status(tr("Calibration saved to %1").arg(path));
+    else context_->showError(tr("Save the calibration"), error);
+  });
+  connect(&context, &ConsoleContext::panelTick, this, &CalibrationJob::refresh);
+  connect(&context, &ConsoleContext::stateChanged, this, &CalibrationJob::refresh);
+}
+
+QString CalibrationJob::save(const QString& path) const {
+  const LiveCalibrator* c = context_->session().calibrator();
+  if (!c) return tr("No calibration runs (it needs the ghost).");
+  const CalibrationState s = c->state();
+  CalibrationFit fit;  // what the twins use now, as a fit's text
+  fit.value = s.applied;
+  fit.sigma = s.sigma;
+  fit.observed = s.observed;
+  if (!s.history.empty()) {
+    fit.from = s.history.front().from;
+    fit.to = s.history.back().to;
+    fit.segments = s.history.back().segments;
+  }
+  QSaveFile file(path);
+  const std::string text = calibrationParamsText(fit);
+  if (!file.open(QIODevice::WriteOnly) || file.write(text.data(), static_cast<qint64>(text.size())) < 0 || !file.commit())
+    return tr("%1: %2").arg(path, file.errorString());
+  return {};
+}
+
+void CalibrationJob::refresh() {
+  // A replay shows the log's calibration; the live one comes back after.
+  const QString log = context_->state().replaying() ? context_->feeds().current()->logPath() : QString();
+  if (log != replayed_) {
+    replayed_ = log;
+    if (log.isEmpty()) {
+      panel_->clearReplayed();
+      seen_ = -1;
+    } else {
+      std::string error;
+      std::unique_ptr<SessionLogReader> reader = SessionLogReader::open(log.toStdString(), error);
+      panel_->setReplayed(reader ? reader->calibration() : std::vector<LogCalibration>{}, QFileInfo(log).fileName());
+    }
+  }
+  if (!replayed_.isEmpty()) return;
+  const LiveCalibrator* c = context_->session().calibrator();
+  if (c != calibrator_) {
+    calibrator_ = c;
+    seen_ = -1;
+    refusalsSeen_ = 0;
+  }
+  if (!c) {
+    if (seen_ != 0)
+      panel_->setLive(nullptr, context_->session().ghost()
+                                   ? tr("Calibration is off.")
+                                   : tr("No calibration: it runs with the predictive ghost, which is off or could not be built."));
+    seen_ = 0;
+    return;
+  }
+  if (c->version() == seen_) return;
+  const CalibrationState s = c->state();
+  seen_ = s.version;
+  panel_->setLive(&s);
+  if (s.refusals > refusalsSeen_) {
+    context_->event(QStringLiteral("calibration"), tr("Calibration fit refused, the values kept: %1").arg(QString::fromStdString(s.lastRefusal)),
+                    false);  // the session logs the fit itself
+    refusalsSeen_ = s.refusals;
+  }
+}
+
+}  // namespace sp

@@ -1,0 +1,40 @@
+#pragma once
+// The console's calibration job: the Calibration dock (ui/jobs/calibration/
+// calibration_panel.h) over the session's live calibrator (app/calibration/
+// live_calibrator.h): shows each fit, says a refused one in the event list,
+// freezes, resets to the files, saves a parameters file. While a replay is
+// shown, the replayed log's calibration table.
+//
+// Thread: GUI thread only.
+
+#include <cstdint>
+
+#include "ui/console_context.h"
+
+namespace sp {
+
+class CalibrationPanel;
+
+class CalibrationJob : public ConsoleJob {
+  Q_OBJECT
+
+ public:
+  using ConsoleJob::ConsoleJob;
+  QString name() const override { return QStringLiteral("calibration"); }
+  void install(ConsoleContext& context) override;
+  CalibrationPanel* panel() const { return panel_; }
+  /// Writes the values the twins use now as a parameters file: "" or why not.
+  QString save(const QString& path) const;
+
+ private:
+  void refresh();
+
+  ConsoleContext* context_ = nullptr;
+  CalibrationPanel* panel_ = nullptr;
+  int64_t seen_ = -1;       // the calibrator's version shown
+  int refusalsSeen_ = 0;    // refused fits already said in the event list
+  const void* calibrator_ = nullptr;  // the one seen_ counts (a new world makes another)
+  QString replayed_;        // the log shown, "" when live
+};
+
+}  // namespace sp

@@ -1,0 +1,203 @@
+#include "ui/jobs/calibration/calibration_panel.h"
+
+#include <QChart>
+#include <QChartView>
+#include <QComboBox>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QLineSeries>
+#include <QPushButton>
+#include <QTableWidget>
+#include <QValueAxis>
+#include <QVBoxLayout>
+
+#include <algorithm>
+#include <cmath>
+
+namespace sp {
+
+namespace {
+
+// A value as shown: factors as such, the delay in milliseconds.
+QString shown(size_t param, double v) {
+  if (calParams()[param].unit[0] == 's') return QString::number(v * 1000, 'f', 1) + " ms";
+  return QString::number(v, 'f', 4);
+}
+
+}  // namespace
+
+CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(kCalParams) {
+  auto* layout = new QVBoxLayout(this);
+  table_ = new QTableWidget(kCalParams, 4, this);
+  table_->setHorizontalHeaderLabels({tr("Parameter"), tr("Value"), tr("±"), tr("Files")});
+  table_->verticalHeader()->hide();
+  table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  table_->setSelectionMode(QAbstractItemView::NoSelection);
+  table_->horizontalHeader()->setSectionResizeMode(0, QHeaderView::Stretch);
+  for (int i = 0; i < kCalParams; ++i) {
+    const CalParamInfo& p = calParams()[static_cast<size_t>(i)];
+    auto* name = new QTableWidgetItem(tr(p.label));
+    name->setToolTip(QString::fromUtf8(p.key));
+    table_->setItem(i, 0, name);
+    table_->setItem(i, 3, new QTableWidgetItem(shown(static_cast<size_t>(i), p.files)));
+    showRow(i, p.files, 0, false, tr("files"));
+  }
+  table_->resizeColumnsToContents();
+  table_->setMinimumHeight(table_->verticalHeader()->length() + table_->horizontalHeader()->height() + 4);
+  layout->addWidget(table_);
+
+  auto* plotRow = new QHBoxLayout;
+  plotRow->addWidget(new QLabel(tr("Plot:"), this));
+  plotted_ = new QComboBox(this);
+  for (const CalParamInfo& p : calParams()) plotted_->addItem(tr(p.label));
+  plotRow->addWidget(plotted_, 1);
+  layout->addLayout(plotRow);
+  chart_ = new QChart;
+  chart_->legend()->hide();
+  chart_->setMargins(QMargins(2, 2, 2, 2));
+  value_ = new QLineSeries;
+  upper_ = new QLineSeries;
+  lower_ = new QLineSeries;
+  QPen band(Qt::gray);
+  band.setStyle(Qt::DashLine);
+  upper_->setPen(band);
+  lower_->setPen(band);
+  axisX_ = new QValueAxis;
+  axisX_->setTitleText(tr("robot time [s]"));
+  axisY_ = new QValueAxis;
+  chart_->addAxis(axisX_, Qt::AlignBottom);
+  chart_->addAxis(axisY_, Qt::AlignLeft);
+  for (QLineSeries* s : {value_, upper_, lower_}) {
+    chart_->addSeries(s);
+    s->attachAxis(axisX_);
+    s->attachAxis(axisY_);
+  }
+  view_ = new QChartView(chart_, this);
+  view_->setMinimumHeight(140);
+  view_->setRenderHint(QPainter::Antialiasing);
+  layout->addWidget(view_, 1);
+  connect(plotted_, &QComboBox::currentIndexChanged, this, [this] { replot(); });
+
+  auto* buttons = new QHBoxLayout;
+  freeze_ = new QPushButton(tr("Freeze"), this);
+  freeze_->setCheckable(true);
+  freeze_->setToolTip(tr("Keep the values the twins use now; fits go on and are shown"));
+  reset_ = new QPushButton(tr("Reset to files"), this);
+  reset_->setToolTip(tr("The twins use the robot and world files' values again"));
+  save_ = new QPushButton(tr("Save…"), this);
+  save_->setToolTip(tr("Save the values as a parameters file (calibration.* keys)"));
+  for (QPushButton* b : {freeze_, reset_, save_}) buttons->addWidget(b);
+  layout->addLayout(buttons);
+  status_ = new QLabel(this);
+  status_->setWordWrap(true);
+  layout->addWidget(status_);
+  connect(freeze_, &QPushButton::toggled, this, &CalibrationPanel::freezeToggled);
+  connect(reset_, &QPushButton::clicked, this, &CalibrationPanel::resetRequested);
+  connect(save_, &QPushButton::clicked, this, &CalibrationPanel::saveRequested);
+}
+
+void CalibrationPanel::showRow(int row, double value, double sigma, bool observed, const QString& status) {
+  const size_t p = static_cast<size_t>(row);
+  auto* v = new QTableWidgetItem(shown(p, value));
+  auto* s = new QTableWidgetItem(observed ? shown(p, sigma) : status);
+  if (!observed) {
+    v->setForeground(palette().color(QPalette::Disabled, QPalette::Text));
+    s->setForeground(palette().color(QPalette::Disabled, QPalette::Text));
+    s->setToolTip(tr("The motion so far cannot tell this parameter: it keeps its value"));
+  }
+  table_->setItem(row, 1, v);
+  table_->setItem(row, 2, s);
+}
+
+void CalibrationPanel::setLive(const CalibrationState* state, const QString& why) {
+  if (replayed_) return;
+  const bool live = state != nullptr;
+  for (QPushButton* b : {freeze_, reset_, save_}) b->setEnabled(live);
+  if (!state) {
+    status_->setText(why);
+    return;
+  }
+  for (int i = 0; i < kCalParams; ++i) {
+    const size_t p = static_cast<size_t>(i);
+    showRow(i, state->applied[p], state->sigma[p], state->observed[p], tr("unobserved"));
+  }
+  for (auto& s : series_) s.clear();
+  for (const CalibrationFit& fit : state->history)
+    if (fit.refused.empty())
+      for (size_t p = 0; p < kCalParams; ++p)
+        if (fit.observed[p]) series_[p].push_back({fit.to, fit.value[p], fit.sigma[p]});
+  freeze_->blockSignals(true);
+  freeze_->setChecked(state->frozen);
+  freeze_->blockSignals(false);
+  QString text;
+  if (state->history.empty()) {
+    text = tr("Drive to calibrate: a fit needs a few seconds of the wheels turning.");
+  } else {
+    const CalibrationFit& last = state->history.back();
+    text = last.refused.empty()
+               ? tr("Fit %1 at %2 s: %3 segments, cost %4 → %5, %6 ms.")
+                     .arg(state->fits)
+                     .arg(last.to, 0, 'f', 1)
+                     .arg(last.segments)
+                     .arg(last.costBefore, 0, 'g', 3)
+                     .arg(last.costAfter, 0, 'g', 3)
+                     .arg(last.wallMs, 0, 'f', 0)
+               : tr("Fit %1 refused, the values kept: %2").arg(state->fits).arg(QString::fromStdString(last.refused));
+  }
+  if (state->frozen) text += tr(" Frozen: new fits are not applied.");
+  status_->setText(text);
+  replot();
+}
+
+void CalibrationPanel::setReplayed(const std::vector<LogCalibration>& rows, const QString& label) {
+  replayed_ = rows;
+  for (QPushButton* b : {freeze_, reset_, save_}) b->setEnabled(false);
+  for (auto& s : series_) s.clear();
+  std::vector<const LogCalibration*> newest(kCalParams, nullptr);
+  for (const LogCalibration& r : rows)
+    for (size_t p = 0; p < kCalParams; ++p)
+      if (r.param == calParams()[p].key) {
+        if (r.status.rfind("refused", 0) == 0) continue;
+        newest[p] = &r;
+        if (r.observed) series_[p].push_back({r.time, r.value, r.sigma});
+      }
+  for (int i = 0; i < kCalParams; ++i) {
+    const size_t p = static_cast<size_t>(i);
+    if (newest[p]) showRow(i, newest[p]->value, newest[p]->sigma, newest[p]->observed, tr("unobserved"));
+    else showRow(i, calParams()[p].files, 0, false, tr("not in the log"));
+  }
+  status_->setText(rows.empty() ? tr("The replayed log %1 holds no calibration.").arg(label)
+                                : tr("The calibration the console fitted in %1 (%2 fits).")
+                                      .arg(label)
+                                      .arg(rows.size() / kCalParams));
+  replot();
+}
+
+void CalibrationPanel::clearReplayed() { replayed_.reset(); }
+
+int CalibrationPanel::plottedPoints() const { return static_cast<int>(value_->count()); }
+
+void CalibrationPanel::replot() {
+  const size_t p = static_cast<size_t>(std::max(0, plotted_->currentIndex()));
+  const std::vector<Point>& pts = series_[p];
+  const double k = calParams()[p].unit[0] == 's' ? 1000 : 1;  // the delay in ms
+  QList<QPointF> v, up, down;
+  double lo = calParams()[p].files * k, hi = lo;
+  for (const Point& x : pts) {
+    v.append({x.time, x.value * k});
+    up.append({x.time, (x.value + x.sigma) * k});
+    down.append({x.time, (x.value - x.sigma) * k});
+    lo = std::min(lo, (x.value - x.sigma) * k);
+    hi = std::max(hi, (x.value + x.sigma) * k);
+  }
+  value_->replace(v);
+  upper_->replace(up);
+  lower_->replace(down);
+  const double pad = std::max(1e-3, (hi - lo) * 0.1);
+  axisY_->setRange(lo - pad, hi + pad);
+  axisY_->setTitleText(calParams()[p].unit[0] == 's' ? tr("ms") : tr("× files"));
+  if (!pts.empty()) axisX_->setRange(pts.front().time, std::max(pts.back().time, pts.front().time + 1));
+}
+
+}  // namespace sp
