@@ -485,6 +485,10 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       fit.observed[kGain] = fit.sigma[kGain] <= kUnobserved * calParams()[kGain].scale;
       if (fit.observed[kGain]) {
         v[kGain] *= k;
+        // The ground speed goes as radius x gain: keep what the start had
+        // found of it while the gain moves (the fit below refines both).
+        constexpr size_t kRadius = static_cast<size_t>(CalParam::WheelRadius);
+        if (!o.fixed[kRadius]) v[kRadius] /= k;
         r = residuals(pb, v, why);
         ++fit.twinRuns;
         if (!r) return done("the twin diverged with the motor gain fitted: " + why);
@@ -563,6 +567,12 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       }
     }
     if (!stepped) break;
+  }
+  // A fit that predicts the window worse than its start (the contacts'
+  // noise can defeat a step) keeps the start's values: nothing learnt.
+  if (fit.costAfter > fit.costBefore) {
+    for (int p = 0; p < kFitted; ++p) v[static_cast<size_t>(p)] = start[static_cast<size_t>(p)];
+    fit.costAfter = fit.costBefore;
   }
   // The deviations at the fit, inflated by the residuals' own scatter.
   std::sort(everSmooth.begin(), everSmooth.end());

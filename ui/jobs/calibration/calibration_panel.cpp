@@ -34,6 +34,7 @@ CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(k
   table_->verticalHeader()->hide();
   table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   table_->setSelectionMode(QAbstractItemView::NoSelection);
+  table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   table_->horizontalHeader()->setSectionResizeMode(0, QHeaderView::Stretch);
   for (int i = 0; i < kCalParams; ++i) {
     const CalParamInfo& p = calParams()[static_cast<size_t>(i)];

@@ -1,0 +1,111 @@
+// The Calibration dock in a running console, as an operator meets it: a
+// stand-in that is not its twin (--perturb 7: wheels +1.2 % on average,
+// motors 6 % fast) driven straight; the dock fills with fits, friction stays
+// unobserved on a straight drive, the twins' parameters follow, Freeze keeps
+// the values, Reset puts the files back, Save writes a parameters file that
+// loads with the values shown, and the session log's calibration table
+// holds the fits. Real window under Xvfb, real stand-in on loopback.
+
+#include <QApplication>
+#include <QDockWidget>
+#include <QLabel>
+#include <QPushButton>
+#include <QTableWidget>
+#include <QTemporaryDir>
+#include <QtTest>
+
+#include <cmath>
+
+#include "app/console/console_session.h"
+#include "app/log/session_log.h"
+#include "tests/ui/console_fixture.h"
+#include "ui/jobs/calibration/calibration_job.h"
+#include "ui/jobs/calibration/calibration_panel.h"
+#include "ui/jobs/drive/control_panel.h"
+
+using namespace sp;
+
+class TestCalibrationDock : public QObject {
+  Q_OBJECT
+
+ private slots:
+  void fitsShowFreezeResetSave() {
+    QTemporaryDir dir;
+    QVERIFY(dir.isValid());
+    ConsoleOptions options;
+    options.perturbSeed = 7;
+    std::unique_ptr<MainWindow> window;
+    const QString error = test::startConsole(dir, QStringLiteral("terrains/flat.world.xml"), options, window);
+    QVERIFY2(error.isEmpty(), qPrintable(error));
+    MainWindow& w = *window;
+    auto* job = w.job<CalibrationJob>();
+    QVERIFY(job);
+    CalibrationPanel* panel = job->panel();
+    auto* dock = w.findChild<QDockWidget*>(QStringLiteral("calibrationDock"));
+    QVERIFY(dock);
+    dock->show();
+    dock->raise();
+    QTRY_VERIFY_WITH_TIMEOUT(w.consoleState().leaseHeld(), 10000);
+    w.controlPanel()->setDrive(0.5, 0);
+    LiveCalibrator* calibrator = w.context().session().calibrator();
+    QVERIFY(calibrator);
+
+    // Fits land while driving, and the dock shows them.
+    QTRY_VERIFY_WITH_TIMEOUT(calibrator->state().fits >= 3, 30000);
+    QTest::qWait(300);  // a panel tick
+    const CalibrationState s = calibrator->state();
+    qInfo("%d fits; wheel radius %.4f +- %.4f, gain %.4f, status: %s", s.fits, s.applied[0], s.sigma[0], s.applied[3],
+          qPrintable(panel->statusLabel()->text()));
+    QVERIFY(s.observed[0]);
+    QVERIFY(std::abs(s.applied[0] - 1.012) < 0.015);  // the hidden mean is 1.012
+    QVERIFY(std::abs(s.applied[3] - 1.0605) < 0.02);  // hidden 1.0605
+    QVERIFY(!s.observed[static_cast<size_t>(CalParam::Friction)]);
+    QCOMPARE(panel->table()->item(0, 1)->text(), QString::number(s.applied[0], 'f', 4));
+    QCOMPARE(panel->table()->item(2, 2)->text(), QStringLiteral("unobserved"));
+    QVERIFY(panel->plottedPoints() >= 2);
+    QCOMPARE(w.context().session().twinParams().calWheelRadius, s.applied[0]);
+    dock->grab().save(dir.filePath(QStringLiteral("dock.png")));
+    if (qEnvironmentVariableIsSet("SP_KEEP_SHOT")) dock->grab().save(qEnvironmentVariable("SP_KEEP_SHOT"));
+
+    // Save: a parameters file with the values the twins use.
+    const QString saved = dir.filePath(QStringLiteral("calibrated.params"));
+    QVERIFY2(job->save(saved).isEmpty(), qPrintable(job->save(saved)));
+    SimParams loaded;
+    Diagnostics diag;
+    QVERIFY2(loadParams(saved.toStdString(), loaded, diag), diag.format().c_str());
+    QVERIFY(std::abs(loaded.calWheelRadius - calibrator->state().applied[0]) < 1e-9 ||
+            calibrator->state().version != s.version);
+
+    // Freeze: fits go on, the applied values stay.
+    panel->freezeButton()->click();
+    QVERIFY(calibrator->state().frozen);
+    const CalValues frozen = calibrator->state().applied;
+    const int fits = calibrator->state().fits;
+    QTRY_VERIFY_WITH_TIMEOUT(calibrator->state().fits >= fits + 2, 20000);
+    QVERIFY(calibrator->state().applied == frozen);
+    panel->freezeButton()->click();
+    QVERIFY(!calibrator->state().frozen);
+
+    // Reset: the files' values, at once.
+    panel->resetButton()->click();
+    QVERIFY(calibrator->state().applied == filesCalValues());
+    QCOMPARE(w.context().session().twinParams().calWheelRadius, 1.0);
+
+    // The session log holds the fits: one row per parameter per fit.
+    const std::string log = w.context().session().logPath();
+    window.reset();
+    std::string why;
+    std::unique_ptr<SessionLogReader> reader = SessionLogReader::open(log, why);
+    QVERIFY2(reader, why.c_str());
+    const std::vector<LogCalibration> rows = reader->calibration();
+    qInfo("%zu calibration rows in the log", rows.size());
+    QVERIFY(rows.size() >= 5 * kCalParams);
+    QCOMPARE(rows.size() % kCalParams, size_t(0));
+    bool sawFrozen = false;
+    for (const LogCalibration& r : rows) sawFrozen |= r.status == "frozen";
+    QVERIFY(sawFrozen);
+  }
+};
+
+int main(int argc, char** argv) { return test::glTestMain<TestCalibrationDock>(argc, argv); }
+#include "tst_calibration_dock.moc"
