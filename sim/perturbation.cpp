@@ -42,7 +42,7 @@ WorldModel perturbWorld(WorldModel world, const Perturbation& p) {
   RobotModel& robot = world.robots[0].model;
   for (size_t i = 0; i < robot.links.size() && i < p.linkMass.size(); ++i) {
     robot.links[i].mass *= p.linkMass[i];
-    robot.links[i].centreOfMassShift = p.centreOfMass[i];
+    robot.links[i].centreOfMassShift = robot.links[i].centreOfMassShift + p.centreOfMass[i];  // composes
   }
   if (robot.drive)
     for (size_t w = 0; w < 4; ++w) {
@@ -54,7 +54,7 @@ WorldModel perturbWorld(WorldModel world, const Perturbation& p) {
       for (ActuatorSpec& a : robot.actuators)
         if (a.joint == joint) {
           a.maxTorque *= p.torqueLimit;
-          a.velocityScale = p.velocityGain;
+          a.velocityScale *= p.velocityGain;
         }
     }
   world.defaultContact.mu *= p.friction;
@@ -67,7 +67,8 @@ WorldModel calibratedWorld(const WorldModel& world, const SimParams& params) {
   Perturbation p;
   const double front = params.calWheelRadius * (1 + params.calWheelRadiusSplit / 2);
   const double rear = params.calWheelRadius * (1 - params.calWheelRadiusSplit / 2);
-  p.wheelRadius = {front, front, rear, rear};
+  const double left = 1 + params.calWheelRadiusSide / 2, right = 1 - params.calWheelRadiusSide / 2;
+  p.wheelRadius = {front * left, front * right, rear * left, rear * right};  // FL FR RL RR
   const size_t links = world.robots[0].model.links.size();
   p.linkMass.assign(links, params.calMass);
   p.centreOfMass.assign(links, Vec3{});

@@ -32,6 +32,7 @@ const std::array<CalParamInfo, kCalParams>& calParams() {
       // Probes of half a scale: a smaller one drowns in the contacts' noise.
       {"calibration.wheel_radius", "wheel radius", "", 1, 0.8, 1.2, 0.03, 0.015},
       {"calibration.wheel_radius_split", "radius front - rear", "", 0, -0.1, 0.1, 0.03, 0.015},
+      {"calibration.wheel_radius_side", "radius left - right", "", 0, -0.1, 0.1, 0.03, 0.015},
       {"calibration.friction", "tyre friction", "", 1, 0.3, 3, 0.3, 0.15},
       {"calibration.motor_gain", "wheel motor gain", "", 1, 0.5, 1.5, 0.2, 0.1},
       {"calibration.delay", "command delay", "s", 0, 0, 0.5, 0.06, 0.03},
@@ -41,20 +42,48 @@ const std::array<CalParamInfo, kCalParams>& calParams() {
 }
 
 CalValues calValues(const SimParams& p) {
-  return {p.calWheelRadius, p.calWheelRadiusSplit, p.calFriction, p.calMotorGain, p.calDelay, p.calMass};
+  return {p.calWheelRadius, p.calWheelRadiusSplit, p.calWheelRadiusSide, p.calFriction, p.calMotorGain, p.calDelay, p.calMass};
 }
 
 SimParams withCalValues(SimParams p, const CalValues& v) {
   p.calWheelRadius = v[0];
   p.calWheelRadiusSplit = v[1];
-  p.calFriction = v[2];
-  p.calMotorGain = v[3];
-  p.calDelay = v[4];
-  p.calMass = v[5];
+  p.calWheelRadiusSide = v[2];
+  p.calFriction = v[3];
+  p.calMotorGain = v[4];
+  p.calDelay = v[5];
+  p.calMass = v[6];
   return p;
 }
 
 CalValues filesCalValues() { return calValues(SimParams{}); }
+
+CalEstimate filesEstimate() {
+  CalEstimate e;
+  e.value = filesCalValues();
+  return e;
+}
+
+CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit) {
+  CalEstimate out = prior;
+  out.time = std::max(prior.time, fit.to);
+  const double dt = std::max(0.0, fit.to - prior.time);
+  for (size_t i = 0; i < kCalParams; ++i) {
+    if (!fit.observed[i] || !(fit.sigma[i] > 0)) continue;
+    if (!prior.observed[i]) {
+      out.value[i] = fit.value[i];
+      out.sigma[i] = fit.sigma[i];
+      out.observed[i] = true;
+      continue;
+    }
+    const double drift = kDrift * calParams()[i].scale;
+    const double p = prior.sigma[i] * prior.sigma[i] + drift * drift * dt;
+    const double q = fit.sigma[i] * fit.sigma[i];
+    out.value[i] = (prior.value[i] * q + fit.value[i] * p) / (p + q);
+    out.sigma[i] = std::sqrt(p * q / (p + q));
+  }
+  return out;
+}
 
 namespace {
 
@@ -170,9 +199,12 @@ int modelJoint(const std::optional<RigidRobot>& rigid, int full) {
 // The scaled residuals of the twin calibrated by `v` over every segment, or
 // nullopt and `why` when the twin cannot be built or diverges.
 // `turns`, when given, receives each checkpoint's wheel turns since its
-// anchor, (twin, robot), for the motor gain's closed form.
+// anchor, (twin, robot), for the motor gain's closed form. `jitter` [m]
+// lifts every anchor by that much: a run from anchors a micrometre off
+// differs from the plain one by the contacts' chaos alone (the noise probe).
 std::optional<std::vector<double>> residuals(const Problem& pb, const CalValues& v, std::string& why,
-                                             std::vector<std::pair<double, double>>* turns = nullptr) {
+                                             std::vector<std::pair<double, double>>* turns = nullptr,
+                                             double jitter = 0) {
   WorldModel model = calibratedWorld(*pb.files, withCalValues(pb.profile, v));
   std::optional<RigidRobot> rigid;
   if (!pb.held.empty()) {
@@ -212,7 +244,9 @@ std::optional<std::vector<double>> residuals(const Problem& pb, const CalValues&
     }
     const std::vector<double> positions = rigid ? rigidJoints(*rigid, a.jointPositions) : a.jointPositions;
     const std::vector<double> rates = rigid ? rigidJoints(*rigid, a.jointRates) : a.jointRates;
-    why = world->setRobotMotion(0, linkMotions(robot, a.base, a.baseLinearVelocity, a.baseAngularVelocity, positions, rates));
+    Pose lifted = a.base;
+    lifted.p.z += jitter;
+    why = world->setRobotMotion(0, linkMotions(robot, lifted, a.baseLinearVelocity, a.baseAngularVelocity, positions, rates));
     if (!why.empty()) return std::nullopt;
     Runner runner(*world);
     const int64_t start = world->stepCount();
@@ -272,13 +306,19 @@ double meanSquare(const std::vector<double>& r) {
 }
 
 // Runs the candidates on up to `threads` threads; a failed one is nullopt.
-std::vector<std::optional<std::vector<double>>> runAll(const Problem& pb, const std::vector<CalValues>& candidates,
+// A candidate twin: its values, and the noise probe's jitter (residuals()).
+struct Candidate {
+  CalValues values;
+  double jitter = 0;
+};
+
+std::vector<std::optional<std::vector<double>>> runAll(const Problem& pb, const std::vector<Candidate>& candidates,
                                                        int threads, std::string& why) {
   std::vector<std::optional<std::vector<double>>> out(candidates.size());
   std::vector<std::string> whys(candidates.size());
   std::atomic<size_t> next{0};
   const auto work = [&] {
-    for (size_t i; (i = next++) < candidates.size();) out[i] = residuals(pb, candidates[i], whys[i]);
+    for (size_t i; (i = next++) < candidates.size();) out[i] = residuals(pb, candidates[i].values, whys[i], nullptr, candidates[i].jitter);
   };
   std::vector<std::thread> pool;
   for (int t = 1; t < std::min<int>(threads, static_cast<int>(candidates.size())); ++t) pool.emplace_back(work);
@@ -339,12 +379,17 @@ Normal normalEquations(const std::vector<std::vector<double>>& jac, const std::v
 // Each parameter's standard deviation (in its own units) given the scaled
 // Jacobian columns `jac` (d residual / d (value / scale)); parameters the
 // data cannot pin are dropped from `on` one at a time, worst first.
-// While stepping (`scatter` false) the residuals' scales are taken as
-// given: far from the fit they are large for want of fitting, not noise.
+// Observability is judged on the residuals' scales as given (far from the
+// fit they are large for want of fitting, not noise): a parameter is
+// observed when its deviation is at most kUnobserved of its scale. The
+// deviations reported grow by the residuals' own scatter and by
+// `correlated`, the residuals that move together (a segment's checkpoints
+// share its anchor's error: they count as one), so that fusing fits
+// (fuse()) weighs each window for what it is worth.
 std::vector<int> observable(const std::vector<std::vector<double>>& jac, const std::vector<double>& r,
-                            std::vector<int> on, CalValues& sigma, bool scatter) {
+                            std::vector<int> on, CalValues& sigma, double correlated) {
   const double dof = std::max<double>(1, static_cast<double>(r.size()) - static_cast<double>(on.size()));
-  const double inflate = scatter ? std::max(1.0, meanSquare(r) * static_cast<double>(r.size()) / dof) : 1.0;
+  const double inflate = correlated * std::max(1.0, meanSquare(r) * static_cast<double>(r.size()) / dof);
   while (!on.empty()) {
     const Normal n = normalEquations(jac, r, on);
     // The covariance's diagonal: one solve per unit vector.
@@ -354,14 +399,14 @@ std::vector<int> observable(const std::vector<std::vector<double>>& jac, const s
       std::vector<double> e(on.size(), 0), x;
       e[k] = 1;
       if (!solve(n.h, e, x)) singular = true;
-      else var[k] = x[k] * inflate;
+      else var[k] = x[k];
     }
     size_t worst = 0;
     for (size_t k = 0; k < on.size(); ++k)
       if (singular ? n.h[k][k] < n.h[worst][worst] : var[k] > var[worst]) worst = k;
     if (!singular && std::sqrt(var[worst]) <= kUnobserved) {
       for (size_t k = 0; k < on.size(); ++k)
-        sigma[static_cast<size_t>(on[k])] = std::sqrt(var[k]) * calParams()[static_cast<size_t>(on[k])].scale;
+        sigma[static_cast<size_t>(on[k])] = std::sqrt(var[k] * inflate) * calParams()[static_cast<size_t>(on[k])].scale;
       return on;
     }
     on.erase(on.begin() + static_cast<long>(worst));
@@ -389,6 +434,27 @@ std::optional<std::pair<double, double>> massFromLoads(const WorldModel& files, 
   // Neighbouring frames are not independent (the body rocks over ~0.2 s):
   // count one sample per 10 frames.
   return std::make_pair(mean, std::sqrt(var / (static_cast<double>(x.size()) / 10)));
+}
+
+// The fit's problem over `frames` (usable, oldest first): the twin's
+// weld, the commands in order, the driving segments. "" or why not.
+std::string makeProblem(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& frames,
+                        const std::vector<TimedCommand>& commands, const CalibrationOptions& o, Problem& pb) {
+  const RobotModel& robot = files.robots[0].model;
+  pb.files = &files;
+  pb.profile = profile;
+  pb.frames = &frames;
+  std::string why;
+  const std::optional<std::vector<int>> held = holdableJoints(robot, profile.ghostHold, why);
+  if (!held) return why;
+  pb.held = *held;
+  pb.weld = frames.back().jointPositions;
+  pb.wheels = robot.drive->wheels;
+  pb.articulation = robot.drive->articulation;
+  pb.commands = commands;
+  std::stable_sort(pb.commands.begin(), pb.commands.end(), [](const TimedCommand& a, const TimedCommand& b) { return a.time < b.time; });
+  pb.segments = cutSegments(pb, o);
+  return {};
 }
 
 }  // namespace
@@ -432,19 +498,8 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
     }
 
   Problem pb;
-  pb.files = &files;
-  pb.profile = profile;
-  pb.frames = &frames;
-  std::string why;
-  const std::optional<std::vector<int>> held = holdableJoints(robot, profile.ghostHold, why);
-  if (!held) return done(why);
-  pb.held = *held;
-  pb.weld = frames.back().jointPositions;
-  pb.wheels = robot.drive->wheels;
-  pb.articulation = robot.drive->articulation;
-  for (const TimedCommand& c : commands) pb.commands.push_back(c);
-  std::stable_sort(pb.commands.begin(), pb.commands.end(), [](const TimedCommand& a, const TimedCommand& b) { return a.time < b.time; });
-  pb.segments = cutSegments(pb, o);
+  std::string why = makeProblem(files, profile, frames, commands, o, pb);
+  if (!why.empty()) return done(why);
   fit.segments = static_cast<int>(pb.segments.size());
   if (fit.segments < o.minSegments)
     return done("not enough driving: " + std::to_string(fit.segments) + " segments of " + shortestText(o.horizon) +
@@ -500,21 +555,26 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   std::vector<std::vector<double>> jac(kFitted);
   std::vector<int> on, everSmooth;  // everSmooth: moved the twin more than its noise at some iteration
   for (int it = 0; it < o.iterations && !free.empty(); ++it) {
-    // Central differences, two candidates per free parameter, in parallel.
-    // Contacts make a twin's response partly chaotic: a parameter whose
-    // two one-sided differences disagree more than they move (curvature
-    // over slope) only stirs noise at this scale and is left out.
-    std::vector<CalValues> probes;
+    // Central differences, two candidates per free parameter, and the
+    // noise probe, in parallel. Contacts make a twin's response partly
+    // chaotic: a parameter whose difference moves the residuals less than
+    // anchors a micrometre off do only stirs noise and is left out
+    // (friction on grip).
+    std::vector<Candidate> probes;
     for (int p : free)
       for (double sign : {1.0, -1.0}) {
         CalValues c = v;
         c[static_cast<size_t>(p)] += sign * calParams()[static_cast<size_t>(p)].probe;
-        probes.push_back(c);
+        probes.push_back({c, 0});
       }
+    probes.push_back({v, 1e-6});
     if (abort && abort()) return done("cancelled");
     const auto runs = runAll(pb, probes, o.threads, why);
     fit.twinRuns += static_cast<int>(probes.size());
     std::vector<int> smooth;
+    if (!probes.empty() && !runs.back()) return done("the twin diverged from anchors a micrometre off: " + why);
+    double noise = 0;
+    for (size_t i = 0; i < r->size(); ++i) noise += ((*runs.back())[i] - (*r)[i]) * ((*runs.back())[i] - (*r)[i]);
     for (size_t k = 0; k < free.size(); ++k) {
       const CalParamInfo& info = calParams()[static_cast<size_t>(free[k])];
       const auto& up = runs[2 * k];
@@ -522,20 +582,20 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       if (!up || !down) return done("the twin diverged probing " + std::string(info.key) + ": " + why);
       std::vector<double>& col = jac[static_cast<size_t>(free[k])];
       col.resize(r->size());
-      double slope = 0, curve = 0;
+      double move = 0;  // the two probes apart, against two noise realisations
       for (size_t i = 0; i < r->size(); ++i) {
-        const double half = ((*up)[i] - (*down)[i]) / 2;
-        const double bend = ((*up)[i] + (*down)[i]) / 2 - (*r)[i];
-        col[i] = half / info.probe * info.scale;
-        slope += half * half;
-        curve += bend * bend;
+        const double apart = (*up)[i] - (*down)[i];
+        col[i] = apart / 2 / info.probe * info.scale;
+        move += apart * apart;
       }
-      if (curve < slope) smooth.push_back(free[k]);
-      if (curve < slope && std::find(everSmooth.begin(), everSmooth.end(), free[k]) == everSmooth.end())
-        everSmooth.push_back(free[k]);
+      if (getenv("SP_CAL_DEBUG")) fprintf(stderr, "it %d %s move %.3g noise %.3g\n", it, info.key, move, noise);
+      if (move > 4 * noise) {
+        smooth.push_back(free[k]);
+        if (std::find(everSmooth.begin(), everSmooth.end(), free[k]) == everSmooth.end()) everSmooth.push_back(free[k]);
+      }
     }
     CalValues sigma{};
-    on = observable(jac, *r, smooth, sigma, false);
+    on = observable(jac, *r, smooth, sigma, 1);
     for (int p : free) fit.sigma[static_cast<size_t>(p)] = sigma[static_cast<size_t>(p)];
     if (on.empty()) break;
     const Normal n = normalEquations(jac, *r, on);
@@ -578,7 +638,7 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   std::sort(everSmooth.begin(), everSmooth.end());
   if (!everSmooth.empty()) {
     CalValues sigma{};
-    on = observable(jac, *r, everSmooth, sigma, true);
+    on = observable(jac, *r, everSmooth, sigma, std::max(1.0, o.horizon / o.checkpoint));
     for (int p : free) fit.sigma[static_cast<size_t>(p)] = sigma[static_cast<size_t>(p)];
   }
   for (int p : on) fit.observed[static_cast<size_t>(p)] = true;
@@ -601,6 +661,39 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   }
   for (int p = 0; p < kFitted; ++p) fit.value[static_cast<size_t>(p)] = v[static_cast<size_t>(p)];
   return done("");
+}
+
+PredictionCheck checkPredictions(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& in,
+                                 const std::vector<TimedCommand>& commands, const CalValues& values, double horizon,
+                                 double spacing) {
+  PredictionCheck out;
+  if (files.robots.empty() || !files.robots[0].model.drive) {
+    out.problem = "the world has no robot with a drive";
+    return out;
+  }
+  const std::vector<RobotFrame> frames = usableFrames(in, 0);
+  if (frames.size() < 2) {
+    out.problem = "not enough telemetry";
+    return out;
+  }
+  CalibrationOptions o;
+  o.spacing = spacing;
+  o.horizon = horizon;
+  o.checkpoint = horizon / 2;  // two per segment: the last is the one judged
+  Problem pb;
+  out.problem = makeProblem(files, profile, frames, commands, o, pb);
+  if (!out.problem.empty()) return out;
+  const std::optional<std::vector<double>> r = residuals(pb, values, out.problem);
+  if (!r) return out;
+  size_t at = 0;
+  for (const Segment& seg : pb.segments) {
+    const size_t last = at + (seg.checkpoints.size() - 1) * kPerCheckpoint;
+    out.time.push_back(frames[seg.anchor].time);
+    out.position.push_back(std::hypot((*r)[last], (*r)[last + 1]) * kResidualScale.position);
+    out.heading.push_back(std::abs((*r)[last + 2]) * kResidualScale.heading);
+    at += seg.checkpoints.size() * kPerCheckpoint;
+  }
+  return out;
 }
 
 std::optional<CalibrationInput> calibrationInput(const std::string& path, std::string& error) {

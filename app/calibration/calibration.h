@@ -53,8 +53,8 @@
 namespace sp {
 
 /// The fitted parameters, in the order of calParams().
-enum class CalParam : int { WheelRadius, WheelRadiusSplit, Friction, MotorGain, Delay, Mass };
-constexpr int kCalParams = 6;
+enum class CalParam : int { WheelRadius, WheelRadiusSplit, WheelRadiusSide, Friction, MotorGain, Delay, Mass };
+constexpr int kCalParams = 7;
 using CalValues = std::array<double, kCalParams>;
 using CalFlags = std::array<bool, kCalParams>;
 
@@ -115,6 +115,37 @@ struct CalibrationFit {
 CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& frames,
                               const std::vector<TimedCommand>& commands, const CalValues& start,
                               const CalibrationOptions& options = {}, const std::function<bool()>& abort = {});
+
+/// What the console holds of the robot across fits: one window's fit is
+/// noisy (the contacts, a window of a few turns), so fits are fused.
+struct CalEstimate {
+  CalValues value = {};  ///< what the twins use
+  CalValues sigma = {};  ///< one standard deviation; 0 where never observed
+  CalFlags observed{};   ///< some fit observed it
+  double time = 0;       ///< [s] robot time of the newest fit fused
+};
+/// The files' values, none observed.
+CalEstimate filesEstimate();
+/// `prior` updated by `fit` (accepted): each parameter the fit observed is
+/// fused by inverse-variance weighting (a Kalman update of a constant),
+/// its prior deviation first grown by kDrift per second since the prior's
+/// time (a robot's tyres and loads do change, slowly); the rest are kept.
+CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit);
+/// The drift: a share of each parameter's scale per square-root second.
+constexpr double kDrift = 0.005;
+
+/// How far the twin calibrated by `values` lands from the robot `horizon`
+/// seconds after each anchor (every `spacing` s along the driving parts of
+/// `frames`), as the ghost predicts over a link: the benchmark's measure.
+struct PredictionCheck {
+  std::vector<double> time;      ///< [s] each anchor's robot time
+  std::vector<double> position;  ///< [m] horizontal error at anchor + horizon
+  std::vector<double> heading;   ///< [rad] absolute heading error there
+  std::string problem;           ///< "" or why there are none
+};
+PredictionCheck checkPredictions(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& frames,
+                                 const std::vector<TimedCommand>& commands, const CalValues& values, double horizon,
+                                 double spacing);
 
 /// What a session log (a robot's own, or a console's telemetry log) holds
 /// for calibration: the files' world, the frames and the commands.

@@ -15,7 +15,7 @@ constexpr double kCommandMemory = 120;  // [s] of robot time: the commands a win
 
 LiveCalibrator::LiveCalibrator(WorldModel files, const SimParams& profile, const CalValues& start, const Options& options)
     : files_(std::move(files)), profile_(profile), files0_(filesCalValues()), options_(options) {
-  state_.applied = start;
+  state_.applied = estimate_.value = start;
   worker_ = std::thread([this] { run(); });
 }
 
@@ -68,6 +68,7 @@ void LiveCalibrator::freeze(bool frozen) {
 
 void LiveCalibrator::reset() {
   std::lock_guard lock(mutex_);
+  estimate_ = filesEstimate();
   state_.applied = files0_;
   state_.sigma = {};
   state_.observed = {};
@@ -106,12 +107,10 @@ void LiveCalibrator::run() {
       ++state_.refusals;
       state_.lastRefusal = fit.refused;
     } else if (!state_.frozen && state_.applied == start) {  // not reset meanwhile
-      state_.applied = fit.value;
-      for (size_t i = 0; i < kCalParams; ++i)
-        if (fit.observed[i]) {
-          state_.sigma[i] = fit.sigma[i];
-          state_.observed[i] = true;
-        }
+      estimate_ = fuse(estimate_, fit);
+      state_.applied = estimate_.value;
+      state_.sigma = estimate_.sigma;
+      state_.observed = estimate_.observed;
     }
     state_.history.push_back(fit);
     if (state_.history.size() > CalibrationState::kHistory) state_.history.erase(state_.history.begin());

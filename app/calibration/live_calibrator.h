@@ -34,9 +34,9 @@ namespace sp {
 /// What the console shows of its calibration.
 struct CalibrationState {
   int64_t version = 0;      ///< counts changes of `applied` (and fits done)
-  CalValues applied{};      ///< what the twins use now
-  CalValues sigma{};        ///< of the fit that set each (0: the files', or unobserved so far)
-  CalFlags observed{};      ///< set by a fit (else the files' or kept)
+  CalValues applied{};      ///< what the twins use now: the fits fused (calibration.h, fuse())
+  CalValues sigma{};        ///< its deviation (0: the files', or never observed)
+  CalFlags observed{};      ///< some fit observed it (else the files' or the start's)
   bool frozen = false;
   int fits = 0, refusals = 0;
   std::string lastRefusal;  ///< "" or why the last refused fit was
@@ -94,6 +94,7 @@ class LiveCalibrator {
   std::deque<TimedCommand> commands_;
   double lastFitAt_ = -1e300;  // robot time of the newest frame the last fit saw
   CalibrationState state_;
+  CalEstimate estimate_;  // state_'s applied, sigma and observed, fused
   std::thread worker_;
 };
 

@@ -92,6 +92,15 @@ class TestCalibration : public QObject {
     QVERIFY(fit.observed[0]);
     QVERIFY2(std::abs(fit.value[0] - 0.98) <= 0.003 * 0.98, qPrintable(QString::number(fit.value[0], 'f', 5)));
   }
+  void debugSide() {
+    const WorldModel world = loadWorldFile("flat.world.xml");
+    Perturbation p = none(world);
+    p.wheelRadius = {0.98, 1.02, 0.98, 1.02};
+    const RecordedDrive d = recordDrive(world, SimParams{}, p, commands(world, kDriveAndTurn), 10.0);
+    const CalibrationFit fit = fitCalibration(world, ghostProfile(), d.frames, d.commands, filesCalValues());
+    print(fit);
+  }
+
   void straightDriveLeavesFrictionUnobserved() {
     const WorldModel world = loadWorldFile("flat.world.xml");
     Perturbation p = none(world);

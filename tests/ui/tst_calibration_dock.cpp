@@ -54,14 +54,14 @@ class TestCalibrationDock : public QObject {
     QTRY_VERIFY_WITH_TIMEOUT(calibrator->state().fits >= 3, 30000);
     QTest::qWait(300);  // a panel tick
     const CalibrationState s = calibrator->state();
-    qInfo("%d fits; wheel radius %.4f +- %.4f, gain %.4f, status: %s", s.fits, s.applied[0], s.sigma[0], s.applied[3],
+    qInfo("%d fits; wheel radius %.4f +- %.4f, gain %.4f, status: %s", s.fits, s.applied[0], s.sigma[0], s.applied[static_cast<size_t>(CalParam::MotorGain)],
           qPrintable(panel->statusLabel()->text()));
     QVERIFY(s.observed[0]);
     QVERIFY(std::abs(s.applied[0] - 1.012) < 0.015);  // the hidden mean is 1.012
-    QVERIFY(std::abs(s.applied[3] - 1.0605) < 0.02);  // hidden 1.0605
+    QVERIFY(std::abs(s.applied[static_cast<size_t>(CalParam::MotorGain)] - 1.0605) < 0.02);  // hidden 1.0605
     QVERIFY(!s.observed[static_cast<size_t>(CalParam::Friction)]);
     QCOMPARE(panel->table()->item(0, 1)->text(), QString::number(s.applied[0], 'f', 4));
-    QCOMPARE(panel->table()->item(2, 2)->text(), QStringLiteral("unobserved"));
+    QCOMPARE(panel->table()->item(static_cast<int>(CalParam::Friction), 2)->text(), QStringLiteral("unobserved"));
     QVERIFY(panel->plottedPoints() >= 2);
     QCOMPARE(w.context().session().twinParams().calWheelRadius, s.applied[0]);
     dock->grab().save(dir.filePath(QStringLiteral("dock.png")));

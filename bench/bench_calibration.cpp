@@ -1,0 +1,271 @@
+// Benchmark of calibration from telemetry (issue 28, docs/performance.md):
+// robots that are not their twin (20 perturbation seeds), driven and turned
+// for 30 s while the console's fitter runs as it does live (8 s windows every
+// 3 s, two steps each from the last values), then judged over the next 30 s
+// and on a rehearsed sequence. Prints a table; asserts nothing.
+//
+//   build/bench/bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J]
+//
+// Per world and seed:
+//   ghost error   the ghost's prediction over a 1 s each way link is 2 s
+//                 ahead of the newest telemetry: a twin anchored on a frame
+//                 (the ghost's profile and hold) predicts 2 s under the
+//                 commands at their arrival, every 0.5 s over 30-60 s; the
+//                 median horizontal and heading errors for the files' twin,
+//                 the calibrated twin and the matched twin (the robot's own
+//                 physics and delay: the floor the ghost's coarse profile sets);
+//   fitted        wheel radius against the hidden mean of the four wheels,
+//                 total mass against the hidden total;
+//   rehearsal     a 30 s sequence rehearsed (app/rehearse) with the files' and
+//                 with the calibrated parameters, from rest, against the
+//                 perturbed robot running it: end position errors;
+//   fit cost      wall time of each online fit (on this thread).
+// Seed 0 is the control: the robot is its twin.
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/calibration/calibration.h"
+#include "app/calibration/recorded_drive.h"
+#include "app/rehearse/rehearsal.h"
+#include "sim/command_file.h"
+#include "sim/model_loader.h"
+#include "sim/perturbation.h"
+
+using namespace sp;
+
+namespace {
+
+// 60 s of driving and turning at varied speeds: the first half calibrates,
+// the second judges.
+const char* const kDrive =
+    "0.5 drive 0.5 0\n"
+    "5 drive 0.7 12\n"
+    "10 drive 0.6 -15\n"
+    "15 drive 0.8 0\n"
+    "20 drive 0.5 20\n"
+    "25 drive 0.7 -10\n"
+    "30 drive 0.6 0\n"
+    "35 drive 0.8 15\n"
+    "40 drive 0.5 -20\n"
+    "45 drive 0.7 0\n"
+    "50 drive 0.6 10\n"
+    "55 drive 0.8 -12\n";
+// The rehearsed sequence: 30 s, stopping at the end.
+const char* const kRehearsed =
+    "0.5 drive 0.6 0\n"
+    "8 drive 0.6 15\n"
+    "16 drive 0.7 -10\n"
+    "24 drive 0.5 0\n"
+    "30 stop\n";
+
+struct Case {
+  std::string world;
+  uint64_t seed = 0;
+  double filesPos = 0, calPos = 0, matchedPos = 0;      // medians [m]
+  double filesHead = 0, calHead = 0, matchedHead = 0;   // [rad]
+  double radiusFit = 0, radiusTrue = 0, massFit = 0, massTrue = 0;
+  double rehearseFiles = 0, rehearseCal = 0;  // [m] end position errors
+  double fitMsMax = 0, fitMsMedian = 0;
+  int fits = 0, refused = 0;
+  std::string problem;
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+std::vector<TimedCommand> parse(const WorldModel& w, const char* text) {
+  Diagnostics diag;
+  auto seq = parseCommandSequence(text, "<bench>", diag, &w.robots[0].model);
+  if (!seq) {
+    std::fprintf(stderr, "%s", diag.format().c_str());
+    std::exit(1);
+  }
+  return *seq;
+}
+
+Perturbation identity(const WorldModel& w) {
+  Perturbation p;
+  p.linkMass.assign(w.robots[0].model.links.size(), 1.0);
+  p.centreOfMass.assign(w.robots[0].model.links.size(), Vec3{});
+  return p;
+}
+
+Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
+  Case c;
+  c.world = name;
+  c.seed = seed;
+  const RobotModel& robot = world.robots[0].model;
+  const Perturbation p = seed == 0 ? identity(world) : drawPerturbation(seed, robot);
+  const std::vector<TimedCommand> drive = parse(world, kDrive);
+  const RecordedDrive d = recordDrive(world, SimParams{}, p, drive, 60.0);
+  if (!d.problem.empty()) {
+    c.problem = d.problem;
+    return c;
+  }
+  SimParams profile;
+  profile.step = profile.ghostStep;
+  profile.iterations = profile.ghostIterations;
+
+  // The console's fitter over the first 30 s, as it runs live.
+  CalEstimate estimate = filesEstimate();
+  CalibrationOptions o;
+  o.window = 8;
+  o.iterations = 2;
+  std::vector<double> fitMs;
+  for (double end = 8; end <= 30 + 1e-9; end += 3) {
+    std::vector<RobotFrame> upTo;
+    for (const RobotFrame& f : d.frames)
+      if (f.time <= end) upTo.push_back(f);
+    const CalibrationFit fit = fitCalibration(world, profile, upTo, d.commands, estimate.value, o);
+    fitMs.push_back(fit.wallMs);
+    if (std::getenv("SP_BENCH_TRACE"))
+      std::fprintf(stderr, "seed %llu fit to %.0f s: %s cost %.3f->%.3f %s\n", static_cast<unsigned long long>(seed), end,
+                   calibrationParamsText(fit).c_str(), fit.costBefore, fit.costAfter, fit.refused.c_str());
+    ++c.fits;
+    if (!fit.refused.empty()) ++c.refused;
+    else estimate = fuse(estimate, fit);
+  }
+  const CalValues values = estimate.value;
+  c.fitMsMax = *std::max_element(fitMs.begin(), fitMs.end());
+  c.fitMsMedian = median(fitMs);
+  double radius = 0;
+  for (double r : p.wheelRadius) radius += r / 4;
+  c.radiusTrue = radius;
+  c.radiusFit = values[static_cast<size_t>(CalParam::WheelRadius)];
+  double files = 0, perturbed = 0;
+  for (size_t i = 0; i < robot.links.size(); ++i) {
+    files += robot.links[i].mass;
+    perturbed += robot.links[i].mass * p.linkMass[i];
+  }
+  c.massTrue = perturbed / files;
+  c.massFit = values[static_cast<size_t>(CalParam::Mass)];
+
+  // The ghost's error over 30-60 s, 2 s ahead.
+  std::vector<RobotFrame> judged;
+  for (const RobotFrame& f : d.frames)
+    if (f.time >= 30) judged.push_back(f);
+  const auto check = [&](const WorldModel& twin, const CalValues& v, double& pos, double& head) {
+    const PredictionCheck k = checkPredictions(twin, profile, judged, d.commands, v, 2.0, 0.5);
+    if (!k.problem.empty()) c.problem = k.problem;
+    pos = median(k.position);
+    head = median(k.heading);
+  };
+  check(world, filesCalValues(), c.filesPos, c.filesHead);
+  check(world, values, c.calPos, c.calHead);
+  CalValues matchedDelay = filesCalValues();
+  matchedDelay[static_cast<size_t>(CalParam::Delay)] = p.delay;
+  check(perturbWorld(world, p), matchedDelay, c.matchedPos, c.matchedHead);
+
+  // A rehearsed 30 s sequence against the robot running it.
+  const std::vector<TimedCommand> seq = parse(world, kRehearsed);
+  const RecordedDrive truth = recordDrive(world, SimParams{}, p, seq, 32.0);
+  const auto rehearsedEnd = [&](const SimParams& params) {
+    RehearsalPlan plan{world, params, FlightRules{}, seq, std::nullopt, true};
+    plan.rules.settle = 32.0 - seq.back().time - params.calDelay;
+    const RehearsalResult r = rehearse(plan);
+    return r.path.empty() ? Vec3{NAN, NAN, NAN} : r.path.back().base.p;
+  };
+  const Vec3 end = truth.frames.back().base.p;
+  const Vec3 a = rehearsedEnd(SimParams{});
+  const Vec3 b = rehearsedEnd(withCalValues(SimParams{}, values));
+  c.rehearseFiles = std::hypot(a.x - end.x, a.y - end.y);
+  c.rehearseCal = std::hypot(b.x - end.x, b.y - end.y);
+  return c;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int seeds = 20, jobs = 2;
+  std::string worlds = "flat,bumpy,track";
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--seeds" && i + 1 < argc) seeds = std::atoi(argv[++i]);
+    else if (a == "--jobs" && i + 1 < argc) jobs = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--worlds" && i + 1 < argc) worlds = argv[++i];
+    else {
+      std::fprintf(stderr, "usage: bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J]\n");
+      return 2;
+    }
+  }
+  const std::pair<const char*, const char*> files[] = {
+      {"flat", "terrains/flat.world.xml"}, {"bumpy", "terrains/bumpy.world.xml"}, {"track", "terrains/test_track.world.xml"}};
+  std::vector<std::pair<std::string, WorldModel>> loaded;
+  for (const auto& [name, path] : files) {
+    if (worlds.find(name) == std::string::npos) continue;
+    Diagnostics diag;
+    auto w = loadWorld(std::string(SP_SOURCE_DIR) + "/" + path, diag);
+    if (!w) {
+      std::fprintf(stderr, "%s", diag.format().c_str());
+      return 1;
+    }
+    loaded.emplace_back(name, std::move(*w));
+  }
+  std::vector<std::pair<size_t, uint64_t>> work;
+  for (size_t w = 0; w < loaded.size(); ++w)
+    for (int s = 0; s <= seeds; ++s) work.emplace_back(w, static_cast<uint64_t>(s));
+  std::vector<Case> cases(work.size());
+  std::atomic<size_t> next{0};
+  std::mutex print;
+  std::printf("world  seed | ghost pos [cm] files  calib  matched | heading [deg] files calib matched | radius fit/true  "
+              "mass fit/true | rehearsal end [m] files calib | fits (refused) fit ms med/max\n");
+  const auto worker = [&] {
+    for (size_t i; (i = next++) < work.size();) {
+      const auto& [w, seed] = work[i];
+      Case c = run(loaded[w].first, loaded[w].second, seed);
+      std::lock_guard lock(print);
+      std::printf("%-6s %4llu | %6.2f %6.2f %6.2f | %5.2f %5.2f %5.2f | %.4f/%.4f %.3f/%.3f | %6.3f %6.3f | %d (%d) %4.0f/%4.0f %s\n",
+                  c.world.c_str(), static_cast<unsigned long long>(c.seed), c.filesPos * 100, c.calPos * 100,
+                  c.matchedPos * 100, c.filesHead * 57.2958, c.calHead * 57.2958, c.matchedHead * 57.2958, c.radiusFit,
+                  c.radiusTrue, c.massFit, c.massTrue, c.rehearseFiles, c.rehearseCal, c.fits, c.refused, c.fitMsMedian,
+                  c.fitMsMax, c.problem.c_str());
+      std::fflush(stdout);
+      cases[i] = std::move(c);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int j = 1; j < jobs; ++j) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+
+  // Summary per world over the perturbed seeds, and the control (seed 0).
+  std::printf("\nsummary (perturbed seeds 1..%d):\n", seeds);
+  std::printf("world  | ghost pos median of medians: files calib matched, calib/matched | heading calib/matched | "
+              "radius |err| max, median | mass |err| max | rehearsal calib/files median, max | control: calib/files pos\n");
+  for (const auto& [name, _] : loaded) {
+    std::vector<double> fp, cp, mp, ch, mh, rerr, merr, reh;
+    double controlRatio = NAN;
+    for (const Case& c : cases) {
+      if (c.world != name) continue;
+      if (c.seed == 0) {
+        controlRatio = c.calPos / c.filesPos;
+        continue;
+      }
+      fp.push_back(c.filesPos);
+      cp.push_back(c.calPos);
+      mp.push_back(c.matchedPos);
+      ch.push_back(c.calHead);
+      mh.push_back(c.matchedHead);
+      rerr.push_back(std::abs(c.radiusFit / c.radiusTrue - 1));
+      merr.push_back(std::abs(c.massFit / c.massTrue - 1));
+      reh.push_back(c.rehearseCal / c.rehearseFiles);
+    }
+    std::printf("%-6s | %.2f %.2f %.2f cm, %.2f | %.2f | %.2f %%, %.2f %% | %.2f %% | %.2f, %.2f | %.3f\n", name.c_str(),
+                median(fp) * 100, median(cp) * 100, median(mp) * 100, median(cp) / median(mp), median(ch) / median(mh),
+                *std::max_element(rerr.begin(), rerr.end()) * 100, median(rerr) * 100,
+                *std::max_element(merr.begin(), merr.end()) * 100, median(reh), *std::max_element(reh.begin(), reh.end()),
+                controlRatio);
+  }
+  return 0;
+}
