@@ -136,7 +136,7 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
     if (!fit.refused.empty()) ++c.refused;
     else estimate = fuse(estimate, fit);
   }
-  const CalValues values = estimate.value;
+  const CalValues values = significantValues(estimate);
   c.fitMsMax = *std::max_element(fitMs.begin(), fitMs.end());
   c.fitMsMedian = median(fitMs);
   double radius = 0;

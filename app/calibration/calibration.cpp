@@ -64,6 +64,13 @@ CalEstimate filesEstimate() {
   return e;
 }
 
+CalValues significantValues(const CalEstimate& e) {
+  CalValues out = e.value;
+  for (size_t i = 0; i < kCalParams; ++i)
+    if (e.observed[i] && std::abs(e.value[i] - calParams()[i].files) <= 2 * e.sigma[i]) out[i] = calParams()[i].files;
+  return out;
+}
+
 CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit) {
   CalEstimate out = prior;
   out.time = std::max(prior.time, fit.to);

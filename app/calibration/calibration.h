@@ -133,6 +133,10 @@ CalEstimate filesEstimate();
 CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit);
 /// The drift: a share of each parameter's scale per square-root second.
 constexpr double kDrift = 0.005;
+/// What the twins are given of `estimate`: each parameter where it differs
+/// from the files' value by more than two deviations, else the files'
+/// (a robot that is its twin keeps its twin: the fits' noise is not applied).
+CalValues significantValues(const CalEstimate& estimate);
 
 /// How far the twin calibrated by `values` lands from the robot `horizon`
 /// seconds after each anchor (every `spacing` s along the driving parts of

@@ -93,7 +93,7 @@ void LiveCalibrator::run() {
       if (stop_) return;
       frames.assign(frames_.begin(), frames_.end());
       commands.assign(commands_.begin(), commands_.end());
-      start = state_.applied;
+      start = estimate_.value;
       lastFitAt_ = frames.back().time;
     }
     const CalibrationFit fit = fitCalibration(files_, profile_, frames, commands, start, options_.fit, [&] {
@@ -106,9 +106,9 @@ void LiveCalibrator::run() {
     if (!fit.refused.empty()) {
       ++state_.refusals;
       state_.lastRefusal = fit.refused;
-    } else if (!state_.frozen && state_.applied == start) {  // not reset meanwhile
+    } else if (!state_.frozen && estimate_.value == start) {  // not reset meanwhile
       estimate_ = fuse(estimate_, fit);
-      state_.applied = estimate_.value;
+      state_.applied = significantValues(estimate_);
       state_.sigma = estimate_.sigma;
       state_.observed = estimate_.observed;
     }

@@ -34,7 +34,7 @@ namespace sp {
 /// What the console shows of its calibration.
 struct CalibrationState {
   int64_t version = 0;      ///< counts changes of `applied` (and fits done)
-  CalValues applied{};      ///< what the twins use now: the fits fused (calibration.h, fuse())
+  CalValues applied{};      ///< what the twins use now: the fits fused, where significant (calibration.h)
   CalValues sigma{};        ///< its deviation (0: the files', or never observed)
   CalFlags observed{};      ///< some fit observed it (else the files' or the start's)
   bool frozen = false;
