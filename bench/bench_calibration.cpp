@@ -44,8 +44,11 @@ using namespace sp;
 namespace {
 
 // 60 s of driving and turning at varied speeds: the first half calibrates,
-// the second judges.
-const char* const kDrive =
+// the second judges. Each world's drive stays on its terrain: the open
+// plane takes anything; the bumpy field (20 x 20 m, the robot at its
+// centre) is driven in loops; the test track (22 x 4 m) straight along,
+// weaving a little.
+const char* const kDriveOpen =
     "0.5 drive 0.5 0\n"
     "5 drive 0.7 12\n"
     "10 drive 0.6 -15\n"
@@ -58,12 +61,44 @@ const char* const kDrive =
     "45 drive 0.7 0\n"
     "50 drive 0.6 10\n"
     "55 drive 0.8 -12\n";
-// The rehearsed sequence: 30 s, stopping at the end.
-const char* const kRehearsed =
+const char* const kDriveLoops =
+    "0.5 drive 0.5 20\n"
+    "6 drive 0.6 12\n"
+    "12 drive 0.4 25\n"
+    "18 drive 0.6 15\n"
+    "24 drive 0.5 22\n"
+    "30 drive 0.6 12\n"
+    "36 drive 0.4 25\n"
+    "42 drive 0.6 15\n"
+    "48 drive 0.5 20\n"
+    "54 drive 0.6 12\n";
+const char* const kDriveAlong =
+    "0.5 drive 0.3 0\n"
+    "6 drive 0.35 6\n"
+    "12 drive 0.3 -6\n"
+    "18 drive 0.35 0\n"
+    "24 drive 0.3 6\n"
+    "30 drive 0.35 -6\n"
+    "36 drive 0.3 0\n"
+    "42 drive 0.35 6\n"
+    "48 drive 0.3 -6\n"
+    "54 drive 0.35 0\n";
+// The rehearsed sequences: 30 s, stopping at the end, on the same ground.
+const char* const kRehearsedOpen =
     "0.5 drive 0.6 0\n"
     "8 drive 0.6 15\n"
     "16 drive 0.7 -10\n"
     "24 drive 0.5 0\n"
+    "30 stop\n";
+const char* const kRehearsedLoops =
+    "0.5 drive 0.5 18\n"
+    "10 drive 0.6 12\n"
+    "20 drive 0.4 22\n"
+    "30 stop\n";
+const char* const kRehearsedAlong =
+    "0.5 drive 0.3 0\n"
+    "10 drive 0.35 5\n"
+    "20 drive 0.3 -5\n"
     "30 stop\n";
 
 struct Case {
@@ -102,6 +137,9 @@ Perturbation identity(const WorldModel& w) {
 }
 
 Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
+  const bool loops = name == "bumpy", along = name == "track";
+  const char* const kDrive = loops ? kDriveLoops : along ? kDriveAlong : kDriveOpen;
+  const char* const kRehearsed = loops ? kRehearsedLoops : along ? kRehearsedAlong : kRehearsedOpen;
   Case c;
   c.world = name;
   c.seed = seed;
@@ -129,9 +167,6 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
       if (f.time <= end) upTo.push_back(f);
     const CalibrationFit fit = fitCalibration(world, profile, upTo, d.commands, estimate.value, o);
     fitMs.push_back(fit.wallMs);
-    if (std::getenv("SP_BENCH_TRACE"))
-      std::fprintf(stderr, "seed %llu fit to %.0f s: %s cost %.3f->%.3f %s\n", static_cast<unsigned long long>(seed), end,
-                   calibrationParamsText(fit).c_str(), fit.costBefore, fit.costAfter, fit.refused.c_str());
     ++c.fits;
     if (!fit.refused.empty()) ++c.refused;
     else estimate = fuse(estimate, fit);

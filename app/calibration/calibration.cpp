@@ -547,13 +547,24 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       fit.observed[kGain] = fit.sigma[kGain] <= kUnobserved * calParams()[kGain].scale;
       if (fit.observed[kGain]) {
         v[kGain] *= k;
-        // The ground speed goes as radius x gain: keep what the start had
-        // found of it while the gain moves (the fit below refines both).
+        // The ground speed goes as radius x gain: when the start had found
+        // it (a refinement) it is kept by moving the radius with the gain;
+        // when not (a first fit) the radius stays. Whichever predicts the
+        // window better.
         constexpr size_t kRadius = static_cast<size_t>(CalParam::WheelRadius);
-        if (!o.fixed[kRadius]) v[kRadius] /= k;
-        r = residuals(pb, v, why);
-        ++fit.twinRuns;
-        if (!r) return done("the twin diverged with the motor gain fitted: " + why);
+        std::vector<Candidate> both{{v, 0}};
+        if (!o.fixed[kRadius]) {
+          both.push_back({v, 0});
+          both.back().values[kRadius] /= k;
+        }
+        const auto runs = runAll(pb, both, o.threads, why);
+        fit.twinRuns += static_cast<int>(both.size());
+        size_t best = 0;
+        for (size_t b = 0; b < runs.size(); ++b)
+          if (runs[b] && (!runs[best] || meanSquare(*runs[b]) < meanSquare(*runs[best]))) best = b;
+        if (!runs[best]) return done("the twin diverged with the motor gain fitted: " + why);
+        v = both[best].values;
+        r = runs[best];
         fit.costAfter = meanSquare(*r);
       }
     }
@@ -595,7 +606,6 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
         col[i] = apart / 2 / info.probe * info.scale;
         move += apart * apart;
       }
-      if (getenv("SP_CAL_DEBUG")) fprintf(stderr, "it %d %s move %.3g noise %.3g\n", it, info.key, move, noise);
       if (move > 4 * noise) {
         smooth.push_back(free[k]);
         if (std::find(everSmooth.begin(), everSmooth.end(), free[k]) == everSmooth.end()) everSmooth.push_back(free[k]);

@@ -97,6 +97,7 @@ void LiveCalibrator::run() {
       lastFitAt_ = frames.back().time;
     }
     const CalibrationFit fit = fitCalibration(files_, profile_, frames, commands, start, options_.fit, [&] {
+      if (options_.duringFit) options_.duringFit();
       std::lock_guard lock(mutex_);
       return stop_;
     });

@@ -17,6 +17,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -58,6 +59,9 @@ class LiveCalibrator {
       o.threads = 2;
       return o;
     }();
+    /// Tests: called on the worker between the twin runs of each fit,
+    /// holding no lock (to prove the GUI thread never waits on a fit).
+    std::function<void()> duringFit;
   };
   /// Fits the robot of `files` (the console's world, its first robot) with
   /// the physics `profile` (the ghost's: step, iterations, hold) from

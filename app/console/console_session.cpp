@@ -271,10 +271,12 @@ std::string ConsoleSession::commandRefusal(bool leaseHeld) const {
 }
 
 void ConsoleSession::commandSent(const Command& command) {
-  if (recorder_) recorder_->command(command, robot());
+  // When it will act on the robot, by the ghost's clock (before the
+  // calibrated delay: a fit adds its own).
+  const std::optional<double> arrival = ghost_ ? std::optional(ghost_->ghostTime(Ghost::now())) : std::nullopt;
+  if (recorder_) recorder_->command(command, robot(), arrival);
   if (ghost_) {
-    // Dated before the ghost adds the calibrated delay: the fit adds its own.
-    if (calibrator_) calibrator_->command(command, ghost_->ghostTime(Ghost::now()));
+    if (calibrator_) calibrator_->command(command, *arrival);
     ghost_->commandSent(command);
   }
 }

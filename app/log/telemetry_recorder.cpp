@@ -38,8 +38,9 @@ void TelemetryRecorder::laser(const net::LaserMsg& m) {
   writer_->logLaser(LogLaser{std::llround(m.time * 1000), m.time, m.angleMin, m.angleStep, m.ranges});
 }
 
-void TelemetryRecorder::command(const Command& command, const RobotModel* robot) {
-  writer_->logCommand(rowKey(), time_, "operator", command, robot);
+void TelemetryRecorder::command(const Command& command, const RobotModel* robot, std::optional<double> arrival) {
+  const double t = arrival ? *arrival : time_;
+  writer_->logCommand(std::llround(t * 1000), t, "operator", command, robot);
 }
 
 void TelemetryRecorder::event(const std::string& kind, const std::string& text) {

@@ -13,6 +13,7 @@
 // the disk (SessionLogWriter queues).
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "app/console/robot_frame.h"
@@ -34,9 +35,10 @@ class TelemetryRecorder {
   /// (telemetry names mapped; joints the robot did not report are zero).
   void telemetry(const net::TelemetryMsg& message, const RobotModel& robot);
   void laser(const net::LaserMsg& message);
-  /// A command the operator sent (source "operator"), at the robot time of
-  /// the latest telemetry.
-  void command(const Command& command, const RobotModel* robot);
+  /// A command the operator sent (source "operator"), at the robot time it
+  /// is expected to take effect (`arrival`: the ghost's clock estimate,
+  /// app/ghost/ghost_clock.h), or without one at the latest telemetry's.
+  void command(const Command& command, const RobotModel* robot, std::optional<double> arrival = std::nullopt);
   /// An event ("link", "estop", "note", ...) at the latest robot time.
   void event(const std::string& kind, const std::string& text);
   /// What the console's ghost predicted for a frame (app/ghost/ghost.h).
