@@ -79,11 +79,13 @@ int main(int argc, char** argv) {
   const QCommandLineOption delay(QStringLiteral("delay"), QStringLiteral("The stand-in's link delays every frame by S seconds each way (rehearse a slow link; the ghost spans it)."), QStringLiteral("S"));
   const QCommandLineOption perturb(QStringLiteral("perturb"), QStringLiteral("The stand-in is a robot that is not its twin: hidden deviations from the files drawn from SEED (simpartner-robot --help lists them)."), QStringLiteral("SEED"));
   const QCommandLineOption noGhost(QStringLiteral("no-ghost"), QStringLiteral("Do not run the predictive ghost."));
+  const QCommandLineOption noCalibration(QStringLiteral("no-calibration"),
+                                         QStringLiteral("Do not calibrate the twin from telemetry while driving."));
   const QCommandLineOption rules(QStringLiteral("rules"), QStringLiteral("Flight rules for rehearsals (default: built-in, see config/flight.rules)."), QStringLiteral("FILE"));
   const QCommandLineOption sequenceFile(QStringLiteral("sequence"), QStringLiteral("Open this command sequence in the Sequence dock."), QStringLiteral("FILE"));
   const QCommandLineOption replay(QStringLiteral("replay"), QStringLiteral("Open this session log in the Replay dock."), QStringLiteral("LOG"));
   const QCommandLineOption drive(QStringLiteral("drive"), QStringLiteral("Drive at SPEED m/s once in control (for demonstrations)."), QStringLiteral("SPEED"));
-  parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, delay, perturb, noGhost, monitor, screenshot, quitAfter, drive, rules,
+  parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, delay, perturb, noGhost, noCalibration, monitor, screenshot, quitAfter, drive, rules,
                      sequenceFile, replay});
   if (!parser.parse(QCoreApplication::arguments())) {
     std::cerr << "<command line>: error: " << parser.errorText().toStdString() << "\n";
@@ -148,6 +150,7 @@ int main(int argc, char** argv) {
     }
   }
   options.ghost = !parser.isSet(noGhost);
+  options.calibrate = !parser.isSet(noCalibration);
   if (parser.isSet(drive) && !(driveSpeed = numberOption(parser, drive, -10, 10))) return 2;
   if (parser.isSet(quitAfter) && !(quitSeconds = numberOption(parser, quitAfter, 0.1, 1e6))) return 2;
 

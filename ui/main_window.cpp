@@ -60,6 +60,7 @@ ConsoleSessionOptions toSessionOptions(const ConsoleOptions& o, const QString& l
   s.delay = o.delay;
   s.perturbSeed = o.perturbSeed;
   s.ghost = o.ghost;
+  s.calibrate = o.calibrate;
   return s;
 }
 

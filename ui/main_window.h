@@ -75,6 +75,7 @@ struct ConsoleOptions {
   double delay = 0;           ///< [s] one-way delay the stand-in's link emulates (each way)
   std::optional<uint64_t> perturbSeed;  ///< the stand-in is a robot that is not its twin (sim/perturbation.h)
   bool ghost = true;          ///< run and show the predictive ghost
+  bool calibrate = true;      ///< calibrate the twin from telemetry (app/calibration/live_calibrator.h)
   bool takeControl = true;    ///< ask for the lease as soon as connected
   QString rules;              ///< flight rules file for rehearsals; "" = the built-in defaults
   QString sequence;           ///< a sequence file to open in the Sequence dock
