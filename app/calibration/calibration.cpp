@@ -71,21 +71,22 @@ CalValues significantValues(const CalEstimate& e) {
   return out;
 }
 
-CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit) {
+CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit, double overlap) {
   CalEstimate out = prior;
   out.time = std::max(prior.time, fit.to);
   const double dt = std::max(0.0, fit.to - prior.time);
   for (size_t i = 0; i < kCalParams; ++i) {
     if (!fit.observed[i] || !(fit.sigma[i] > 0)) continue;
+    const double sigma = fit.sigma[i] * std::sqrt(std::max(1.0, overlap));
     if (!prior.observed[i]) {
       out.value[i] = fit.value[i];
-      out.sigma[i] = fit.sigma[i];
+      out.sigma[i] = sigma;
       out.observed[i] = true;
       continue;
     }
     const double drift = kDrift * calParams()[i].scale;
     const double p = prior.sigma[i] * prior.sigma[i] + drift * drift * dt;
-    const double q = fit.sigma[i] * fit.sigma[i];
+    const double q = sigma * sigma;
     out.value[i] = (prior.value[i] * q + fit.value[i] * p) / (p + q);
     out.sigma[i] = std::sqrt(p * q / (p + q));
   }

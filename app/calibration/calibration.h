@@ -130,7 +130,10 @@ CalEstimate filesEstimate();
 /// fused by inverse-variance weighting (a Kalman update of a constant),
 /// its prior deviation first grown by kDrift per second since the prior's
 /// time (a robot's tyres and loads do change, slowly); the rest are kept.
-CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit);
+/// `overlap`: how many fits each frame is in (window over period: the live
+/// fitter's 8 s every 3 s is 2.7); the fit's variances are multiplied by
+/// it, so that overlapping windows are not counted as independent.
+CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit, double overlap = 1);
 /// The drift: a share of each parameter's scale per square-root second.
 constexpr double kDrift = 0.005;
 /// What the twins are given of `estimate`: each parameter where it differs

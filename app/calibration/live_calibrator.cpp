@@ -108,7 +108,7 @@ void LiveCalibrator::run() {
       ++state_.refusals;
       state_.lastRefusal = fit.refused;
     } else if (!state_.frozen && estimate_.value == start) {  // not reset meanwhile
-      estimate_ = fuse(estimate_, fit);
+      estimate_ = fuse(estimate_, fit, options_.fit.window / options_.period);
       state_.applied = significantValues(estimate_);
       state_.sigma = estimate_.sigma;
       state_.observed = estimate_.observed;
