@@ -626,10 +626,10 @@ class TestConsole : public QObject {
             link->minimumSizeHint().height(), plots->width(), plots->height(), plots->minimumSizeHint().width(),
             plots->minimumSizeHint().height());
       QVERIFY(w.viewShare() >= 0.5);
-      // The link under the controls, not a tab of theirs; the Sequence and
-      // Terrain docks are.
+      // The link under the controls, not a tab of theirs; the Sequence,
+      // Terrain and Calibration docks are.
       QVERIFY(!w.tabifiedDockWidgets(controls).contains(link));
-      QCOMPARE(w.tabifiedDockWidgets(controls).size(), 2);
+      QCOMPARE(w.tabifiedDockWidgets(controls).size(), 3);
       QVERIFY(link->isVisible() && link->y() > controls->y());
       w.resizeDocks({controls}, {900}, Qt::Horizontal);
       w.resizeDocks({plots}, {450}, Qt::Vertical);
