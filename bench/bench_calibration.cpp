@@ -34,6 +34,7 @@
 
 #include "app/calibration/calibration.h"
 #include "app/calibration/recorded_drive.h"
+#include "app/ghost/ghost.h"
 #include "app/rehearse/rehearsal.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
@@ -151,9 +152,7 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
     c.problem = d.problem;
     return c;
   }
-  SimParams profile;
-  profile.step = profile.ghostStep;
-  profile.iterations = profile.ghostIterations;
+  const SimParams profile = Ghost::profile(SimParams{});
 
   // The console's fitter over the first 30 s, as it runs live.
   CalEstimate estimate = filesEstimate();

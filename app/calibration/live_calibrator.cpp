@@ -59,6 +59,11 @@ int64_t LiveCalibrator::version() const {
   return state_.version;
 }
 
+CalValues LiveCalibrator::applied() const {
+  std::lock_guard lock(mutex_);
+  return state_.applied;
+}
+
 void LiveCalibrator::freeze(bool frozen) {
   std::lock_guard lock(mutex_);
   if (state_.frozen == frozen) return;

@@ -80,6 +80,8 @@ class LiveCalibrator {
   CalibrationState state() const;
   /// The version alone (cheap to poll).
   int64_t version() const;
+  /// What the twins use now (state().applied without copying the history).
+  CalValues applied() const;
   void freeze(bool frozen);
   /// Back to the files' values; the fits start from them again.
   void reset();

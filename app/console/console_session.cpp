@@ -54,27 +54,27 @@ void ConsoleSession::setWorld(WorldModel world) {
   lastPrediction_.reset();
   ghostError_.clear();
   calibrationSeen_ = calibrationFitsLogged_ = 0;
-  if (options_.ghost) ghost_ = Ghost::create(calibratedWorld(*world_, params_), params_, options_.ghostOptions, ghostError_);
-  if (ghost_) {
-    if (params_.calDelay > 0) ghost_->setCalibration(calibratedWorld(*world_, params_), params_.calDelay);
-    if (options_.calibrate) {
-      SimParams profile = params_;  // the ghost's physics: the twin it calibrates
-      profile.step = params_.ghostStep;
-      profile.iterations = params_.ghostIterations;
-      calibrator_ = std::make_unique<LiveCalibrator>(*world_, profile, calValues(params_), options_.calibration);
-    }
-  }
+  if (options_.ghost) ghost_ = Ghost::create(*world_, params_, options_.ghostOptions, ghostError_);
+  ghostCalibration_ = calValues(params_);
+  // The calibration fits the ghost's own twin.
+  if (ghost_ && options_.calibrate)
+    calibrator_ = std::make_unique<LiveCalibrator>(*world_, Ghost::profile(params_), ghostCalibration_, options_.calibration);
 }
 
 SimParams ConsoleSession::twinParams() const {
-  return calibrator_ ? withCalValues(params_, calibrator_->state().applied) : params_;
+  return calibrator_ ? withCalValues(params_, calibrator_->applied()) : params_;
 }
 
 void ConsoleSession::takeCalibration() {
   if (!calibrator_ || calibrator_->version() == calibrationSeen_) return;
   const CalibrationState s = calibrator_->state();
-  const SimParams calibrated = withCalValues(params_, s.applied);
-  if (ghost_) ghost_->setCalibration(calibratedWorld(*world_, calibrated), calibrated.calDelay);
+  // The ghost rebuilds its twin for a new calibration: only when the values
+  // changed (a refused or frozen fit, a freeze, count as versions too).
+  if (ghost_ && s.applied != ghostCalibration_) {
+    const SimParams calibrated = withCalValues(params_, s.applied);
+    ghost_->setCalibration(calibratedWorld(*world_, calibrated), calibrated.calDelay);
+    ghostCalibration_ = s.applied;
+  }
   calibrationSeen_ = s.version;
   // The fits since the last call, one row per parameter (the history keeps the newest).
   const int fresh = std::min<int>(s.fits - calibrationFitsLogged_, static_cast<int>(s.history.size()));

@@ -217,6 +217,7 @@ class ConsoleSession {
   std::unique_ptr<LiveCalibrator> calibrator_;
   int64_t calibrationSeen_ = 0;  // the calibrator's version the ghost and the log have
   int calibrationFitsLogged_ = 0;
+  CalValues ghostCalibration_{};  // the calibration the ghost was last handed
   std::string ghostError_;
   std::optional<GhostError> lastPrediction_;
   JointNameMap positions_, rates_;

@@ -8,12 +8,20 @@
 
 #include "app/ghost/ghost_impl.h"
 #include "app/ghost/hold_policy.h"
+#include "sim/perturbation.h"
 #include "sim/runner.h"
 
 namespace sp {
 
 double Ghost::now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+SimParams Ghost::profile(const SimParams& params) {
+  SimParams p = params;
+  p.step = params.ghostStep;
+  p.iterations = params.ghostIterations;
+  return p;
 }
 
 std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& params, std::string& error) {
@@ -26,10 +34,8 @@ std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& p
     error = "the world has no robot to predict";
     return nullptr;
   }
-  SimParams profile = params;
-  profile.step = params.ghostStep;
-  profile.iterations = params.ghostIterations;
-  std::unique_ptr<Ghost> g(new Ghost(world, profile, options));
+  std::unique_ptr<Ghost> g(new Ghost(calibratedWorld(world, params), profile(params), options));
+  g->delay_ = params.calDelay;
   const RobotModel& robot = world.robots[0].model;
   std::optional<std::vector<int>> held = holdableJoints(robot, params.ghostHold, error);
   if (!held) return nullptr;

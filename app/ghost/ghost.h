@@ -116,9 +116,14 @@ class Ghost {
     double trailSpacing = 0.1;   ///< [s] robot time between trail points
   };
 
-  /// Builds the three worlds from `world` with the ghost profile of
-  /// `params` and starts the threads. nullptr and `error` if a world cannot
-  /// be built or the world has no robot.
+  /// The ghost's physics profile of `params`: ghost.step and
+  /// ghost.iterations as its step and solver iterations (the twin the
+  /// console's calibration fits, too).
+  static SimParams profile(const SimParams& params);
+  /// Builds the three worlds from `world`, calibrated by `params`'
+  /// calibration.* keys (commands act calibration.delay after they
+  /// arrive), with the ghost profile of `params`, and starts the threads.
+  /// nullptr and `error` if a world cannot be built or the world has no robot.
   static std::unique_ptr<Ghost> create(const WorldModel& world, const SimParams& params, std::string& error);
   static std::unique_ptr<Ghost> create(const WorldModel& world, const SimParams& params, const Options& options,
                                        std::string& error);

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "app/calibration/calibration.h"
+#include "app/ghost/ghost.h"
 #include "app/tools/headless_runner.h"
 #include "app/log/log_export.h"
 #include "app/validation/plot_svg.h"
@@ -464,11 +465,7 @@ int calibrate(const std::vector<std::string>& args) {
     std::cerr << error << "\n";
     return 1;
   }
-  sp::SimParams profile = in->params;
-  if (profileName == "ghost") {
-    profile.step = in->params.ghostStep;
-    profile.iterations = in->params.ghostIterations;
-  }
+  const sp::SimParams profile = profileName == "ghost" ? sp::Ghost::profile(in->params) : in->params;
   sp::CalibrationOptions options;
   options.window = window;
   options.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));

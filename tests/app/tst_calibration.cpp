@@ -30,6 +30,7 @@
 #include "app/calibration/calibration.h"
 #include "app/calibration/live_calibrator.h"
 #include "app/calibration/recorded_drive.h"
+#include "app/ghost/ghost.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "tests/test_files.h"
@@ -46,12 +47,7 @@ WorldModel loadWorldFile(const std::string& name) {
 }
 
 // The ghost's physics, as the console fits it.
-SimParams ghostProfile() {
-  SimParams p;
-  p.step = p.ghostStep;
-  p.iterations = p.ghostIterations;
-  return p;
-}
+SimParams ghostProfile() { return Ghost::profile(SimParams{}); }
 
 std::vector<TimedCommand> commands(const WorldModel& world, const char* text) {
   std::vector<TimedCommand> out;
