@@ -111,7 +111,7 @@ struct RobotServerConfig {
   /// connections that dribble their HELLO can never lock the operator out
   /// (a connection on loopback or a LAN says HELLO within milliseconds).
   /// More than maxConnections: no such pool (a test's control).
-  size_t maxUnauthenticated = 16;
+  size_t maxUnauthenticated = 32;
   /// [s] a connection without a good HELLO by then is closed.
   double helloTimeout = 2.0;
   /// Where the server reports connections, refusals and bad frames (one
