@@ -483,6 +483,8 @@ void readActuator(const XMLElement* e, std::vector<PendingActuator>& out, NameSe
   r.nonNegative("kd");
   a.integralLimit = r.number("integral_limit", 0);
   r.nonNegative("integral_limit");
+  a.velocityScale = r.number("velocity_scale", 1);
+  r.positive("velocity_scale");
   a.continuous = r.boolean("continuous", false);
   p.hasTarget = r.has("target");
   p.targetFile = r.number("target", 0);

@@ -1,8 +1,10 @@
 #include "sim/perturbation.h"
 
 #include <cstdio>
+#include <tinyxml2.h>
 
 #include "sim/random.h"
+#include "sim/text.h"
 
 namespace sp {
 
@@ -62,19 +64,84 @@ WorldModel perturbWorld(WorldModel world, const Perturbation& p) {
   return world;
 }
 
-WorldModel calibratedWorld(const WorldModel& world, const SimParams& params) {
-  if (!params.calibrated() || world.robots.empty()) return world;
+namespace {
+
+// The calibration as a perturbation of the files' robot: what both the
+// twins (calibratedWorld) and a saved robot file apply.
+Perturbation calibrationPerturbation(const SimParams& params, size_t links) {
   Perturbation p;
   const double front = params.calWheelRadius * (1 + params.calWheelRadiusSplit / 2);
   const double rear = params.calWheelRadius * (1 - params.calWheelRadiusSplit / 2);
   const double left = 1 + params.calWheelRadiusSide / 2, right = 1 - params.calWheelRadiusSide / 2;
   p.wheelRadius = {front * left, front * right, rear * left, rear * right};  // FL FR RL RR
-  const size_t links = world.robots[0].model.links.size();
   p.linkMass.assign(links, params.calMass);
   p.centreOfMass.assign(links, Vec3{});
   p.friction = params.calFriction;
   p.velocityGain = params.calMotorGain;
-  return perturbWorld(world, p);
+  return p;
+}
+
+}  // namespace
+
+WorldModel calibratedWorld(const WorldModel& world, const SimParams& params) {
+  if (!params.calibrated() || world.robots.empty()) return world;
+  return perturbWorld(world, calibrationPerturbation(params, world.robots[0].model.links.size()));
+}
+
+std::optional<std::string> calibratedRobotText(const std::string& text, const RobotModel& robot, const SimParams& params,
+                                               std::string& error) {
+  using namespace tinyxml2;
+  const std::string where = robot.file.empty() ? std::string("robot file") : robot.file;
+  XMLDocument doc;
+  if (doc.Parse(text.data(), text.size()) != XML_SUCCESS || !doc.RootElement()) {
+    error = where + ": error: not a robot file: " + (doc.ErrorStr() ? doc.ErrorStr() : "no root element");
+    return std::nullopt;
+  }
+  const Perturbation p = calibrationPerturbation(params, robot.links.size());
+  const auto scale = [](XMLElement* e, const char* attr, double factor, double fallback) {
+    e->SetAttribute(attr, shortestText(e->DoubleAttribute(attr, fallback) * factor).c_str());
+  };
+  std::vector<bool> seen(robot.links.size(), false);
+  for (XMLElement* e = doc.RootElement()->FirstChildElement(); e; e = e->NextSiblingElement()) {
+    const char* name = e->Attribute("name");
+    if (!name) continue;
+    if (std::string_view(e->Name()) == "link") {
+      const int i = robot.findLink(name);
+      if (i < 0) continue;
+      seen[static_cast<size_t>(i)] = true;
+      scale(e, "mass", p.linkMass[static_cast<size_t>(i)], 0);
+      if (!robot.drive) continue;
+      for (size_t w = 0; w < 4; ++w) {
+        const int joint = robot.drive->wheels[w];
+        if (joint < 0 || robot.joints[static_cast<size_t>(joint)].child != i) continue;
+        // The tyre: the wheel link's round geoms, as perturbWorld scales them.
+        for (XMLElement* g = e->FirstChildElement("geom"); g; g = g->NextSiblingElement("geom")) {
+          const std::string type = g->Attribute("type") ? g->Attribute("type") : "";
+          if (type == "cylinder" || type == "sphere") scale(g, "radius", p.wheelRadius[w], 0);
+        }
+      }
+    } else if (std::string_view(e->Name()) == "actuator" && robot.drive && e->Attribute("joint")) {
+      const int joint = robot.findJoint(e->Attribute("joint"));
+      for (int wheel : robot.drive->wheels)
+        if (joint >= 0 && joint == wheel) scale(e, "velocity_scale", p.velocityGain, 1);
+    }
+  }
+  for (size_t i = 0; i < seen.size(); ++i)
+    if (!seen[i]) {
+      error = where + ": error: link '" + robot.links[i].name + "' is not in the file's text (a file other than the one loaded?)";
+      return std::nullopt;
+    }
+  const std::string note = " Calibrated from telemetry (SimPartner, app/calibration/): link masses x " +
+                           shortestText(params.calMass) + ", tyre radii and wheel motors' velocity_scale written in. " +
+                           "Not in a robot file, keep them in the parameters: calibration.friction = " +
+                           shortestText(params.calFriction) + " (the ground's contact), calibration.delay = " +
+                           shortestText(params.calDelay) + " s (the link's). ";
+  XMLComment* comment = doc.NewComment(note.c_str());
+  if (doc.FirstChild() && doc.FirstChild()->ToDeclaration()) doc.InsertAfterChild(doc.FirstChild(), comment);
+  else doc.InsertFirstChild(comment);
+  XMLPrinter printer;
+  doc.Print(&printer);
+  return std::string(printer.CStr(), static_cast<size_t>(printer.CStrSize() > 0 ? printer.CStrSize() - 1 : 0));
 }
 
 std::string Perturbation::report(const RobotModel& robot) const {

@@ -23,6 +23,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -74,5 +75,16 @@ WorldModel perturbWorld(WorldModel world, const Perturbation& p);
 /// scaled (the delay is the caller's: it schedules the commands). `world`
 /// itself when the keys are the files' (identity).
 WorldModel calibratedWorld(const WorldModel& world, const SimParams& params);
+
+/// The robot file `text` (which loaded as `robot`) with `params`' calibration
+/// written in: every link's mass, each wheel's tyre radius and the wheel
+/// motors' `velocity_scale`, so that the file alone builds the calibrated
+/// robot (its comments and everything else kept). Friction is the ground's
+/// (a world's <contact>) and the delay the link's: they stay in the
+/// parameters file, and a comment at the top says so with their values.
+/// nullopt and `error` when `text` does not parse or does not hold `robot`'s
+/// links.
+std::optional<std::string> calibratedRobotText(const std::string& text, const RobotModel& robot, const SimParams& params,
+                                               std::string& error);
 
 }  // namespace sp

@@ -85,8 +85,9 @@ struct ActuatorSpec {
   double integralLimit = 0;       ///< clamp of the integral term [rad s]
   bool continuous = false;        ///< wrap angle errors to (-pi, pi]
   double initialTarget = 0;       ///< initial set-point of Position mode [rad]
-  /// The motor reaches this times the commanded speed in Velocity mode (not
-  /// in files: a perturbed robot's mis-calibrated speed loop, sim/perturbation.h).
+  /// The motor reaches this times the commanded speed in Velocity mode: a
+  /// calibrated robot file's measured speed loop (`velocity_scale`), or a
+  /// perturbed robot's mis-calibrated one (sim/perturbation.h).
   double velocityScale = 1;
   int line = 0;
 };

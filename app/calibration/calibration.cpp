@@ -724,6 +724,7 @@ std::optional<CalibrationInput> calibrationInput(const std::string& path, std::s
   in.params = logged->params;
   const std::map<std::string, std::string> meta = reader->meta();
   if (const auto it = meta.find("log_source"); it != meta.end()) in.source = it->second;
+  if (const auto it = meta.find("robot_contents"); it != meta.end()) in.robotText = it->second;
   const RobotModel& robot = in.world.robots[0].model;
   for (const LogSample& s : reader->samplesBetween(-1e300, 1e300)) in.frames.push_back(frameFromSample(s, robot.joints.size()));
   for (const LogCommand& c : reader->commands()) {

@@ -162,6 +162,7 @@ struct CalibrationInput {
   std::vector<RobotFrame> frames;
   std::vector<TimedCommand> commands;
   std::string source;  ///< the log's meta log_source ("" for a robot's own)
+  std::string robotText;  ///< the robot file as logged (calibratedRobotText writes a calibrated one)
 };
 /// nullopt and `error` (naming `path`) when the log cannot be read.
 std::optional<CalibrationInput> calibrationInput(const std::string& path, std::string& error);

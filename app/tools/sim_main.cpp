@@ -91,13 +91,16 @@ constexpr const char* kUsage = R"(usage:
       Gathers DIR's results into results.csv and report.md (pass/fail, end
       pose, minimum stability margin, health, end hash per sample), naming
       failed and missing tasks. Exits 0 when every task ran, 4 otherwise.
-  simpartner-sim calibrate LOG [--out FILE] [--window S] [--profile ghost|robot]
+  simpartner-sim calibrate LOG [--out FILE] [--robot-out FILE] [--window S] [--profile ghost|robot]
       Fits the twin to the robot that made LOG (a robot's own log or a
       console's telemetry log): wheel radius and its front-rear split, tyre
       friction, wheel motor gain, command delay (fitting the twin's
       predictions) and total mass (from the wheel loads). Prints each with
       its deviation, or "unobserved" when the motion cannot tell, and writes
       the calibration.* keys to FILE (a parameters file; default: none).
+      --robot-out FILE  also the log's robot file with the fitted masses,
+                        tyre radii and wheel motor gain written in (friction
+                        and delay stay parameters: a comment says so)
       --window S        fit the last S seconds (default: the whole log)
       --profile P       the twin fitted: ghost (the console's ghost's
                         physics, default) or robot (the log's own physics)
@@ -432,13 +435,14 @@ int exportLog(const std::vector<std::string>& args) {
 }
 
 int calibrate(const std::vector<std::string>& args) {
-  std::string log, out, profileName = "ghost";
+  std::string log, out, robotOut, profileName = "ghost";
   double window = 0;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if ((a == "--out" || a == "--window" || a == "--profile") && i + 1 < args.size()) {
+    if ((a == "--out" || a == "--robot-out" || a == "--window" || a == "--profile") && i + 1 < args.size()) {
       const std::string& v = args[++i];
       if (a == "--out") out = v;
+      else if (a == "--robot-out") robotOut = v;
       else if (a == "--profile") profileName = v;
       else {
         char* end = nullptr;
@@ -493,6 +497,17 @@ int calibrate(const std::vector<std::string>& args) {
       return 1;
     }
     std::printf("wrote %s\n", out.c_str());
+  }
+  if (!robotOut.empty()) {
+    const std::optional<std::string> text = sp::calibratedRobotText(
+        in->robotText, in->world.robots[0].model, sp::withCalValues(in->params, fit.value), error);
+    std::ofstream f;
+    if (text) f.open(robotOut);
+    if (!text || !(f << *text).flush()) {
+      std::cerr << (text ? robotOut + ": error: cannot write the robot file" : error) << "\n";
+      return 1;
+    }
+    std::printf("wrote %s\n", robotOut.c_str());
   }
   return 0;
 }

@@ -18,7 +18,12 @@
 //     and the previous values kept; the control with 2 % is accepted;
 //   - a window without driving is refused and says what is missing;
 //   - `simpartner-sim calibrate LOG` on a straight-line log prints friction
-//     as unobserved and writes a parameters file that loads.
+//     as unobserved and writes a parameters file that loads, and a robot
+//     file that loads;
+//   - a calibration saved as a robot file builds the calibrated twin: every
+//     link's mass, tyre radius and wheel motor gain equal to what the
+//     calibration.* keys make of the files (1e-6), friction and delay named
+//     in its comment; the files' own values (control) leave it unchanged.
 
 #include <QtTest>
 
@@ -32,6 +37,8 @@
 #include "app/calibration/recorded_drive.h"
 #include "app/ghost/ghost.h"
 #include "sim/command_file.h"
+#include "sim/file_set.h"
+#include "sim/perturbation.h"
 #include "sim/model_loader.h"
 #include "tests/test_files.h"
 
@@ -220,6 +227,49 @@ class TestCalibration : public QObject {
   // The offline tool on a robot's own log of a straight drive: friction is
   // printed unobserved, the parameters file it writes loads; a log of a
   // robot standing still exits 7 and says what is missing.
+  void calibrationSavedAsARobotFile() {
+    const WorldModel world = loadWorldFile("flat.world.xml");
+    const RobotModel& files = world.robots[0].model;
+    const std::optional<std::string> text = readSourceFile(files.file, nullptr);
+    QVERIFY(text);
+    SimParams params;
+    params.calWheelRadius = 0.981, params.calWheelRadiusSplit = 0.012, params.calWheelRadiusSide = -0.006;
+    params.calMass = 1.107, params.calMotorGain = 0.913, params.calFriction = 0.8, params.calDelay = 0.031;
+    const auto roundTrip = [&](const SimParams& p) {
+      std::string error;
+      const std::optional<std::string> written = calibratedRobotText(*text, files, p, error);
+      if (!written) qFatal("%s", error.c_str());
+      Diagnostics diag;
+      std::optional<RobotModel> robot = parseRobot(*written, "calibrated.xml", diag);
+      if (!robot) qFatal("%s\n%s", diag.format().c_str(), written->c_str());
+      return std::pair{*robot, *written};
+    };
+    // What makes two robots the same twin here: masses, tyre radii, motor gains.
+    const auto differs = [](const RobotModel& a, const RobotModel& b) {
+      double worst = 0;
+      for (size_t i = 0; i < a.links.size(); ++i) {
+        worst = std::max(worst, std::abs(a.links[i].mass - b.links[i].mass));
+        for (size_t g = 0; g < a.links[i].geoms.size(); ++g)
+          worst = std::max(worst, std::abs(a.links[i].geoms[g].radius - b.links[i].geoms[g].radius));
+      }
+      for (size_t i = 0; i < a.actuators.size(); ++i)
+        worst = std::max(worst, std::abs(a.actuators[i].velocityScale - b.actuators[i].velocityScale));
+      return worst;
+    };
+    const auto [saved, written] = roundTrip(params);
+    const RobotModel twin = calibratedWorld(world, params).robots[0].model;
+    QVERIFY2(differs(saved, twin) < 1e-6, qPrintable(QString::number(differs(saved, twin))));
+    QVERIFY(differs(saved, files) > 0.01);  // it did change the robot
+    QVERIFY2(written.find("calibration.friction = 0.8") != std::string::npos &&
+                 written.find("calibration.delay = 0.031") != std::string::npos,
+             written.c_str());
+    QVERIFY(written.rfind("<?xml", 0) == 0);  // the declaration stays first
+    QVERIFY(differs(roundTrip(SimParams{}).first, files) < 1e-9);
+    std::string error;
+    QVERIFY(!calibratedRobotText("<robot><link", files, params, error));
+    QVERIFY2(QString::fromStdString(error).contains("error: not a robot file"), error.c_str());
+  }
+
   void calibrateCommandOnALog() {
     QTemporaryDir dir;
     QVERIFY(dir.isValid());
@@ -248,6 +298,9 @@ class TestCalibration : public QObject {
     Diagnostics diag;
     QVERIFY2(loadParams(params.toStdString(), loaded, diag), diag.format().c_str());
     QVERIFY(std::abs(loaded.calWheelRadius - 1) < 0.01);
+    const QString robotFile = dir.filePath("calibrated.xml");
+    QCOMPARE(runSim({"calibrate", dir.filePath("straight.db"), "--robot-out", robotFile}, out), 0);
+    QVERIFY2(loadRobot(robotFile.toStdString(), diag).has_value(), diag.format().c_str());
     QCOMPARE(runSim({"calibrate", dir.filePath("still.db")}, out), 7);
     QVERIFY2(out.contains("not enough driving"), qPrintable(out));
   }

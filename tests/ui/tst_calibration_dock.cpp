@@ -3,7 +3,7 @@
 // motors 6 % fast) driven straight; the dock fills with fits, friction stays
 // unobserved on a straight drive, the twins' parameters follow, Freeze keeps
 // the values, Reset puts the files back, Save writes a parameters file that
-// loads with the values shown, and the session log's calibration table
+// loads with the values shown (or a robot file with them written in), and the session log's calibration table
 // holds the fits. Real window under Xvfb, real stand-in on loopback.
 
 #include <QApplication>
@@ -18,6 +18,7 @@
 
 #include "app/console/console_session.h"
 #include "app/log/session_log.h"
+#include "sim/model_loader.h"
 #include "tests/ui/console_fixture.h"
 #include "ui/jobs/calibration/calibration_job.h"
 #include "ui/jobs/calibration/calibration_panel.h"
@@ -75,6 +76,16 @@ class TestCalibrationDock : public QObject {
     QVERIFY2(loadParams(saved.toStdString(), loaded, diag), diag.format().c_str());
     QVERIFY(std::abs(loaded.calWheelRadius - calibrator->state().applied[0]) < 1e-9 ||
             calibrator->state().version != s.version);
+    // ... or a robot file that loads, its motors as fast as the fit says.
+    const QString robotFile = dir.filePath(QStringLiteral("calibrated.xml"));
+    QVERIFY2(job->save(robotFile).isEmpty(), qPrintable(job->save(robotFile)));
+    const std::optional<RobotModel> robot = loadRobot(robotFile.toStdString(), diag);
+    QVERIFY2(robot, diag.format().c_str());
+    const RobotModel& files = w.context().session().world()->robots[0].model;
+    const int wheel = files.findActuator(files.joints[static_cast<size_t>(files.drive->wheels[0])].name);
+    QVERIFY(wheel >= 0);
+    QVERIFY2(std::abs(robot->actuators[static_cast<size_t>(wheel)].velocityScale - 1.0605) < 0.02,
+             qPrintable(QString::number(robot->actuators[static_cast<size_t>(wheel)].velocityScale)));
 
     // Freeze: fits go on, the applied values stay.
     panel->freezeButton()->click();

@@ -6,6 +6,8 @@
 
 #include "app/console/console_session.h"
 #include "app/log/session_log.h"
+#include "sim/file_set.h"
+#include "sim/perturbation.h"
 #include "ui/jobs/calibration/calibration_panel.h"
 #include "ui/robot_feed.h"
 
@@ -28,8 +30,9 @@ void CalibrationJob::install(ConsoleContext& context) {
     }
   });
   connect(panel_, &CalibrationPanel::saveRequested, this, [this] {
+    QString filter = tr("Parameters (*.params)");
     const QString path = QFileDialog::getSaveFileName(panel_, tr("Save the calibration"), QStringLiteral("calibrated.params"),
-                                                      tr("Parameters (*.params)"));
+                                                      tr("Parameters (*.params);;Robot file (*.xml)"), &filter);
     if (path.isEmpty()) return;
     const QString error = save(path);
     if (error.isEmpty()) context_->status(tr("Calibration saved to %1").arg(path));
@@ -52,8 +55,21 @@ QString CalibrationJob::save(const QString& path) const {
     fit.to = s.history.back().to;
     fit.segments = s.history.back().segments;
   }
+  std::string text = calibrationParamsText(fit);
+  if (path.endsWith(QLatin1String(".xml"), Qt::CaseInsensitive)) {
+    // A robot file: the files' robot with the values written in.
+    const WorldModel* world = context_->session().world();
+    if (!world || world->robots.empty()) return tr("No robot loaded.");
+    const RobotModel& robot = world->robots[0].model;
+    const std::optional<std::string> original = readSourceFile(robot.file, nullptr);
+    if (!original) return tr("%1: cannot read the robot file").arg(QString::fromStdString(robot.file));
+    std::string error;
+    std::optional<std::string> calibrated =
+        calibratedRobotText(*original, robot, withCalValues(context_->session().params(), s.applied), error);
+    if (!calibrated) return QString::fromStdString(error);
+    text = std::move(*calibrated);
+  }
   QSaveFile file(path);
-  const std::string text = calibrationParamsText(fit);
   if (!file.open(QIODevice::WriteOnly) || file.write(text.data(), static_cast<qint64>(text.size())) < 0 || !file.commit())
     return tr("%1: %2").arg(path, file.errorString());
   return {};
