@@ -12,8 +12,10 @@
 //                 (the ghost's profile and hold) predicts 2 s under the
 //                 commands at their arrival, every 0.5 s over 30-60 s; the
 //                 median horizontal and heading errors for the files' twin,
-//                 the calibrated twin and the matched twin (the robot's own
-//                 physics and delay: the floor the ghost's coarse profile sets);
+//                 the calibrated twin, the oracle (the fitted parameters at the
+//                 hidden values: the floor this parameter set allows) and the
+//                 matched twin (the robot's own physics and delay: the floor
+//                 the ghost's coarse profile sets);
 //   fitted        wheel radius against the hidden mean of the four wheels,
 //                 total mass against the hidden total;
 //   rehearsal     a 30 s sequence rehearsed (app/rehearse) with the files' and
@@ -106,6 +108,7 @@ struct Case {
   std::string world;
   uint64_t seed = 0;
   double filesPos = 0, calPos = 0, matchedPos = 0;      // medians [m]
+  double oraclePos = 0, oracleHead = 0;                  // the hidden values of the fitted parameters
   double filesHead = 0, calHead = 0, matchedHead = 0;   // [rad]
   double radiusFit = 0, radiusTrue = 0, massFit = 0, massTrue = 0;
   double rehearseFiles = 0, rehearseCal = 0;  // [m] end position errors
@@ -204,6 +207,22 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
   };
   check(world, filesCalValues(), c.filesPos, c.filesHead);
   check(world, values, c.calPos, c.calHead);
+  // The oracle: the fitted parameters at the hidden values (what a perfect
+  // fit of this parameter set would give; the rest of the robot's deviations
+  // - each link's mass and centre, torque limits, IMU bias - left out).
+  CalValues oracle = filesCalValues();
+  const auto& radii = p.wheelRadius;  // FL FR RL RR
+  const double front = (radii[0] + radii[1]) / 2, rear = (radii[2] + radii[3]) / 2;
+  oracle[static_cast<size_t>(CalParam::WheelRadius)] = (front + rear) / 2;
+  oracle[static_cast<size_t>(CalParam::WheelRadiusSplit)] = (front - rear) / ((front + rear) / 2);
+  oracle[static_cast<size_t>(CalParam::WheelRadiusSide)] = ((radii[0] + radii[2]) - (radii[1] + radii[3])) / (radii[0] + radii[1] + radii[2] + radii[3]) * 2;
+  oracle[static_cast<size_t>(CalParam::WheelRadiusDiag)] =
+      ((radii[0] + radii[3]) - (radii[1] + radii[2])) / (radii[0] + radii[1] + radii[2] + radii[3]) * 2;
+  oracle[static_cast<size_t>(CalParam::Friction)] = p.friction;
+  oracle[static_cast<size_t>(CalParam::MotorGain)] = p.velocityGain;
+  oracle[static_cast<size_t>(CalParam::Delay)] = p.delay;
+  oracle[static_cast<size_t>(CalParam::Mass)] = c.massTrue;
+  check(world, oracle, c.oraclePos, c.oracleHead);
   CalValues matchedDelay = filesCalValues();
   matchedDelay[static_cast<size_t>(CalParam::Delay)] = p.delay;
   check(perturbWorld(world, p), matchedDelay, c.matchedPos, c.matchedHead);
@@ -259,16 +278,17 @@ int main(int argc, char** argv) {
   std::vector<Case> cases(work.size());
   std::atomic<size_t> next{0};
   std::mutex print;
-  std::printf("world  seed | ghost pos [cm] files  calib  matched | heading [deg] files calib matched | radius fit/true  "
+  std::printf("world  seed | ghost pos [cm] files  calib  oracle matched | heading [deg] files calib oracle matched | radius fit/true  "
               "mass fit/true | rehearsal end [m] files calib | fits (refused) fit ms med/max\n");
   const auto worker = [&] {
     for (size_t i; (i = next++) < work.size();) {
       const auto& [w, seed] = work[i];
       Case c = run(loaded[w].first, loaded[w].second, seed);
       std::lock_guard lock(print);
-      std::printf("%-6s %4llu | %6.2f %6.2f %6.2f | %5.2f %5.2f %5.2f | %.4f/%.4f %.3f/%.3f | %6.3f %6.3f | %d (%d) %4.0f/%4.0f %s\n",
+      std::printf("%-6s %4llu | %6.2f %6.2f %6.2f %6.2f | %5.2f %5.2f %5.2f %5.2f | %.4f/%.4f %.3f/%.3f | %6.3f %6.3f | %d (%d) %4.0f/%4.0f %s\n",
                   c.world.c_str(), static_cast<unsigned long long>(c.seed), c.filesPos * 100, c.calPos * 100,
-                  c.matchedPos * 100, c.filesHead * 57.2958, c.calHead * 57.2958, c.matchedHead * 57.2958, c.radiusFit,
+                  c.oraclePos * 100, c.matchedPos * 100, c.filesHead * 57.2958, c.calHead * 57.2958, c.oracleHead * 57.2958,
+                  c.matchedHead * 57.2958, c.radiusFit,
                   c.radiusTrue, c.massFit, c.massTrue, c.rehearseFiles, c.rehearseCal, c.fits, c.refused, c.fitMsMedian,
                   c.fitMsMax, c.problem.c_str());
       std::fflush(stdout);

@@ -222,6 +222,8 @@ const std::vector<Entry>& table() {
             real(&SimParams::calWheelRadiusSplit, closed(-0.1, 0.1))),
       entry("calibration.wheel_radius_side", "twins: left minus right tyre radius, relative, [-0.1, 0.1]",
             real(&SimParams::calWheelRadiusSide, closed(-0.1, 0.1))),
+      entry("calibration.wheel_radius_diag", "twins: front-left and rear-right minus front-right and rear-left tyre radius, relative, [-0.1, 0.1]",
+            real(&SimParams::calWheelRadiusDiag, closed(-0.1, 0.1))),
       entry("calibration.friction", "twins: factor on every contact's friction, [0.3, 3]",
             real(&SimParams::calFriction, closed(0.3, 3))),
       entry("calibration.motor_gain", "twins: the wheel motors reach this times the commanded speed, [0.5, 1.5]",

@@ -57,13 +57,14 @@ struct SimParams {
   double calWheelRadius = 1;       ///< tyres' effective radius, both axles
   double calWheelRadiusSplit = 0;  ///< front minus rear radius, relative (front x (1 + s/2), rear x (1 - s/2))
   double calWheelRadiusSide = 0;   ///< left minus right radius, relative (left x (1 + s/2), right x (1 - s/2))
+  double calWheelRadiusDiag = 0;   ///< one diagonal minus the other, relative (FL, RR x (1 + d/2); FR, RL x (1 - d/2))
   double calFriction = 1;          ///< every contact's mu
   double calMotorGain = 1;         ///< wheel motors reach gain x the commanded speed
   double calDelay = 0;             ///< [s] between a command's arrival and its effect
   double calMass = 1;              ///< every link's mass
   /// Whether any calibration.* key differs from the files (identity).
   bool calibrated() const {
-    return calWheelRadius != 1 || calWheelRadiusSplit != 0 || calWheelRadiusSide != 0 || calFriction != 1 || calMotorGain != 1 ||
+    return calWheelRadius != 1 || calWheelRadiusSplit != 0 || calWheelRadiusSide != 0 || calWheelRadiusDiag != 0 || calFriction != 1 || calMotorGain != 1 ||
            calDelay != 0 || calMass != 1;
   }
   // Gaits (sim/gait.h); swings in degrees about the stance pose

@@ -73,7 +73,8 @@ Perturbation calibrationPerturbation(const SimParams& params, size_t links) {
   const double front = params.calWheelRadius * (1 + params.calWheelRadiusSplit / 2);
   const double rear = params.calWheelRadius * (1 - params.calWheelRadiusSplit / 2);
   const double left = 1 + params.calWheelRadiusSide / 2, right = 1 - params.calWheelRadiusSide / 2;
-  p.wheelRadius = {front * left, front * right, rear * left, rear * right};  // FL FR RL RR
+  const double diag = 1 + params.calWheelRadiusDiag / 2, antiDiag = 1 - params.calWheelRadiusDiag / 2;
+  p.wheelRadius = {front * left * diag, front * right * antiDiag, rear * left * antiDiag, rear * right * diag};  // FL FR RL RR
   p.linkMass.assign(links, params.calMass);
   p.centreOfMass.assign(links, Vec3{});
   p.friction = params.calFriction;

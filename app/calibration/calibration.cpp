@@ -33,6 +33,7 @@ const std::array<CalParamInfo, kCalParams>& calParams() {
       {"calibration.wheel_radius", "wheel radius", "", 1, 0.8, 1.2, 0.03, 0.015},
       {"calibration.wheel_radius_split", "radius front - rear", "", 0, -0.1, 0.1, 0.03, 0.015},
       {"calibration.wheel_radius_side", "radius left - right", "", 0, -0.1, 0.1, 0.03, 0.015},
+      {"calibration.wheel_radius_diag", "radius FL+RR - FR+RL", "", 0, -0.1, 0.1, 0.03, 0.015},
       {"calibration.friction", "tyre friction", "", 1, 0.3, 3, 0.3, 0.15},
       {"calibration.motor_gain", "wheel motor gain", "", 1, 0.5, 1.5, 0.2, 0.1},
       {"calibration.delay", "command delay", "s", 0, 0, 0.5, 0.06, 0.03},
@@ -42,17 +43,19 @@ const std::array<CalParamInfo, kCalParams>& calParams() {
 }
 
 CalValues calValues(const SimParams& p) {
-  return {p.calWheelRadius, p.calWheelRadiusSplit, p.calWheelRadiusSide, p.calFriction, p.calMotorGain, p.calDelay, p.calMass};
+  return {p.calWheelRadius, p.calWheelRadiusSplit, p.calWheelRadiusSide, p.calWheelRadiusDiag,
+          p.calFriction,    p.calMotorGain,        p.calDelay,           p.calMass};
 }
 
 SimParams withCalValues(SimParams p, const CalValues& v) {
   p.calWheelRadius = v[0];
   p.calWheelRadiusSplit = v[1];
   p.calWheelRadiusSide = v[2];
-  p.calFriction = v[3];
-  p.calMotorGain = v[4];
-  p.calDelay = v[5];
-  p.calMass = v[6];
+  p.calWheelRadiusDiag = v[3];
+  p.calFriction = v[4];
+  p.calMotorGain = v[5];
+  p.calDelay = v[6];
+  p.calMass = v[7];
   return p;
 }
 

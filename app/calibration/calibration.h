@@ -53,8 +53,8 @@
 namespace sp {
 
 /// The fitted parameters, in the order of calParams().
-enum class CalParam : int { WheelRadius, WheelRadiusSplit, WheelRadiusSide, Friction, MotorGain, Delay, Mass };
-constexpr int kCalParams = 7;
+enum class CalParam : int { WheelRadius, WheelRadiusSplit, WheelRadiusSide, WheelRadiusDiag, Friction, MotorGain, Delay, Mass };
+constexpr int kCalParams = 8;
 using CalValues = std::array<double, kCalParams>;
 using CalFlags = std::array<bool, kCalParams>;
 

@@ -99,7 +99,7 @@ class TestCalibration : public QObject {
     QVERIFY2(d.problem.empty(), d.problem.c_str());
     // Asked for the wheel radius alone (the rest held at the files'): 0.3 %.
     CalibrationOptions alone;
-    for (CalParam q : {CalParam::WheelRadiusSplit, CalParam::WheelRadiusSide, CalParam::Friction, CalParam::MotorGain,
+    for (CalParam q : {CalParam::WheelRadiusSplit, CalParam::WheelRadiusSide, CalParam::WheelRadiusDiag, CalParam::Friction, CalParam::MotorGain,
                        CalParam::Delay, CalParam::Mass})
       alone.fixed[static_cast<size_t>(q)] = true;
     const CalibrationFit one = fitCalibration(world, ghostProfile(), d.frames, d.commands, filesCalValues(), alone);
@@ -233,7 +233,7 @@ class TestCalibration : public QObject {
     const std::optional<std::string> text = readSourceFile(files.file, nullptr);
     QVERIFY(text);
     SimParams params;
-    params.calWheelRadius = 0.981, params.calWheelRadiusSplit = 0.012, params.calWheelRadiusSide = -0.006;
+    params.calWheelRadius = 0.981, params.calWheelRadiusSplit = 0.012, params.calWheelRadiusSide = -0.006, params.calWheelRadiusDiag = 0.008;
     params.calMass = 1.107, params.calMotorGain = 0.913, params.calFriction = 0.8, params.calDelay = 0.031;
     const auto roundTrip = [&](const SimParams& p) {
       std::string error;
