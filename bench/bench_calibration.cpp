@@ -4,7 +4,7 @@
 // 3 s, two steps each from the last values), then judged over the next 30 s
 // and on a rehearsed sequence. Prints a table; asserts nothing.
 //
-//   build/bench/bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J]
+//   build/bench/bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J] [--iterations 1|2]
 //
 // Per world and seed:
 //   ghost error   the ghost's prediction over a 1 s each way link is 2 s
@@ -104,6 +104,11 @@ const char* const kRehearsedAlong =
     "20 drive 0.3 -5\n"
     "30 stop\n";
 
+// Levenberg-Marquardt steps per online fit: the console takes two when the
+// first leaves time within its period (app/calibration/live_calibrator.h),
+// else one; --iterations 1 measures the loaded case.
+int gIterations = 2;
+
 struct Case {
   std::string world;
   uint64_t seed = 0;
@@ -161,7 +166,7 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
   CalEstimate estimate = filesEstimate();
   CalibrationOptions o;
   o.window = 8;
-  o.iterations = 2;
+  o.iterations = gIterations;
   std::vector<double> fitMs;
   for (double end = 8; end <= 30 + 1e-9; end += 3) {
     std::vector<RobotFrame> upTo;
@@ -254,8 +259,9 @@ int main(int argc, char** argv) {
     if (a == "--seeds" && i + 1 < argc) seeds = std::atoi(argv[++i]);
     else if (a == "--jobs" && i + 1 < argc) jobs = std::max(1, std::atoi(argv[++i]));
     else if (a == "--worlds" && i + 1 < argc) worlds = argv[++i];
+    else if (a == "--iterations" && i + 1 < argc) gIterations = std::clamp(std::atoi(argv[++i]), 1, 10);
     else {
-      std::fprintf(stderr, "usage: bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J]\n");
+      std::fprintf(stderr, "usage: bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J] [--iterations 1|2]\n");
       return 2;
     }
   }

@@ -70,7 +70,7 @@ CalEstimate filesEstimate() {
 CalValues significantValues(const CalEstimate& e) {
   CalValues out = e.value;
   for (size_t i = 0; i < kCalParams; ++i)
-    if (e.observed[i] && std::abs(e.value[i] - calParams()[i].files) <= 2 * e.sigma[i]) out[i] = calParams()[i].files;
+    if (e.observed[i] && std::abs(e.value[i] - calParams()[i].files) <= kSignificance * e.sigma[i]) out[i] = calParams()[i].files;
   return out;
 }
 
@@ -576,7 +576,11 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   double lambda = 1e-3;
   std::vector<std::vector<double>> jac(kFitted);
   std::vector<int> on, everSmooth;  // everSmooth: moved the twin more than its noise at some iteration
+  const auto elapsedMs = [&] {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - began).count();
+  };
   for (int it = 0; it < o.iterations && !free.empty(); ++it) {
+    const double iterationBegan = elapsedMs();
     // Central differences, two candidates per free parameter, and the
     // noise probe, in parallel. Contacts make a twin's response partly
     // chaotic: a parameter whose difference moves the residuals less than
@@ -648,6 +652,7 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       }
     }
     if (!stepped) break;
+    if (o.budgetMs > 0 && elapsedMs() + (elapsedMs() - iterationBegan) > o.budgetMs) break;  // the next would overrun
   }
   // A fit that predicts the window worse than its start (the contacts'
   // noise can defeat a step) keeps the start's values: nothing learnt.

@@ -82,6 +82,10 @@ struct CalibrationOptions {
   double horizon = 2;        ///< [s] each segment predicts
   double checkpoint = 0.25;  ///< [s] between compared frames
   int iterations = 5;        ///< Levenberg-Marquardt iterations per fit
+  /// [ms] of wall time: a further iteration starts only when the last one's
+  /// duration still fits in it (the first always runs); 0 = no limit. The
+  /// console's fits land on time on a loaded machine this way.
+  double budgetMs = 0;
   int threads = 1;           ///< candidate twins run at once
   int minSegments = 3;       ///< fewer driving segments: refused (not enough motion)
   /// Parameters held at their start values whatever the data says (the
@@ -137,9 +141,15 @@ CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit, double ove
 /// The drift: a share of each parameter's scale per square-root second.
 constexpr double kDrift = 0.005;
 /// What the twins are given of `estimate`: each parameter where it differs
-/// from the files' value by more than two deviations, else the files'
-/// (a robot that is its twin keeps its twin: the fits' noise is not applied).
+/// from the files' value by more than kSignificance deviations, else the
+/// files' (a robot that is its twin keeps its twin: the fits' noise is not
+/// applied).
 CalValues significantValues(const CalEstimate& estimate);
+/// One deviation: at two, a robot whose tyres are 0.7 % off kept the files'
+/// (the benchmark's bumpy field: the ghost 1.5x the matched twin's error,
+/// 1.13x at one); at one, a robot that is its twin still changes the
+/// ghost's error by at most a few per cent (docs/performance.md).
+constexpr double kSignificance = 1.0;
 
 /// How far the twin calibrated by `values` lands from the robot `horizon`
 /// seconds after each anchor (every `spacing` s along the driving parts of

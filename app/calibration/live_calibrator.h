@@ -51,12 +51,15 @@ class LiveCalibrator {
     double period = 3;  ///< [s] of new telemetry between fits
     /// Each fit starts from the last one's values: two Levenberg-Marquardt
     /// steps over the newest 8 s follow the robot (a recursive refinement),
-    /// on both cores at nice 10, so that a fit lands every few seconds.
+    /// on both cores at nice 10; the second only when the first left time
+    /// for it within a period, so that a fit lands every period or so even
+    /// on a loaded machine.
     CalibrationOptions fit = [] {
       CalibrationOptions o;
       o.window = 8;
       o.iterations = 2;
       o.threads = 2;
+      o.budgetMs = 3000;
       return o;
     }();
     /// Tests: called on the worker between the twin runs of each fit,
