@@ -93,9 +93,9 @@ constexpr const char* kUsage = R"(usage:
       failed and missing tasks. Exits 0 when every task ran, 4 otherwise.
   simpartner-sim calibrate LOG [--out FILE] [--robot-out FILE] [--window S] [--profile ghost|robot]
       Fits the twin to the robot that made LOG (a robot's own log or a
-      console's telemetry log): wheel radius and its front-rear split, tyre
-      friction, wheel motor gain, command delay (fitting the twin's
-      predictions) and total mass (from the wheel loads). Prints each with
+      console's telemetry log): wheel radius and its front-rear, left-right
+      and diagonal splits, tyre friction, wheel motor gain, command delay
+      (fitting the twin's predictions) and total mass (from the wheel loads). Prints each with
       its deviation, or "unobserved" when the motion cannot tell, and writes
       the calibration.* keys to FILE (a parameters file; default: none).
       --robot-out FILE  also the log's robot file with the fitted masses,
