@@ -210,7 +210,7 @@ ExperimentResult circularDrive(const ValidationOptions& o) {
                              " m, simulated " + num(radius, 3) + " m; error",
                          "about 0.5", error, "%", "|error| <= 0.5 %", std::abs(error) <= 0.5});
     r.metrics.push_back({"the same against the commanded (nominal) hinge angle: model " + num(nominal, 3) + " m; error",
-                         "", nominalError, "%", "", false, false});
+                         "about 0.5", nominalError, "%", "|error| <= 0.5 %", std::abs(nominalError) <= 0.5});
     PlotSeries path{"simulated, " + num(gammaDeg, 0) + " deg", {}, {}, PlotSeries::Style::Line};
     for (const Vec3& p : points) {
       path.x.push_back(p.x);
@@ -234,9 +234,9 @@ ExperimentResult circularDrive(const ValidationOptions& o) {
       "slightly with the legs). The wheel speeds come from the same kinematics, recomputed every step. The "
       "criterion uses the measured hinge angle, as an experimenter with an encoder on the hinge would; the "
       "largest deviation is " + num(worst, 2) + " %, the compliance of the contacts and joints under the "
-      "tyres' side forces (at ERP 0.2 it was about 0.5 %, see config/defaults.params). Against the commanded "
-      "angle (the info rows) the error is larger: the hinge's position controller holds the angle a little "
-      "short of its target under the steering load.";
+      "tyres' side forces (at ERP 0.2 it was about 0.5 %, see config/defaults.params). The paper's 0.5 % is "
+      "judged against the commanded geometry too, as an operator would see it: there the error also holds "
+      "the hinge controller's error under the steering load and the legs' give.";
   return r;
 }
 
@@ -319,16 +319,22 @@ ExperimentResult laserSweep(const ValidationOptions& o) {
   const double proportional =
       proportionalityMismatch({sweeps[0].times, sweeps[0].distances, sweeps[0].commandError},
                               {sweeps[2].times, sweeps[2].distances, sweeps[2].commandError}, 0.5e-3);
-  r.metrics.push_back({"largest range error against the scanner's true pose, all three walls", "", worstTrue * 1000,
-                       "mm", "< 0.001 mm (exact ray casting: ours, not the paper's claim)", worstTrue < 1e-6});
-  r.metrics.push_back({"torso angle error against the commanded rate: linear fit over time, R^2 (slope " +
-                           num(angleFit.slope * 1000, 2) + " mdeg/s)",
-                       "the integrator error grew linearly", angleFit.r2, "", "R^2 >= 0.95", angleFit.r2 >= 0.95});
+  // Judged only what can fail. Ranges against the true pose are exact by
+  // construction (analytic ray casting, tst_sensors tests it) and the
+  // per-metre agreement of the walls is an identity (d tan(phi) dphi): both
+  // for the record. A velocity-mode motor's constant tracking error grows
+  // linearly in angle whatever the physics: for the record too.
+  r.metrics.push_back({"for the record: largest range error against the scanner's true pose, all three walls (exact "
+                       "ray casting, tested in tst_sensors)",
+                       "", worstTrue * 1000, "mm", "", false, false});
+  r.metrics.push_back({"for the record: torso angle error against the commanded rate, linear fit over time, R^2 (slope " +
+                           num(angleFit.slope * 1000, 2) + " mdeg/s; a velocity loop's constant error integrates)",
+                       "the integrator error grew linearly", angleFit.r2, "", "", false, false});
   r.metrics.push_back({"range error against the commanded pose, 6 m wall: linear fit over time, R^2",
                        "grew linearly with time", rangeFit.r2, "", "R^2 >= 0.9", rangeFit.r2 >= 0.9});
-  r.metrics.push_back({"range error per metre of range, 9 m wall against 3 m wall at the same instants: median "
-                       "relative difference",
-                       "proportional to the distance", proportional * 100, "%", "<= 10 %", proportional <= 0.1});
+  r.metrics.push_back({"for the record: range error per metre of range, 9 m wall against 3 m wall at the same "
+                       "instants, median relative difference (an identity: d tan(phi) dphi)",
+                       "proportional to the distance", proportional * 100, "%", "", false, false});
   PlotSpec vsTime{"Laser: range error against time (6 m wall)", "time since the sweep started [s]",
                   "range error [mm]", {}, 960, 540, {}, {}};
   PlotSeries a{"against the true scanner pose", paper.times, {}, PlotSeries::Style::Line};
@@ -365,10 +371,11 @@ ExperimentResult laserSweep(const ValidationOptions& o) {
       "rotation implies. There the torso's angle error grows with time at " + num(angleFit.slope * 1000, 2) +
       " mdeg/s (the motor tracks the commanded rate with a small constant error, which integrates, as the "
       "paper's integrator error did), with a jitter of about a thousandth of a degree riding on it; a line "
-      "explains R^2 = " + num(angleFit.r2, 3) + " of it, which " + verdict(r.metrics[1].pass) +
-      " the criterion stated before the run (R^2 >= 0.95). The range error it causes is proportional to the "
-      "distance: per metre of range the 3 m and 9 m walls agree within " + num(proportional * 100, 3) +
-      " %, since a heading error dphi moves a beam meeting the wall at angle phi by d tan(phi) dphi. The range "
+      "explains R^2 = " + num(angleFit.r2, 3) + " of it. That and the next two figures are reported, not "
+      "judged: a velocity loop's constant error always integrates to a line, exact ray casting always "
+      "gives exact ranges, and the range error it causes is proportional to the distance by geometry "
+      "(per metre of range the 3 m and 9 m walls agree within " + num(proportional * 100, 3) +
+      " %, since a heading error dphi moves a beam meeting the wall at angle phi by d tan(phi) dphi). The range "
       "error itself runs from " + num(paper.commandError.empty() ? 0 : paper.commandError.front() * 1000, 1) +
       " mm to " + num(paper.commandError.empty() ? 0 : paper.commandError.back() * 1000, 1) +
       " mm over the sweep, through zero as tan(phi) changes sign at the wall's normal; a line explains R^2 = " +
@@ -566,19 +573,41 @@ ExperimentResult slipperySurface(const ValidationOptions& o) {
   const SlipperyModes modes = runModes(model, o.params, start, duration, r.title);
   r.simSeconds += modes.seconds;
   const double* v = modes.speed;
-  // Criteria, stated before the run (issue 18): rolling slips >= 90 %, both
-  // gaits are >= 5 x faster than rolling, caterpillar beats rolking.
+  // Criteria, stated before the run (issue 29): the paper's own speeds,
+  // each within a factor of 1.5, and in its order (caterpillar > rolking >
+  // rolling). The slip and the ratios follow from the speeds: for the record.
   const double slip = 1 - v[0] / (1.0 * wheelRadius);
-  r.metrics.push_back({"rolling at 1 rad/s: slip (1 - speed / wheel surface speed)", "98 % (0.0038 m/s)", slip * 100,
-                       "%", ">= 90 %", slip >= 0.9});
-  r.metrics.push_back({"caterpillar against rolling", num(paper[1] / paper[0], 0) + " x", v[1] / v[0], "x", ">= 5 x",
-                       v[1] >= 5 * v[0]});
-  r.metrics.push_back({"rolking against rolling", num(paper[2] / paper[0], 0) + " x", v[2] / v[0], "x", ">= 5 x",
-                       v[2] >= 5 * v[0]});
-  r.metrics.push_back({"caterpillar against rolking", num(paper[1] / paper[2], 2) + " x", v[1] / v[2], "x", "> 1 x",
-                       v[1] > v[2]});
-  for (int m = 0; m < 3; ++m)
-    r.metrics.push_back({std::string("mean speed, ") + kModeNames[m], num(paper[m], 4), v[m], "m/s", "", false, false});
+  for (int m = 0; m < 3; ++m) {
+    const double factor = v[m] > 0 ? std::max(v[m] / paper[m], paper[m] / v[m]) : INFINITY;
+    r.metrics.push_back({std::string("mean speed, ") + kModeNames[m] + " (ours / paper's: " + num(v[m] / paper[m], 2) +
+                             " x)",
+                         num(paper[m], 4), v[m], "m/s", "within a factor of 1.5", factor <= 1.5});
+  }
+  r.metrics.push_back({"order: caterpillar > rolking > rolling", "0.057 > 0.048 > 0.0038", v[1] > v[2] && v[2] > v[0] ? 1.0 : 0.0,
+                       "", "1 (in order)", v[1] > v[2] && v[2] > v[0]});
+  // Converged: the rolling speed must be the surface's, not the iterative
+  // solver's creep (with C above mu the ideal model gives zero).
+  SimParams converged = o.params;
+  converged.iterations = 200;
+  const double rolling200 = [&] {
+    auto w = makeWorld(model, converged);
+    stepFor(*w, start);
+    const double x0 = hingePoint(*w).x;
+    w->submit(WheelsCmd{{1, 1, 1, 1}});
+    stepFor(*w, duration - start);
+    requireHealthy(*w, r.title);
+    r.simSeconds += duration;
+    return (hingePoint(*w).x - x0) / (duration - start);
+  }();
+  const double creep = v[0] > 0 ? std::abs(rolling200 / v[0] - 1) : INFINITY;
+  r.metrics.push_back({"rolling speed at 200 solver iterations (" + num(rolling200, 4) + " m/s) against the default's: change",
+                       "", creep * 100, "%", "<= 10 % (not the solver's creep)", creep <= 0.1});
+  r.metrics.push_back({"for the record: rolling at 1 rad/s, slip (1 - speed / wheel surface speed)", "98 %", slip * 100,
+                       "%", "", false, false});
+  r.metrics.push_back({"for the record: caterpillar against rolling", num(paper[1] / paper[0], 0) + " x", v[1] / v[0],
+                       "x", "", false, false});
+  r.metrics.push_back({"for the record: rolking against rolling", num(paper[2] / paper[0], 0) + " x", v[2] / v[0], "x",
+                       "", false, false});
 
   // Sensitivity (full runs only): C over the range the literature gives
   // for shallow snow, and braced wheels without it.
@@ -590,7 +619,9 @@ ExperimentResult slipperySurface(const ValidationOptions& o) {
                             {kModeNames[2], {}, {}, PlotSeries::Style::Line}};
     sensitivity = " Sensitivity (the same runs, C changed in every contact): ";
     const auto criteria = [&](const double* s) {
-      return 1 - s[0] / wheelRadius >= 0.9 && s[1] >= 5 * s[0] && s[2] >= 5 * s[0] && s[1] > s[2];
+      bool ok = s[1] > s[2] && s[2] > s[0];
+      for (int m = 0; m < 3; ++m) ok = ok && s[m] > 0 && std::max(s[m] / paper[m], paper[m] / s[m]) <= 1.5;
+      return ok;
     };
     for (double ci : {0.0, 0.02, 0.03, 0.06, 0.12}) {
       const SlipperyModes m = runModes(withResistance(model, ci, true), o.params, start, duration, r.title);
@@ -618,14 +649,21 @@ ExperimentResult slipperySurface(const ValidationOptions& o) {
       "With Coulomb friction mu = 0.025 alone the four tyres can push with up to " + num(traction, 0) +
       " N and nothing resists rolling, so the robot rolls at the wheels' surface speed (0.2 m/s at 1 rad/s) "
       "without slipping; the paper's 0.0038 m/s means 98 % slip. Snow resists a tyre moving through it: a "
-      "motion resistance C N against the wheel's travel, C about 0.03 on packed snow and 0.02-0.12 in shallow "
-      "snow (CRREL TR-01-16). C = " + num(c, 2) + " was taken from the literature before the run, not fitted "
+      "motion resistance C N against the wheel's travel; the cited report (CRREL TR-01-16) gives C 0.02-0.03 "
+      "only for very light snow with 10-17 cm sinkage, more in deeper snow, and no real surface pairs ice's "
+      "friction with that resistance: this world is a stand-in, not a measured surface. C = " + num(c, 2) + " was taken from the literature before the run, not fitted "
       "to the paper, and set as a surface property of the world file (contact motion_resistance; rolling meets "
       "it as a torque C N r, a braced wheel sliding as friction mu + C). It exceeds what the tyres can push "
       "with (mu = 0.025), so the wheels spin: rolling slips " + num(slip * 100, 1) + " % (" + num(v[0], 4) +
       " m/s). The gaits move by bracing wheels and pushing with the legs: caterpillar " + num(v[1], 3) +
       " m/s, rolking " + num(v[2], 3) + " m/s, the paper's ordering; their speeds follow from the gait timing "
-      "and hip swing, which the paper does not give (ours are estimates in config/defaults.params)." +
+      "and hip swing, which the paper does not give (ours are estimates in config/defaults.params). Judged "
+      "against the paper's own speeds: rolling " + num(v[0] / paper[0], 2) + " x, caterpillar " +
+      num(v[1] / paper[1], 2) + " x, rolking " + num(v[2] / paper[2], 2) + " x the paper's. At 200 solver "
+      "iterations rolling runs at " + num(rolling200, 4) + " m/s (" + num(creep * 100, 0) + " % from the "
+      "default's): where C exceeds mu the ideal model does not roll at all, and what rolls is the iterative "
+      "solver's creep, so the rolling figure measures the solver, not the surface, until the wheel-ground "
+      "model is replaced (issue 29)." +
       sensitivity;
   return r;
 }

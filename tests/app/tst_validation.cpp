@@ -3,7 +3,9 @@
 
 #include <QtTest>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "app/validation/validation.h"
 
@@ -45,14 +47,27 @@ std::string makeCopyWithout(const std::string& sourceDir, const std::string& cut
   return dir.path().toStdString();
 }
 
-void verifyAll(const ExperimentResult& r) {
+// Every judged metric passes except the known failures (indices into
+// r.metrics), which must fail: the report says why each does (issue 29:
+// the paper's numbers judged before the physics meets them). A change that
+// makes one pass, or another fail, shows here.
+void verifyVerdicts(const ExperimentResult& r, const std::vector<size_t>& knownFailures = {}) {
   QVERIFY(!r.metrics.empty());
   QVERIFY(!r.plots.empty());
-  for (const Metric& m : r.metrics) {
-    qInfo("%s", qPrintable(describe(m)));
-    QVERIFY2(!m.judged || m.pass, qPrintable(describe(m)));
+  for (size_t i = 0; i < r.metrics.size(); ++i) {
+    const Metric& m = r.metrics[i];
+    qInfo("%zu %s%s", i, m.judged ? (m.pass ? "pass " : "FAIL ") : "info ", qPrintable(describe(m)));
   }
+  for (size_t i : knownFailures) {
+    QVERIFY(i < r.metrics.size());
+    QVERIFY2(r.metrics[i].judged && !r.metrics[i].pass, qPrintable("a known failure passed: " + describe(r.metrics[i])));
+  }
+  for (size_t i = 0; i < r.metrics.size(); ++i)
+    if (std::find(knownFailures.begin(), knownFailures.end(), i) == knownFailures.end())
+      QVERIFY2(!r.metrics[i].judged || r.metrics[i].pass, qPrintable(describe(r.metrics[i])));
 }
+
+void verifyAll(const ExperimentResult& r) { verifyVerdicts(r); }
 
 }  // namespace
 
@@ -61,23 +76,23 @@ class TestValidation : public QObject {
 
  private slots:
   // 1. The hinge's path radius matches articulated-steering kinematics
-  // within 0.5 % at 10, 20 and 30 degrees (the measured hinge angle; the
-  // commanded one is reported, not judged).
-  void circularDrive() { verifyAll(sp::circularDrive(quick())); }
+  // within 0.5 % at 10, 20 and 30 degrees against the measured hinge angle.
+  // Against the commanded angle (also judged, issue 29) it misses at 10
+  // and 20 degrees today (known failures: -1.4 % at 10 degrees quick).
+  void circularDrive() { verifyVerdicts(sp::circularDrive(quick()), {1, 3}); }
 
-  // 2. Ranges to the wall are exact against the scanner's true pose, the
-  // torso's angle error against the commanded rotation grows linearly
-  // (R^2 >= 0.95), and the range error it causes is proportional to the
-  // distance. The range error itself does not grow linearly over the sweep
-  // (it passes through zero at the wall's normal): a known difference from
-  // the paper, stated in the report.
+  // 2. One judged criterion: the range error against the commanded pose
+  // grows linearly in time (R^2 >= 0.9), as the paper saw. It does not here
+  // (it passes through zero at the wall's normal): a known failure, stated
+  // in the report. Exact ranges against the true pose (tst_sensors tests
+  // the ray caster), the angle error's linear growth (a velocity loop's
+  // constant error) and the per-metre agreement of the walls (an identity)
+  // cannot fail, so they are for the record only.
   void laserSweep() {
     const ExperimentResult r = sp::laserSweep(quick());
     QCOMPARE(r.metrics.size(), size_t{4});
-    for (const Metric& m : r.metrics) qInfo("%s", qPrintable(describe(m)));
-    for (size_t i : {0, 1, 3}) QVERIFY2(r.metrics[i].pass, qPrintable(describe(r.metrics[i])));
-    QEXPECT_FAIL("", "the range error passes through zero at the wall's normal (docs/validation/report.md)", Continue);
-    QVERIFY2(r.metrics[2].pass, qPrintable(describe(r.metrics[2])));
+    QCOMPARE(std::count_if(r.metrics.begin(), r.metrics.end(), [](const Metric& m) { return m.judged; }), 1);
+    verifyVerdicts(r, {2});
   }
 
   // The laser's criteria can fail: a line through noise-free points is
@@ -114,18 +129,21 @@ class TestValidation : public QObject {
   // front while unloading the rear, the two adding up to its weight.
   void pickAndPlace() { verifyAll(sp::pickAndPlace(quick())); }
 
-  // 4. On mu 0.025 with the motion resistance of packed snow (C = 0.03,
-  // from the literature): rolling slips >= 90 %, both gaits are >= 5 x
-  // faster than rolling, caterpillar beats rolking. Control: the same
-  // world without the resistance fails the slip criterion (the wheels roll).
+  // 4. On mu 0.025 with a motion resistance C = 0.03: the paper's speeds,
+  // each within a factor of 1.5, in its order, and a rolling speed that is
+  // not the solver's creep (<= 10 % change at 200 iterations). Known
+  // failures today: rolling 1.8 x the paper's, and it is the creep (issue
+  // 29's wheel-ground model). Control: the same world without the
+  // resistance rolls at the wheels' surface speed, 50 x the paper's.
   void slipperySurface() {
-    verifyAll(sp::slipperySurface(quick()));
+    verifyVerdicts(sp::slipperySurface(quick()), {0, 4});
     ValidationOptions o = quick();
     o.sourceDir = makeCopyWithout(o.sourceDir, "motion_resistance=\"0.03\"");
     QVERIFY(!o.sourceDir.empty());
     const ExperimentResult bare = sp::slipperySurface(o);
     qInfo("without motion resistance: %s", qPrintable(describe(bare.metrics[0])));
     QVERIFY(!bare.metrics[0].pass);
+    QVERIFY(bare.metrics[0].ours > 0.15);  // rolling, not slipping
   }
 
   // 5. Each bump slows the climb and speeds the descent, and unloads the
