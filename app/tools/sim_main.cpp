@@ -53,10 +53,15 @@ constexpr const char* kUsage = R"(usage:
       (the report names what, where and when), 4 if the CSV could not be
       written whole (a full disk).
   simpartner-sim validate [--out DIR] [--quick] [--params FILE] [--set KEY=VALUE]...
+                          [--convergence STEP/IT,...,STEP/exact]
       Runs the founding paper's five validation experiments headless and
       writes DIR/report.md (default DIR: validation), an SVG plot and the CSV
       data behind each. --quick runs short versions. Exits 0 when every
-      experiment passes its target, 4 when some fail.
+      experiment passes its target, 4 when some fail. --convergence runs
+      the suite at each physics setting (step in seconds / quick solver
+      iterations, or /exact), the last the reference, and writes
+      DIR/convergence.md: every judged figure per setting against the
+      reference, and the cheapest setting within 10 % of it on all.
   simpartner-sim params
       Prints every parameter key with its default and meaning.
   simpartner-sim resim LOG [--from S]
@@ -168,12 +173,14 @@ int check(const std::vector<std::string>& files) {
 
 int validate(const std::vector<std::string>& args, const char* argv0) {
   sp::ValidationOptions o;
-  std::string out = "validation", paramsFile;
+  std::string out = "validation", paramsFile, convergence;
   std::vector<std::string> overrides;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--quick") {
       o.quick = true;
+    } else if (a == "--convergence" && i + 1 < args.size()) {
+      convergence = args[++i];
     } else if ((a == "--out" || a == "--params" || a == "--set") && i + 1 < args.size()) {
       (a == "--out" ? out : a == "--params" ? paramsFile : overrides.emplace_back()) = args[++i];
     } else {
@@ -197,6 +204,24 @@ int validate(const std::vector<std::string>& args, const char* argv0) {
   if (ec) {
     std::cerr << out << ": error: cannot create the output folder: " << ec.message() << "\n";
     return 1;
+  }
+  if (!convergence.empty()) {
+    std::string error;
+    const auto settings = sp::parsePhysicsSettings(convergence, error);
+    if (!settings) {
+      std::cerr << "<command line>: error: " << error << "\n";
+      return 2;
+    }
+    std::string report;
+    try {
+      report = sp::convergenceReport(sp::convergenceStudy(o, *settings, std::cout), o);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 1;
+    }
+    std::ofstream(out + "/convergence.md") << report;
+    std::cout << report << "written to " << out << "/convergence.md\n";
+    return 0;
   }
   std::cout << "SimPartner validation" << (o.quick ? " (quick)" : "") << ": the founding paper's five experiments\n";
   std::vector<sp::ExperimentResult> results;

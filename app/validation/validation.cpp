@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <memory>
@@ -652,8 +653,9 @@ ExperimentResult slipperySurface(const ValidationOptions& o) {
       "motion resistance C N against the wheel's travel; the cited report (CRREL TR-01-16) gives C 0.02-0.03 "
       "only for very light snow with 10-17 cm sinkage, more in deeper snow, and no real surface pairs ice's "
       "friction with that resistance: this world is a stand-in, not a measured surface. C = " + num(c, 2) + " was taken from the literature before the run, not fitted "
-      "to the paper, and set as a surface property of the world file (contact motion_resistance; rolling meets "
-      "it as a torque C N r, a braced wheel sliding as friction mu + C). It exceeds what the tyres can push "
+      "to the paper, and set as a surface property of the world file (contact motion_resistance: a force of at "
+      "most C N on each wheel's hub against its travel, which a braced wheel sliding meets as well, as friction "
+      "mu + C). It exceeds what the tyres can push "
       "with (mu = 0.025), so the wheels spin: rolling slips " + num(slip * 100, 1) + " % (" + num(v[0], 4) +
       " m/s). The gaits move by bracing wheels and pushing with the legs: caterpillar " + num(v[1], 3) +
       " m/s, rolking " + num(v[2], 3) + " m/s, the paper's ordering; their speeds follow from the gait timing "
@@ -936,6 +938,133 @@ std::string validationReport(const std::vector<ExperimentResult>& results, const
          << ".csv))\n\n";
   }
   return md.str();
+}
+
+}  // namespace sp
+
+namespace sp {
+
+std::string PhysicsSetting::label() const {
+  return num(step * 1000, step < 0.001 ? 2 : 1) + " ms, " + (exact ? std::string("exact") : std::to_string(iterations) + " it.");
+}
+
+std::optional<std::vector<PhysicsSetting>> parsePhysicsSettings(const std::string& text, std::string& error) {
+  std::vector<PhysicsSetting> out;
+  size_t at = 0;
+  while (at <= text.size()) {
+    const size_t comma = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, comma - at);
+    at = comma + 1;
+    const size_t slash = item.find('/');
+    PhysicsSetting s;
+    char* end = nullptr;
+    const std::string step = item.substr(0, slash);
+    s.step = std::strtod(step.c_str(), &end);
+    const bool stepOk = slash != std::string::npos && !step.empty() && *end == '\0' && std::isfinite(s.step) &&
+                        s.step >= 1e-5 && s.step <= 0.01;
+    const std::string rest = slash == std::string::npos ? "" : item.substr(slash + 1);
+    bool restOk = rest == "exact";
+    if (restOk) {
+      s.exact = true;
+    } else {
+      const long n = std::strtol(rest.c_str(), &end, 10);
+      restOk = !rest.empty() && *end == '\0' && n >= 1 && n <= 10000;
+      s.iterations = static_cast<int>(n);
+    }
+    if (!stepOk || !restOk) {
+      error = "--convergence: '" + item + "': expected STEP/ITERATIONS or STEP/exact, the step in seconds (1e-5 to 0.01), " +
+              "iterations 1 to 10000";
+      return std::nullopt;
+    }
+    out.push_back(s);
+    if (comma == text.size()) break;
+  }
+  if (out.size() < 2) {
+    error = "--convergence: give at least two settings, the reference (the finest) last";
+    return std::nullopt;
+  }
+  return out;
+}
+
+bool ConvergenceStudy::withinTolerance(size_t s) const {
+  const std::vector<double>& ref = values.back();
+  for (size_t f = 0; f < figures.size(); ++f)
+    if (!(std::abs(values[s][f] - ref[f]) <= tolerance * std::abs(ref[f]))) return false;
+  return true;
+}
+
+ConvergenceStudy convergenceStudy(const ValidationOptions& base, const std::vector<PhysicsSetting>& settings,
+                                  std::ostream& log) {
+  ConvergenceStudy study;
+  study.settings = settings;
+  for (const PhysicsSetting& s : settings) {
+    ValidationOptions o = base;
+    o.params.step = s.step;
+    o.params.iterations = s.iterations;
+    o.params.solver = s.exact ? Solver::Exact : Solver::Quick;
+    log << s.label() << ":\n";
+    const auto t0 = Clock::now();
+    const std::vector<ExperimentResult> results = runValidation(o, log);
+    study.wallSeconds.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+    std::vector<std::string> figures;
+    std::vector<double>& values = study.values.emplace_back();
+    std::vector<bool>& passes = study.passes.emplace_back();
+    for (const ExperimentResult& r : results)
+      for (const Metric& m : r.metrics)
+        if (m.judged) {
+          figures.push_back(std::to_string(r.number) + ". " + r.title + ": " + m.quantity);
+          values.push_back(m.ours);
+          passes.push_back(m.pass);
+        }
+    // The quantity texts carry figures measured in the run (a hinge angle,
+    // a radius): the first setting's name the rows.
+    if (study.figures.empty()) study.figures = figures;
+    if (values.size() != study.figures.size())
+      throw std::runtime_error("convergence study: " + s.label() + " judged " + std::to_string(values.size()) +
+                               " figures, the first setting " + std::to_string(study.figures.size()));
+  }
+  return study;
+}
+
+std::string convergenceReport(const ConvergenceStudy& study, const ValidationOptions& base) {
+  std::string out = "# Convergence of the validation figures\n\n";
+  out += std::string("Each judged figure of the ") + (base.quick ? "quick" : "full") +
+         " suite at each physics setting (the rest as the parameters give: ERP " + num(base.params.erp, 2) +
+         ", CFM " + num(base.params.cfm * 1e6, 1) + "e-6), against the last setting, the reference. A setting is "
+         "within tolerance when every figure is within " + num(study.tolerance * 100, 0) +
+         " % of the reference's. Written by `simpartner-sim validate --convergence`.\n\n";
+  out += "| figure |";
+  for (const PhysicsSetting& s : study.settings) out += " " + s.label() + " |";
+  out += "\n|---|";
+  for (size_t s = 0; s < study.settings.size(); ++s) out += "---|";
+  out += "\n";
+  const std::vector<double>& ref = study.values.back();
+  for (size_t f = 0; f < study.figures.size(); ++f) {
+    out += "| " + study.figures[f] + " |";
+    for (size_t s = 0; s < study.settings.size(); ++s) {
+      const double v = study.values[s][f];
+      out += " " + num(v, std::abs(v) < 0.1 ? 4 : 3) + (study.passes[s][f] ? "" : " (fail)");
+      if (s + 1 < study.settings.size())
+        out += ref[f] != 0 ? " (" + std::string(v - ref[f] >= 0 ? "+" : "") + num(100 * (v - ref[f]) / std::abs(ref[f]), 0) + " %)"
+                           : "";
+      out += " |";
+    }
+    out += "\n";
+  }
+  out += "| within tolerance of the reference |";
+  for (size_t s = 0; s + 1 < study.settings.size(); ++s) out += study.withinTolerance(s) ? " yes |" : " no |";
+  out += " (reference) |\n| suite wall time |";
+  for (double w : study.wallSeconds) out += " " + num(w, 0) + " s |";
+  out += "\n\n";
+  size_t cheapest = study.settings.size();
+  for (size_t s = 0; s + 1 < study.settings.size(); ++s)
+    if (study.withinTolerance(s) && (cheapest == study.settings.size() || study.wallSeconds[s] < study.wallSeconds[cheapest]))
+      cheapest = s;
+  out += cheapest < study.settings.size()
+             ? "The cheapest setting within tolerance: **" + study.settings[cheapest].label() + "** (" +
+                   num(study.wallSeconds[cheapest], 0) + " s).\n"
+             : "No setting but the reference is within tolerance on every figure.\n";
+  return out;
 }
 
 }  // namespace sp

@@ -5,6 +5,7 @@
 // data behind its plots; nothing in a report is typed by hand.
 
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,38 @@ ExperimentResult laserSweep(const ValidationOptions& options);
 ExperimentResult pickAndPlace(const ValidationOptions& options);
 ExperimentResult slipperySurface(const ValidationOptions& options);
 ExperimentResult testTrack(const ValidationOptions& options);
+
+/// One physics setting of a convergence study.
+struct PhysicsSetting {
+  double step = 0.001;  ///< [s]
+  int iterations = 40;  ///< the quick solver's; ignored when exact
+  bool exact = false;   ///< ODE's exact (dense) solver
+  std::string label() const;
+};
+/// Parses "STEP/ITERATIONS" or "STEP/exact" (step in seconds), comma-separated:
+/// "0.001/40,0.0005/200,0.00025/exact". nullopt and `error` naming the item.
+std::optional<std::vector<PhysicsSetting>> parsePhysicsSettings(const std::string& text, std::string& error);
+
+/// Every judged figure of the suite at each setting, against the last
+/// setting (the reference, the finest): so that no verdict rests on solver
+/// error (issue 29). values[s][f]: setting s, figure f.
+struct ConvergenceStudy {
+  std::vector<PhysicsSetting> settings;
+  std::vector<std::string> figures;  ///< "N. experiment: quantity", the judged metrics in suite order
+  std::vector<std::vector<double>> values;
+  std::vector<std::vector<bool>> passes;
+  std::vector<double> wallSeconds;
+  double tolerance = 0.1;  ///< relative to the reference's figure
+  /// |value - reference| <= tolerance x |reference| for every figure.
+  bool withinTolerance(size_t setting) const;
+};
+/// Runs the suite (quick or full, as `base` says) at each setting, the
+/// rest of the physics as `base.params`. Progress to `log`.
+ConvergenceStudy convergenceStudy(const ValidationOptions& base, const std::vector<PhysicsSetting>& settings,
+                                  std::ostream& log);
+/// The study in Markdown: a table of each figure per setting, its relative
+/// difference from the reference, and the cheapest setting within tolerance.
+std::string convergenceReport(const ConvergenceStudy& study, const ValidationOptions& base);
 
 /// A least-squares line y = intercept + slope x and its coefficient of
 /// determination (1 = every point on the line; 0 = no better than the mean).

@@ -124,6 +124,31 @@ class TestValidation : public QObject {
     QVERIFY(proportionalityMismatch({t, dA, eA}, {t2, d2, e2}, 0.5e-3) < 1e-9);
   }
 
+  // The convergence study's settings: good ones parse, each bad item is
+  // named; a setting is within tolerance only when every figure is within
+  // 10 % of the reference's (a figure 11 % off fails it: the control).
+  void convergenceSettingsAndTolerance() {
+    std::string error;
+    const auto good = parsePhysicsSettings("0.001/40,0.0005/200,0.00025/exact", error);
+    QVERIFY2(good, error.c_str());
+    QCOMPARE(good->size(), size_t{3});
+    QCOMPARE((*good)[1].iterations, 200);
+    QVERIFY((*good)[2].exact);
+    for (const char* bad : {"0.001/40", "0.001/40,abc/20", "0.001/40,0.001/0", "0.001/40,1/20", "0.001/40,0.001/exakt",
+                            "0.001/40,", "nan/40,0.001/40"}) {
+      QVERIFY2(!parsePhysicsSettings(bad, error), bad);
+      QVERIFY2(error.rfind("--convergence: ", 0) == 0, error.c_str());
+    }
+    ConvergenceStudy study;
+    study.settings = *good;
+    study.figures = {"a", "b"};
+    study.values = {{1.09, -0.5}, {1.11, -0.5}, {1.0, -0.46}};
+    QVERIFY(study.withinTolerance(0));
+    QVERIFY(!study.withinTolerance(1));  // 11 % off on the first figure
+    study.values[2][1] = -0.4;           // the second now 25 % off in both
+    QVERIFY(!study.withinTolerance(0));
+  }
+
   // 3. The pole is picked, carried and laid down to stay; the front wheels
   // carry more, and the pole (the same pose with and without it) loads the
   // front while unloading the rear, the two adding up to its weight.
