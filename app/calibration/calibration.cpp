@@ -42,20 +42,25 @@ const std::array<CalParamInfo, kCalParams>& calParams() {
   return table;
 }
 
+namespace {
+
+// Where each parameter lives in SimParams, in CalParam order: the one
+// table calValues and withCalValues read.
+constexpr std::array<double SimParams::*, kCalParams> kCalFields{
+    &SimParams::calWheelRadius, &SimParams::calWheelRadiusSplit, &SimParams::calWheelRadiusSide,
+    &SimParams::calWheelRadiusDiag, &SimParams::calFriction, &SimParams::calMotorGain,
+    &SimParams::calDelay, &SimParams::calMass};
+
+}  // namespace
+
 CalValues calValues(const SimParams& p) {
-  return {p.calWheelRadius, p.calWheelRadiusSplit, p.calWheelRadiusSide, p.calWheelRadiusDiag,
-          p.calFriction,    p.calMotorGain,        p.calDelay,           p.calMass};
+  CalValues v{};
+  for (size_t i = 0; i < kCalParams; ++i) v[i] = p.*kCalFields[i];
+  return v;
 }
 
 SimParams withCalValues(SimParams p, const CalValues& v) {
-  p.calWheelRadius = v[0];
-  p.calWheelRadiusSplit = v[1];
-  p.calWheelRadiusSide = v[2];
-  p.calWheelRadiusDiag = v[3];
-  p.calFriction = v[4];
-  p.calMotorGain = v[5];
-  p.calDelay = v[6];
-  p.calMass = v[7];
+  for (size_t i = 0; i < kCalParams; ++i) p.*kCalFields[i] = v[i];
   return p;
 }
 

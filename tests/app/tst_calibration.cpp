@@ -235,6 +235,11 @@ class TestCalibration : public QObject {
     SimParams params;
     params.calWheelRadius = 0.981, params.calWheelRadiusSplit = 0.012, params.calWheelRadiusSide = -0.006, params.calWheelRadiusDiag = 0.008;
     params.calMass = 1.107, params.calMotorGain = 0.913, params.calFriction = 0.8, params.calDelay = 0.031;
+    // The values as the fitter holds them, and back: each in its place.
+    const CalValues held = calValues(params);
+    QCOMPARE(held[static_cast<size_t>(CalParam::WheelRadiusDiag)], 0.008);
+    QCOMPARE(held[static_cast<size_t>(CalParam::Friction)], 0.8);
+    QVERIFY(calValues(withCalValues(SimParams{}, held)) == held);
     const auto roundTrip = [&](const SimParams& p) {
       std::string error;
       const std::optional<std::string> written = calibratedRobotText(*text, files, p, error);
