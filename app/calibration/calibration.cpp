@@ -657,7 +657,8 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       }
     }
     if (!stepped) break;
-    if (o.budgetMs > 0 && elapsedMs() + (elapsedMs() - iterationBegan) > o.budgetMs) break;  // the next would overrun
+    const double now = elapsedMs();
+    if (o.budgetMs > 0 && now + (now - iterationBegan) > o.budgetMs) break;  // the next would overrun
   }
   // A fit that predicts the window worse than its start (the contacts'
   // noise can defeat a step) keeps the start's values: nothing learnt.

@@ -46,17 +46,19 @@ QString CalibrationJob::save(const QString& path) const {
   const LiveCalibrator* c = context_->session().calibrator();
   if (!c) return tr("No calibration runs (it needs the ghost).");
   const CalibrationState s = c->state();
-  CalibrationFit fit;  // what the twins use now, as a fit's text
-  fit.value = s.applied;
-  fit.sigma = s.sigma;
-  fit.observed = s.observed;
-  if (!s.history.empty()) {
-    fit.from = s.history.front().from;
-    fit.to = s.history.back().to;
-    fit.segments = s.history.back().segments;
-  }
-  std::string text = calibrationParamsText(fit);
-  if (path.endsWith(QLatin1String(".xml"), Qt::CaseInsensitive)) {
+  std::string text;
+  if (!path.endsWith(QLatin1String(".xml"), Qt::CaseInsensitive)) {
+    CalibrationFit fit;  // what the twins use now, as a fit's text
+    fit.value = s.applied;
+    fit.sigma = s.sigma;
+    fit.observed = s.observed;
+    if (!s.history.empty()) {
+      fit.from = s.history.front().from;
+      fit.to = s.history.back().to;
+      fit.segments = s.history.back().segments;
+    }
+    text = calibrationParamsText(fit);
+  } else {
     // A robot file: the files' robot with the values written in.
     const WorldModel* world = context_->session().world();
     if (!world || world->robots.empty()) return tr("No robot loaded.");
