@@ -17,13 +17,27 @@ void RobotLink::connected(ClientId client, double) {
   clients_[client] = std::move(c);
 }
 
+namespace {
+
+// Hex digits compare in either case (a client that prints its HMAC in
+// upper case is not refused as a wrong proof).
+std::string lowerHex(std::string hex) {
+  for (char& ch : hex)
+    if (ch >= 'A' && ch <= 'F') ch = static_cast<char>(ch - 'A' + 'a');
+  return hex;
+}
+
+}  // namespace
+
 std::string RobotLink::authenticationProblem(const Client& c, const HelloMsg& hello) const {
   if (config_.token.empty()) return "the robot has no token";
   if (!hello.token.empty()) {
     if (!config_.clearTokenAllowed) return "a token in clear is accepted on loopback only: send 'proof'";
-    return equalConstantTime(hello.token, config_.token) ? "" : "wrong token";
+    return equalConstantTime(lowerHex(hello.token), lowerHex(config_.token)) ? "" : "wrong token";
   }
-  return equalConstantTime(hello.proof, helloProof(config_.token, c.nonce, hello.name, hello.role)) ? "" : "wrong proof";
+  return equalConstantTime(lowerHex(hello.proof), helloProof(config_.token, c.nonce, hello.name, hello.role))
+             ? ""
+             : "wrong proof";
 }
 
 void RobotLink::disconnected(ClientId client, double now) {
@@ -79,6 +93,12 @@ void RobotLink::broadcastLease() {
   const std::string holderName = holder_ && clients_.count(holder_) ? clients_[holder_].name : std::string();
   for (const auto& [id, c] : clients_)
     if (c.authenticated) send(id, LeaseStateMsg{holderName, id == holder_});
+}
+
+void RobotLink::closeUnauthenticated(ClientId client, const std::string& reason) {
+  const auto it = clients_.find(client);
+  if (it == clients_.end() || it->second.authenticated) return;
+  close(client, reason);
 }
 
 void RobotLink::close(ClientId client, const std::string& reason) {

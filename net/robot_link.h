@@ -71,6 +71,9 @@ class RobotLink {
   /// lease holder's robot is stopped with a failsafe saying so, at once
   /// (its keep-alives alone must not keep a blind controller in control).
   void stalled(ClientId client, const std::string& why, double now);
+  /// `client`, not authenticated, took too long to say HELLO: it gets
+  /// ERROR `reason` and is closed (takeClosing).
+  void closeUnauthenticated(ClientId client, const std::string& reason);
   /// The robot is going away (`reason`): it is stopped as by an e-stop
   /// (latched), every client is told (EVENT estop) and closed with `reason`.
   void shutdown(const std::string& reason, double now);

@@ -393,12 +393,11 @@ void RobotServer::onTimer() {
   link_.tick(t);
   // Connections that never said HELLO are closed: they would hold a slot
   // (and a descriptor) for nothing.
+  // Counted from the connection, as on a real link: an emulated link gets
+  // no allowance of its own (the timeout is sized for the slowest link).
   std::vector<ClientId> silent;
-  // An emulated link holds the HELLO for its delay too.
-  const double helloLimit =
-      config_.helloTimeout + (config_.emulation.active() ? config_.emulation.delay + config_.emulation.jitter : 0);
   for (const auto& [id, s] : sessions_)
-    if (!s->closed && !s->closing && t - s->connectedAt > helloLimit && !link_.authenticated(id))
+    if (!s->closed && !s->closing && t - s->connectedAt > config_.helloTimeout && !link_.authenticated(id))
       silent.push_back(id);
   // A controller that has taken nothing of a frame for stallTimeout does
   // not read (the kernel's buffers both ways are full): it is blind, and
@@ -419,9 +418,11 @@ void RobotServer::onTimer() {
   for (ClientId id : lingering) closeSession(id);
   for (ClientId id : silent) {
     ++stats_.helloTimeouts;
-    if (config_.log) config_.log("client " + std::to_string(id) + " closed: no HELLO within " +
-                                 std::to_string(static_cast<int>(config_.helloTimeout * 1000)) + " ms");
-    closeSession(id);
+    const std::string why = "no HELLO within " + std::to_string(std::lround(config_.helloTimeout * 1000)) + " ms";
+    if (config_.log) config_.log("client " + std::to_string(id) + " closed: " + why);
+    // Told why (ERROR), then closed as a refused HELLO is: its last frame
+    // gets kClosingGrace to leave (flush() below).
+    link_.closeUnauthenticated(id, why + ": closed");
   }
   if (t >= nextHeartbeat_) {
     nextHeartbeat_ = t + 0.5;

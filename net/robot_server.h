@@ -112,8 +112,9 @@ struct RobotServerConfig {
   /// (a connection on loopback or a LAN says HELLO within milliseconds).
   /// More than maxConnections: no such pool (a test's control).
   size_t maxUnauthenticated = 32;
-  /// [s] a connection without a good HELLO by then is closed.
-  double helloTimeout = 2.0;
+  /// [s] a connection without a good HELLO by then, counted from its
+  /// opening, is closed (told why); see SimParams::linkHelloTimeout.
+  double helloTimeout = 5.0;
   /// Where the server reports connections, refusals and bad frames (one
   /// line each, no newline); may be empty.
   std::function<void(const std::string&)> log;

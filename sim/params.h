@@ -41,7 +41,11 @@ struct SimParams {
   double linkCommandExpiry = 0.5; ///< [s] console: how much later than the link's usual delay a command may arrive
   double linkLeaseConfirm = 10;   ///< [s] robot: wait for a new holder's first keep-alive
   int linkMaxConnections = 64;    ///< robot: connections open at once; one more is closed at once
-  double linkHelloTimeout = 2;    ///< [s] robot: a connection without a good HELLO by then is closed
+  /// [s] robot: a connection without a good HELLO by then is closed. The
+  /// HELLO answers the CHALLENGE, so it arrives a round trip after the
+  /// connection opened: 5 s carries the slowest link of docs/protocol.md
+  /// (2.2 s) twice over.
+  double linkHelloTimeout = 5;
   double consoleStaleAfter = 0.5; ///< [s] console: no telemetry this long => the robot is drawn grey, "no data"
   double ghostStep = 0.004;       ///< [s] console's predictive ghost: its physics step
   int ghostIterations = 20;       ///< ghost: quick solver iterations

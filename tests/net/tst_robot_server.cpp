@@ -27,6 +27,7 @@
 #include <thread>
 
 #include "app/robot/twin_host.h"
+#include "delay_relay.h"
 #include "net/auth.h"
 #include "net/robot_server.h"
 #include "sim/model_loader.h"
@@ -153,10 +154,47 @@ class TestRobotServer : public QObject {
     Client silent(robot.server->port()), talker(robot.server->port());
     talker.hello(Role::Monitor, "talker");
     QVERIFY(silent.waitFor<ChallengeMsg>(1.0));
+    // It is told why before it is closed.
+    const auto why = silent.waitFor<ErrorMsg>(1.5);
+    QVERIFY(why);
+    QCOMPARE(QString::fromStdString(why->reason), QString("no HELLO within 300 ms: closed"));
     QVERIFY(!silent.next(1.5));
     QVERIFY(silent.eof);
     QVERIFY(talker.waitFor<TelemetryMsg>(1.0));
     QVERIFY(!talker.eof);
+  }
+
+  // Issue 30: the HELLO answers the CHALLENGE, so it reaches the robot a
+  // full round trip after the connection opened. Through a link of 1 s
+  // +- 0.1 each way that the robot knows nothing of (a relay on loopback,
+  // as a tunnel or a long-haul route), every one of eight proving clients
+  // is welcomed at the default hello timeout, and so over the robot's own
+  // emulation of that link. (With the 2 s timeout of before, about half
+  // of them were closed.)
+  void helloOverAPlanetaryLink() {
+    const auto everyoneWelcomed = [](uint16_t port, const char* what) {
+      std::vector<std::future<bool>> clients;
+      for (int i = 0; i < 8; ++i)
+        clients.push_back(std::async(std::launch::async, [port, i] {
+          Client c(port);
+          c.send(c.provingHello(Role::Monitor, "far" + std::to_string(i)));
+          return c.waitFor<WelcomeMsg>(6.0).has_value();
+        }));
+      int welcomed = 0;
+      for (auto& f : clients) welcomed += f.get();
+      qInfo("%s: %d of 8 welcomed", what, welcomed);
+      return welcomed;
+    };
+    {
+      Robot robot;
+      const sp::test::DelayRelay relay(robot.server->port(), 1.0, 0.1);
+      QCOMPARE(everyoneWelcomed(relay.port(), "through a relay"), 8);
+    }
+    LinkEmulatorConfig planetary;
+    planetary.delay = 1.0;
+    planetary.jitter = 0.1;
+    Robot robot(planetary);
+    QCOMPARE(everyoneWelcomed(robot.server->port(), "emulated on the robot"), 8);
   }
 
   // Beyond maxConnections a connection is accepted and closed at once; once
@@ -224,6 +262,22 @@ class TestRobotServer : public QObject {
     Client clear(robot.server->port());
     clear.send(HelloMsg{"intruder", "ffffffffffffffffffffffffffffffff", Role::Control, {}});
     QCOMPARE(clear.waitFor<ErrorMsg>(2.0).value_or(ErrorMsg{}).reason, std::string("authentication failed"));
+  }
+
+  // Issue 30: a proof in upper-case hex opens the connection as the
+  // lower-case one does; the same proof one digit off is refused.
+  void proofInEitherCase() {
+    Robot robot;
+    Client upper(robot.server->port()), wrong(robot.server->port());
+    HelloMsg h = upper.provingHello(Role::Monitor, "shouting");
+    std::transform(h.proof.begin(), h.proof.end(), h.proof.begin(), [](char c) { return static_cast<char>(std::toupper(c)); });
+    QVERIFY(h.proof.find_first_of("ABCDEF") != std::string::npos);
+    upper.send(h);
+    QVERIFY(upper.waitFor<WelcomeMsg>(2.0));
+    HelloMsg w = wrong.provingHello(Role::Monitor, "off");
+    w.proof[0] = w.proof[0] == '0' ? '1' : '0';
+    wrong.send(w);
+    QCOMPARE(wrong.waitFor<ErrorMsg>(2.0).value_or(ErrorMsg{}).reason, std::string("authentication failed"));
   }
 
   // A HELLO captured on one connection does not open another: the proof
