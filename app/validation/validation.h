@@ -14,6 +14,15 @@
 
 namespace sp {
 
+/// What a figure is checked against: the report says so per criterion.
+enum class Basis {
+  Paper,        ///< validation: the paper's figure or observation (from outside the twin)
+  Mathematics,  ///< verification: kinematics or statics the twin must obey
+  Solver,       ///< numerics: the figure does not hang on the solver's settings
+  Control,      ///< a case that must fail the test beside it (the test can fail)
+};
+const char* basisText(Basis basis);
+
 /// One figure of an experiment: ours beside the paper's. A judged metric
 /// has a target stated before the run that the figure can miss; an
 /// unjudged one (judged = false) is reported for context and counts for
@@ -26,6 +35,12 @@ struct Metric {
   std::string target;  ///< what counts as a pass, in words ("" when not judged)
   bool pass = false;
   bool judged = true;
+  Basis basis = Basis::Paper;
+  /// How close to the converged figure (the convergence study's reference)
+  /// the figure must be for its verdict not to rest on solver error, in
+  /// its unit; 0: within 10 % of the reference's. Stated where a relative
+  /// one means nothing (a figure near zero).
+  double converged = 0;
 };
 
 struct ExperimentPlot {
@@ -81,9 +96,12 @@ struct ConvergenceStudy {
   std::vector<std::vector<double>> values;
   std::vector<std::vector<bool>> passes;
   std::vector<double> wallSeconds;
+  std::vector<double> absolute;  ///< each figure's Metric::converged (0: relative)
   double tolerance = 0.1;  ///< relative to the reference's figure
-  /// |value - reference| <= tolerance x |reference| for every figure.
+  /// |value - reference| <= absolute, or tolerance x |reference| where no
+  /// absolute is stated, for every figure.
   bool withinTolerance(size_t setting) const;
+  bool figureWithin(size_t setting, size_t figure) const;
 };
 /// Runs the suite (quick or full, as `base` says) at each setting, the
 /// rest of the physics as `base.params`. Progress to `log`.

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "app/validation/validation.h"
@@ -27,24 +29,32 @@ QString describe(const Metric& m) {
       .arg(QString::fromStdString(m.unit), QString::fromStdString(m.paper), QString::fromStdString(m.target));
 }
 
-// A copy of the ice world and the robot, the world's text without `cut`;
-// returns the copy's source folder ("" on failure). The folder lives as long
-// as the test process.
-std::string makeCopyWithout(const std::string& sourceDir, const std::string& cut) {
-  static QTemporaryDir dir;
-  QFile world(QString::fromStdString(sourceDir + "/terrains/ice.world.xml"));
-  if (!dir.isValid() || !world.open(QIODevice::ReadOnly)) return {};
-  QString text = QString::fromUtf8(world.readAll());
-  if (!text.contains(QString::fromStdString(cut))) return {};
-  text.remove(QString::fromStdString(cut));
-  QDir(dir.path()).mkpath("terrains");
-  QDir(dir.path()).mkpath("robots");
-  QFile out(dir.filePath("terrains/ice.world.xml"));
-  if (!out.open(QIODevice::WriteOnly) || out.write(text.toUtf8()) < 0) return {};
-  out.close();
-  if (!QFile::copy(QString::fromStdString(sourceDir + "/robots/workpartner.xml"), dir.filePath("robots/workpartner.xml")))
-    return {};
-  return dir.path().toStdString();
+// A copy of robots/ and terrains/ with `file`'s text edited: each `from`
+// (which must occur) replaced by its `to`; returns the copy's source folder
+// ("" on failure). A perturbed model for a control: a criterion must fail
+// on it for a physical reason. The folders live as long as the process.
+std::string makeVariant(const std::string& sourceDir, const QString& file,
+                        const std::vector<std::pair<QString, QString>>& edits) {
+  static std::vector<std::unique_ptr<QTemporaryDir>> dirs;
+  dirs.push_back(std::make_unique<QTemporaryDir>());
+  const QDir source(QString::fromStdString(sourceDir)), copy(dirs.back()->path());
+  if (!dirs.back()->isValid()) return {};
+  for (const QString sub : {"robots", "terrains"}) {
+    copy.mkpath(sub);
+    for (const QString& name : QDir(source.filePath(sub)).entryList(QDir::Files))
+      if (!QFile::copy(source.filePath(sub + "/" + name), copy.filePath(sub + "/" + name))) return {};
+  }
+  QFile in(copy.filePath(file));
+  if (!in.open(QIODevice::ReadOnly)) return {};
+  QString text = QString::fromUtf8(in.readAll());
+  in.close();
+  for (const auto& [from, to] : edits) {
+    if (!text.contains(from)) return {};
+    text.replace(from, to);
+  }
+  QFile out(copy.filePath(file));
+  if (!out.open(QIODevice::WriteOnly | QIODevice::Truncate) || out.write(text.toUtf8()) < 0) return {};
+  return copy.path().toStdString();
 }
 
 // Every judged metric passes except the known failures (indices into
@@ -80,6 +90,26 @@ class TestValidation : public QObject {
   // Against the commanded angle (also judged, issue 29) it misses at 10
   // and 20 degrees today (known failures: -1.4 % at 10 degrees quick).
   void circularDrive() { verifyVerdicts(sp::circularDrive(quick()), {1, 3}); }
+
+  // Control (a perturbed world, issue 29): on glare ice (tyres on the
+  // ground at mu 0.003: 0.03 m/s^2 of grip, where the circles at 0.5 m/s
+  // need 0.04-0.12) the robot slides outwards, so the kinematic criterion,
+  // which assumes rolling without side slip, must fail at every angle
+  // (+124 to +168 % today). At mu 0.01, which should hold the 10 and 20
+  // degree circles, 10 degrees still failed (+4 %) and 20 passed: the
+  // tyres fight (their speeds are the model's), so a control this close to
+  // the grip would not say why it fails.
+  void circularDriveControl() {
+    ValidationOptions o = quick();
+    o.sourceDir = makeVariant(o.sourceDir, "terrains/flat.world.xml",
+                              {{R"(<contact a="rubber" b="ground" mu="1.0"/>)", R"(<contact a="rubber" b="ground" mu="0.003"/>)"}});
+    QVERIFY(!o.sourceDir.empty());
+    const ExperimentResult r = sp::circularDrive(o);
+    for (size_t i : {0, 2, 4}) {
+      qInfo("on ice: %s", qPrintable(describe(r.metrics[i])));
+      QVERIFY2(r.metrics[i].judged && !r.metrics[i].pass, qPrintable(describe(r.metrics[i])));
+    }
+  }
 
   // 2. One judged criterion: the range error against the commanded pose
   // grows linearly in time (R^2 >= 0.9), as the paper saw. It does not here
@@ -147,12 +177,34 @@ class TestValidation : public QObject {
     QVERIFY(!study.withinTolerance(1));  // 11 % off on the first figure
     study.values[2][1] = -0.4;           // the second now 25 % off in both
     QVERIFY(!study.withinTolerance(0));
+    // A figure near zero states its tolerance in its unit: 0.1 of a
+    // reference at 0.02 admits -0.05, not 0.15 (which 10 % would refuse both).
+    study.absolute = {0, 0.1};
+    study.values = {{1.0, -0.05}, {1.0, 0.15}, {1.0, 0.02}};
+    QVERIFY(study.withinTolerance(0));
+    QVERIFY(!study.withinTolerance(1));
+    QVERIFY(study.figureWithin(1, 0));
   }
 
   // 3. The pole is picked, carried and laid down to stay; the front wheels
   // carry more, and the pole (the same pose with and without it) loads the
   // front while unloading the rear, the two adding up to its weight.
   void pickAndPlace() { verifyAll(sp::pickAndPlace(quick())); }
+
+  // Control: a robot whose front body is 28 kg lighter and rear body 28 kg
+  // heavier (its batteries moved back) is not front-heavy: the standing
+  // share criterion must fail, the pole's criteria (the same pose with and
+  // without it) still pass.
+  void pickAndPlaceControl() {
+    ValidationOptions o = quick();
+    o.sourceDir = makeVariant(o.sourceDir, "robots/workpartner.xml",
+                              {{R"(name="rear_body" mass="62")", R"(name="rear_body" mass="90")"},
+                               {R"(name="front_body" mass="48")", R"(name="front_body" mass="20")"}});
+    QVERIFY(!o.sourceDir.empty());
+    const ExperimentResult r = sp::pickAndPlace(o);
+    qInfo("batteries back: %s", qPrintable(describe(r.metrics[0])));
+    verifyVerdicts(r, {0});
+  }
 
   // 4. On mu 0.025 with a motion resistance C = 0.03: the paper's speeds,
   // each within a factor of 1.5, in its order, and a rolling speed that is
@@ -163,7 +215,7 @@ class TestValidation : public QObject {
   void slipperySurface() {
     verifyVerdicts(sp::slipperySurface(quick()), {0, 4});
     ValidationOptions o = quick();
-    o.sourceDir = makeCopyWithout(o.sourceDir, "motion_resistance=\"0.03\"");
+    o.sourceDir = makeVariant(o.sourceDir, "terrains/ice.world.xml", {{"motion_resistance=\"0.03\"", ""}});
     QVERIFY(!o.sourceDir.empty());
     const ExperimentResult bare = sp::slipperySurface(o);
     qInfo("without motion resistance: %s", qPrintable(describe(bare.metrics[0])));
