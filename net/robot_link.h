@@ -106,6 +106,11 @@ class RobotLink {
     std::vector<TimedCommand> commands;
   };
   std::vector<SequenceRequest> takeSequences();
+  /// The robot refused `client`'s sequence `hash` (`reason`): SEQUENCE_STATE
+  /// refused to that client alone, as the link's own refusals.
+  void refuseSequenceOf(ClientId client, const std::string& hash, const std::string& reason) {
+    refuseSequence(client, hash, reason);
+  }
   /// Why running sequences must stop, in order: an ABORT, an e-stop, the
   /// failsafe, the lease given up or taken back (each also queued a stop).
   std::vector<std::string> takeAborts();

@@ -267,8 +267,14 @@ void RobotServer::flush() {
     const SequenceMsg& m = r.message;
     const std::string why = robot_.startSequence(
         {m.hash, std::move(r.commands), m.start, m.startPosition, m.startHeading});
-    SequenceStateMsg state{m.hash, why.empty() ? SequenceStateKind::Accepted : SequenceStateKind::Refused, 0, 0, 0, why};
-    link_.sequenceState(state);
+    if (!why.empty()) {
+      link_.refuseSequenceOf(r.client, m.hash, why);
+      continue;
+    }
+    link_.sequenceState({m.hash, SequenceStateKind::Accepted, 0, 0, 0, ""});
+    // The robot reports the accepted sequence until its twin takes it up:
+    // that report is this one, not news (else a late twin sends it twice).
+    lastSequence_ = robot_.state().sequence;
   }
   for (const std::string& why : link_.takeAborts()) robot_.abortSequence(why);
   for (RobotLink::Notice& n : link_.takeNotices())
@@ -453,8 +459,13 @@ void RobotServer::onTimer() {
       if (!st.health.empty()) link_.announce(EventKind::Divergence, st.health);
     }
     if (st.sequence != lastSequence_ && !st.sequence.hash.empty()) {
-      lastSequence_ = st.sequence;
       const SequenceStatus& q = st.sequence;
+      // A sequence shorter than a telemetry period ends between two looks:
+      // clients are still told it ran (done and aborted both mean it did).
+      const bool ended = q.state == SequenceStateKind::Done || q.state == SequenceStateKind::Aborted;
+      if (ended && lastSequence_.hash == q.hash && lastSequence_.state == SequenceStateKind::Accepted)
+        link_.sequenceState({q.hash, SequenceStateKind::Running, 0, q.count, q.startTime, ""});
+      lastSequence_ = st.sequence;
       link_.sequenceState({q.hash, q.state, q.index, q.count, q.startTime, q.reason});
     }
     TelemetryMsg m;

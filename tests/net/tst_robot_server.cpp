@@ -26,6 +26,7 @@
 #include <random>
 #include <thread>
 
+#include "app/rehearse/rehearsal.h"
 #include "app/robot/twin_host.h"
 #include "delay_relay.h"
 #include "net/auth.h"
@@ -49,8 +50,10 @@ struct Robot {
   std::unique_ptr<RobotServer> server;
   std::thread thread;
 
+  /// `startTwin` false: the twin's thread waits for host->start() (a twin
+  /// that takes up what the link hands it late).
   explicit Robot(LinkEmulatorConfig emulation = {}, SimParams params = {},
-                 const std::function<void(RobotServerConfig&)>& tweak = {}) {
+                 const std::function<void(RobotServerConfig&)>& tweak = {}, bool startTwin = true) {
     Diagnostics diag;
     auto model = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
     if (!model) qFatal("%s", diag.format().c_str());
@@ -63,7 +66,7 @@ struct Robot {
     server = std::make_unique<RobotServer>(io, config, *host);
     const std::string error = server->start();
     if (!error.empty()) qFatal("%s", error.c_str());
-    host->start();
+    if (startTwin) host->start();
     thread = std::thread([this] { io.run(); });
   }
   ~Robot() {
@@ -262,6 +265,47 @@ class TestRobotServer : public QObject {
     Client clear(robot.server->port());
     clear.send(HelloMsg{"intruder", "ffffffffffffffffffffffffffffffff", Role::Control, {}});
     QCOMPARE(clear.waitFor<ErrorMsg>(2.0).value_or(ErrorMsg{}).reason, std::string("authentication failed"));
+  }
+
+  // Issue 30: one SEQUENCE gets one 'accepted', however late the twin
+  // takes it up (here its thread starts after a second of telemetry, all
+  // of which still reports the sequence accepted), then 'running' once
+  // it does, and 'done'. (Under load a late twin sent 'accepted' twice;
+  // a sequence shorter than a telemetry period, as this one, went from
+  // 'accepted' to 'done' without 'running'.)
+  void sequenceAcceptedOnce() {
+    // No keep-alives here: a deadman of 10 s keeps the lease meanwhile.
+    Robot robot({}, {}, [](RobotServerConfig& c) { c.link.deadman = 10; }, false);
+    Client op(robot.server->port()), monitor(robot.server->port());
+    op.hello(Role::Control, "operator");
+    monitor.hello(Role::Monitor, "monitor");
+    op.send(LeaseAcquireMsg{});
+    op.send(SequenceMsg{sequenceHash("0 stop\n"), "0 stop", Pose{}, 0.5, 0.5});
+    const auto states = [](Client& c, double seconds) {
+      std::vector<SequenceStateKind> out;
+      const auto t0 = Clock::now();
+      while (::seconds(t0) < seconds)
+        if (auto m = c.waitFor<SequenceStateMsg>(seconds - ::seconds(t0))) out.push_back(m->state);
+      return out;
+    };
+    for (Client* c : {&op, &monitor}) {
+      const std::vector<SequenceStateKind> early = states(*c, c == &op ? 1.0 : 0.1);
+      QCOMPARE(early.size(), size_t{1});
+      QCOMPARE(early[0], SequenceStateKind::Accepted);
+    }
+    robot.host->start();
+    for (Client* c : {&op, &monitor}) {
+      const std::vector<SequenceStateKind> later = states(*c, 1.0);
+      QCOMPARE(later, (std::vector<SequenceStateKind>{SequenceStateKind::Running, SequenceStateKind::Done}));
+    }
+    // A refusal (here the robot's own: a start 5 m away) reaches the sender alone.
+    Pose far;
+    far.p.x = 5;
+    op.send(SequenceMsg{sequenceHash("0 stop\n"), "0 stop", far, 0.5, 0.5});
+    const auto refused = op.waitFor<SequenceStateMsg>(1.0);
+    QVERIFY(refused && refused->state == SequenceStateKind::Refused);
+    QVERIFY2(refused->reason.rfind("stale rehearsal", 0) == 0, refused->reason.c_str());
+    QVERIFY(states(monitor, 0.3).empty());
   }
 
   // Issue 30: a proof in upper-case hex opens the connection as the
