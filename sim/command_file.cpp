@@ -10,6 +10,7 @@
 #include "sim/math.h"
 #include "sim/gait.h"
 #include "sim/robot_model.h"
+#include "sim/terrain_brush.h"
 #include "sim/text.h"
 
 // Units in sequence files: `target` and `velocity` take degrees and deg/s on
@@ -250,5 +251,20 @@ bool checkCommands(const std::vector<TimedCommand>& commands, const RobotModel& 
   return ok;
 }
 
+bool checkCommands(const std::vector<TimedCommand>& commands, const WorldModel& world, std::string_view file,
+                   Diagnostics& diag) {
+  bool ok = true;
+  const HeightGrid* grid = world.terrain.kind == TerrainSpec::Kind::Plane ? nullptr : &world.terrain.grid;
+  for (const TimedCommand& c : commands) {
+    std::string why;
+    if (const auto* patch = std::get_if<TerrainPatchCmd>(&c.command)) why = patchFits(grid, *patch);
+    else if (world.robots.empty()) why = "the world has no robot for this command";
+    else why = checkCommand(c.command, world.robots[0].model).message;
+    if (why.empty()) continue;
+    diag.error(file, c.line, std::move(why));
+    ok = false;
+  }
+  return ok;
+}
 
 }  // namespace sp

@@ -13,6 +13,7 @@
 namespace sp {
 
 struct RobotModel;
+struct WorldModel;
 
 /// Parses one command (without its time) in file syntax. `target` and
 /// `velocity` values are degrees (deg/s) for hinge joints and metres (m/s)
@@ -39,6 +40,11 @@ std::optional<std::vector<TimedCommand>> loadCommandSequence(const std::string& 
 /// checkCommand() does (sim/command_check.h). Returns false on any error;
 /// diagnostics carry `file` and each command's line.
 bool checkCommands(const std::vector<TimedCommand>& commands, const RobotModel& robot,
+                   std::string_view file, Diagnostics& diag);
+/// As above against `world`: its first robot for robot commands, its
+/// terrain for terrain edits (an edit outside the heightfield, or on a
+/// plane, is an error at its line: it would be refused when due).
+bool checkCommands(const std::vector<TimedCommand>& commands, const WorldModel& world,
                    std::string_view file, Diagnostics& diag);
 
 }  // namespace sp

@@ -65,6 +65,7 @@ double lerp(double a, double b, double f) { return a + (b - a) * f; }
 std::string RehearsalResult::summary() const {
   if (!error.empty()) return error;
   if (cancelled) return "cancelled";
+  if (!refused.empty()) return "refused: " + refused.front();
   for (const RuleVerdict& v : verdicts)
     if (!v.passed) return v.message();
   return "passed";
@@ -179,6 +180,10 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   std::vector<TimedCommand> acting = plan.commands;
   for (TimedCommand& c : acting) c.time += plan.params.calDelay;
   runner.schedule(acting);
+  runner.setSubmitHook([&](const ScheduledCommand& c, const std::string& why) {
+    if (!why.empty())
+      result.refused.push_back("line " + std::to_string(c.line) + " at " + shortestText(world->time()) + " s: " + why);
+  });
   const int64_t total = std::max<int64_t>(1, std::llround(result.duration / plan.params.step));
   const int64_t sampleEvery = std::max<int64_t>(1, std::llround(RehearsalResult::kSampleInterval / plan.params.step));
   const int64_t progressEvery = std::max<int64_t>(1, total / 100);
@@ -196,7 +201,7 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   const RunOutcome out = runner.advanceTo(total);
   if (out.stop == RunOutcome::Stop::Diverged) monitor.check(*world);  // the health verdict
   result.verdicts = monitor.verdicts();
-  result.passed = !result.cancelled && monitor.passed() && world->health().healthy();
+  result.passed = !result.cancelled && monitor.passed() && world->health().healthy() && result.refused.empty();
   result.endHash = world->stateHash();
   result.wallSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return result;

@@ -90,6 +90,9 @@ struct RehearsalResult {
   double wallSeconds = 0;  ///< what it took
   uint64_t endHash = 0;    ///< World::stateHash() at the end
   int heldJoints = 0;      ///< joints held rigid (plan.holdUnmoved)
+  /// Commands the twin refused when due ("line N at T s: why"): a
+  /// rehearsal with any does not pass (the robot would refuse them too).
+  std::vector<std::string> refused;
   /// The first failed rule's one-line message, or "passed".
   std::string summary() const;
   /// The rehearsed state at `time` [s from the start], interpolated

@@ -164,7 +164,19 @@ void TwinHost::abortRunning(const std::string& reason) {
 
 void TwinHost::sequenceCommand(const ScheduledCommand& command, const std::string& refusal) {
   World& w = *world_;
-  if (refusal.empty() && log_) log_->writer().logCommand(w.stepCount(), w.time(), "sequence", command.command, &model_);
+  if (!refusal.empty()) {
+    // What the link's checks passed but the twin refused when due: the
+    // sequence cannot run as rehearsed, so it ends here, saying which
+    // (SEQUENCE_STATE aborted to every client, the robot's log and stderr).
+    uint64_t index = 0;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      index = sequence_.index + 1;
+    }
+    abortRunning("command " + std::to_string(index) + " refused: " + refusal);
+    return;
+  }
+  if (log_) log_->writer().logCommand(w.stepCount(), w.time(), "sequence", command.command, &model_);
   std::lock_guard<std::mutex> lock(mutex_);
   ++sequence_.index;
   if (sequence_.index < sequence_.count) return;

@@ -66,7 +66,7 @@ bool samplePlan(const SweepSpec& spec, const std::vector<std::string>& sets, uin
   std::optional<std::vector<TimedCommand>> commands;
   if (world && !world->robots.empty()) {
     commands = loadCommandSequence(spec.commands, diag, &world->robots[0].model);
-    if (commands) checkCommands(*commands, world->robots[0].model, spec.commands, diag);
+    if (commands) checkCommands(*commands, *world, spec.commands, diag);
   }
   if (diag.hasErrors() || !world || !commands) {
     error = diag.format();

@@ -74,7 +74,7 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
   if (!options.commandsFile.empty() && model && !model->robots.empty()) {
     const RobotModel& robot = model->robots[0].model;
     if (auto seq = loadCommandSequence(options.commandsFile, diag, &robot)) {
-      if (checkCommands(*seq, robot, options.commandsFile, diag)) commands = std::move(*seq);
+      if (checkCommands(*seq, *model, options.commandsFile, diag)) commands = std::move(*seq);
     }
   }
   if (options.realTimeFactor && params) params->realTimeFactor = *options.realTimeFactor;
@@ -147,8 +147,16 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
   for (TimedCommand& c : commands) c.time += params->calDelay;
   runner.schedule(commands);
   runner.setSubmitHook([&](const ScheduledCommand& c, const std::string& why) {
-    if (!why.empty()) err << options.commandsFile << ":" << c.line << ": error: " << why << "\n";
-    else if (log) log->writer().logCommand(world->stepCount(), world->time(), "sequence", c.command, &robot.model);
+    if (why.empty()) {
+      if (log) log->writer().logCommand(world->stepCount(), world->time(), "sequence", c.command, &robot.model);
+      return;
+    }
+    // Refused when due (the checks above catch what they can beforehand):
+    // said at once, logged, and the run's exit says so.
+    ++report.commandsRefused;
+    const std::string where = options.commandsFile + ":" + std::to_string(c.line);
+    err << where << ": error: refused at t = " << world->time() << " s: " << why << "\n";
+    if (log) log->writer().logEvent(world->stepCount(), world->time(), "refused", where + ": " + why);
   });
   runner.setMonitor([&](const World& w) {
     if (csv && w.stepCount() % csvEvery == 0) csv->sample(w);
@@ -227,7 +235,9 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
         << " ms, " << report.resyncs << " resyncs)";
   char hash[32];
   std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(report.stateHash));
-  out << "\n  " << report.commandsApplied << " commands applied; base ended at (" << base.p.x << ", "
+  out << "\n  " << report.commandsApplied << " commands applied"
+      << (report.commandsRefused ? ", " + std::to_string(report.commandsRefused) + " refused" : std::string())
+      << "; base ended at (" << base.p.x << ", "
       << base.p.y << ", " << base.p.z << ") m; state hash " << hash << "\n";
   if (log && !report.logError.empty() && log->newlyFailed()) err << "error: " << report.logError << "\n";
   if (log && report.logError.empty() && report.logDropped > 0)

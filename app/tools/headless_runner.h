@@ -46,6 +46,7 @@ struct RunReport {
   double slipped = 0;        ///< sim time not run in real time [s]
   int64_t steps = 0;
   int commandsApplied = 0;
+  int commandsRefused = 0;   ///< sequence commands the twin refused when due (each printed and logged)
   bool interrupted = false;
   uint64_t stateHash = 0;    ///< World::stateHash() at the end
   HealthReport health;       ///< why the run stopped early, if it diverged

@@ -49,7 +49,9 @@ constexpr const char* kUsage = R"(usage:
       --csv FILE        write link poses and joint states (rate.csv Hz)
       --log FILE        write a session log (SQLite; samples at rate.log Hz)
       --quiet           no progress lines
-      Exits 0 when the run completed, 1 on bad input, 3 if the twin diverged
+      Exits 0 when the run completed, 1 on bad input (a file, or a sequence
+      command the twin refused when due: each is printed and logged as a
+      "refused" event), 3 if the twin diverged
       (the report names what, where and when), 4 if the CSV could not be
       written whole (a full disk).
   simpartner-sim validate [--out DIR] [--quick] [--params FILE] [--set KEY=VALUE]...
@@ -135,6 +137,7 @@ bool endsWith(const std::string& s, std::string_view suffix) {
 int check(const std::vector<std::string>& files) {
   sp::Diagnostics diag;
   std::optional<sp::RobotModel> robot;
+  std::optional<sp::WorldModel> world;  // when the robot came from a world: its terrain checks terrain edits
   std::vector<std::string> sequences;
   for (const std::string& f : files) {
     if (endsWith(f, ".params")) {
@@ -146,7 +149,10 @@ int check(const std::vector<std::string>& files) {
       const std::string root = sp::xmlRootName(f);
       if (root == "world") {
         auto w = sp::loadWorld(f, diag);
-        if (w && !w->robots.empty() && !robot) robot = w->robots[0].model;
+        if (w && !w->robots.empty() && !robot) {
+          robot = w->robots[0].model;
+          world = std::move(w);
+        }
       } else if (root == "robot" || root.empty()) {
         // Not well-formed XML (root "") is reported by the robot loader.
         auto r = sp::loadRobot(f, diag);
@@ -162,7 +168,10 @@ int check(const std::vector<std::string>& files) {
   }
   for (const std::string& f : sequences) {
     auto seq = sp::loadCommandSequence(f, diag, robot ? &*robot : nullptr);
-    if (seq && robot) sp::checkCommands(*seq, *robot, f, diag);
+    if (seq && world)
+      sp::checkCommands(*seq, *world, f, diag);
+    else if (seq && robot)
+      sp::checkCommands(*seq, *robot, f, diag);
   }
   std::cerr << diag.format();
   const int errors = diag.errorCount();
@@ -305,6 +314,7 @@ int run(const std::vector<std::string>& args) {
   const auto report = sp::runHeadless(o, std::cout, std::cerr, monotonicSeconds, sleepUntilSeconds, &gStop);
   if (!report) return 1;
   if (!report->health.healthy()) return 3;
+  if (report->commandsRefused > 0) return 1;
   return report->csvError.empty() ? 0 : 4;
 }
 
@@ -361,7 +371,7 @@ int rehearseCommand(const std::vector<std::string>& args) {
   std::optional<std::vector<sp::TimedCommand>> commands;
   if (world && !world->robots.empty()) {
     commands = sp::loadCommandSequence(commandsFile, diag, &world->robots[0].model);
-    if (commands) sp::checkCommands(*commands, world->robots[0].model, commandsFile, diag);
+    if (commands) sp::checkCommands(*commands, *world, commandsFile, diag);
   }
   if (diag.hasErrors() || !commands) {
     std::cerr << diag.format();
@@ -377,6 +387,7 @@ int rehearseCommand(const std::vector<std::string>& args) {
   std::cout << "rehearsal of " << commandsFile << " (hash " << sp::sequenceHash(sp::sequenceText(*commands, &world->robots[0].model))
             << ") on " << worldFile << ": " << r.duration << " s simulated in " << r.wallSeconds << " s\n";
   for (const sp::RuleVerdict& v : r.verdicts) std::cout << "  " << (v.passed ? "pass  " : "FAIL  ") << v.message() << "\n";
+  for (const std::string& why : r.refused) std::cerr << commandsFile << ": error: refused: " << why << "\n";
   std::cout << (r.passed ? "passed" : "failed: " + r.summary()) << "\n";
   if (robust > 0) {
     const sp::RobustnessResult rob = sp::robustness(plan, 1, 2);

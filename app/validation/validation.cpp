@@ -478,7 +478,7 @@ ExperimentResult pickAndPlace(const ValidationOptions& o) {
   Diagnostics diag;
   const std::string seqFile = o.sourceDir + "/terrains/pick_place.seq";
   auto seq = loadCommandSequence(seqFile, diag, &model.robots[0].model);
-  if (!seq || !checkCommands(*seq, model.robots[0].model, seqFile, diag)) throw std::runtime_error(diag.format());
+  if (!seq || !checkCommands(*seq, model, seqFile, diag)) throw std::runtime_error(diag.format());
   int pole = -1;
   for (size_t i = 0; i < model.objects.size(); ++i)
     if (!model.objects[i].isStatic) pole = static_cast<int>(i);

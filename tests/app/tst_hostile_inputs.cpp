@@ -255,6 +255,33 @@ class TestHostileInputs : public QObject {
     QVERIFY2(r.exit == 0, qPrintable(r.err));
   }
 
+  // Issue 30: a terrain edit outside the world's 81 x 81 heightfield is
+  // refused at its line by check, run and rehearse (it used to vanish: 0
+  // errors, "0 commands applied", exit 0), and on a plane world too.
+  // Control: the same edit inside the grid checks, runs and rehearses.
+  void terrainEditsOutsideTheGrid() {
+    const QString bumpy = QStringLiteral(SP_SOURCE_DIR "/terrains/bumpy.world.xml");
+    const QString flat = QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml");
+    const QString seq = dir_.filePath(QStringLiteral("edit.seq"));
+    write(seq, "0.2 terrain 200 200 2 2 0.1 0.1 0.1 0.1\n");
+    const QString outside = seq + ":1: error: terrain: the patch (columns 200..201, rows 200..201) lies outside the 81 x 81 heightfield";
+    for (const QStringList& args : {QStringList{"check", bumpy, seq},
+                                    QStringList{"run", "--world", bumpy, "--commands", seq, "--rtf", "max", "--duration", "1"},
+                                    QStringList{"rehearse", "--world", bumpy, "--commands", seq}}) {
+      const Run r = tool(QStringLiteral("simpartner-sim"), args);
+      QVERIFY2(r.exit == 1 && r.err.contains(outside), qPrintable(args.join(' ') + ": " + r.err));
+    }
+    Run r = tool(QStringLiteral("simpartner-sim"), {"check", flat, seq});
+    QVERIFY2(r.exit == 1 && r.err.contains(seq + ":1: error: terrain: the world's terrain is a plane"), qPrintable(r.err));
+    write(seq, "0.2 terrain 10 10 2 2 0.1 0.1 0.1 0.1\n");
+    for (const QStringList& args : {QStringList{"check", bumpy, seq},
+                                    QStringList{"run", "--world", bumpy, "--commands", seq, "--rtf", "max", "--duration", "1"}}) {
+      r = tool(QStringLiteral("simpartner-sim"), args);
+      QVERIFY2(r.exit == 0, qPrintable(args.join(' ') + ": " + r.err));
+    }
+    QVERIFY2(r.out.contains("1 commands applied"), qPrintable(r.out));
+  }
+
   // logcheck: a log without its samples is not ok. Control: the log is.
   void logcheckWantsSamples() {
     Run r = tool(QStringLiteral("simpartner-logcheck"), {log_});
