@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <mutex>
 #include <thread>
 
@@ -131,6 +132,65 @@ std::string placeRobot(World& world, const RehearsalStart& s, const RigidRobot* 
   return why;
 }
 
+namespace {
+
+// The state rehearsals start from, read off `w` (robot 0, the objects).
+RehearsalStart stateOf(const World& w) {
+  const RobotModel& robot = w.robotModel(0);
+  RehearsalStart s;
+  s.base = w.linkPose(0, 0);
+  s.baseLinear = w.linkLinearVelocity(0, 0);
+  s.baseAngular = w.linkAngularVelocity(0, 0);
+  for (size_t j = 0; j < robot.joints.size(); ++j) {
+    s.jointPositions.push_back(w.jointPosition(0, static_cast<int>(j)));
+    s.jointRates.push_back(w.jointRate(0, static_cast<int>(j)));
+  }
+  for (size_t o = 0; o < w.model().objects.size(); ++o)
+    s.objects.emplace_back(w.model().objects[o].name, w.objectPose(static_cast<int>(o)));
+  return s;
+}
+
+}  // namespace
+
+std::optional<SettledStart> settleWorldStart(const WorldModel& model, const SimParams& params, std::string& why) {
+  Diagnostics diag;
+  std::unique_ptr<World> w = World::create(model, params, diag);
+  if (!w) {
+    why = "cannot build the twin: " + diag.format();
+    return std::nullopt;
+  }
+  // Still: the base stays within kSettleDrift of where it was kSettleStill
+  // ago (its velocity alone chatters by a centimetre a second on rough
+  // ground while it goes nowhere).
+  const size_t window = static_cast<size_t>(std::max<int64_t>(1, std::llround(kSettleStill / params.step)));
+  std::deque<Vec3> recent;
+  std::string last = "it never touched the ground";
+  while (w->time() < kSettleLimit) {
+    if (!w->step()) {
+      why = "the twin diverged while the robot settled: " + w->health().message();
+      return std::nullopt;
+    }
+    bool grounded = false;
+    for (const LinkContact& c : w->linkContacts()) grounded = grounded || (c.robot == 0 && (c.terrain || c.object >= 0));
+    recent.push_back(w->linkPose(0, 0).p);
+    if (recent.size() > window + 1) recent.pop_front();
+    if (!grounded) {
+      recent.clear();
+      continue;
+    }
+    double drift = 0;
+    for (const Vec3& p : recent) drift = std::max(drift, norm(p - recent.front()));
+    if (recent.size() > window && drift <= kSettleDrift) return SettledStart{stateOf(*w), w->time()};
+    char text[120];
+    std::snprintf(text, sizeof text, "its base still moved %.1f mm in the last %.1f s", drift * 1000, kSettleStill);
+    last = text;
+  }
+  char text[80];
+  std::snprintf(text, sizeof text, "the robot did not settle within %.0f s of the world's start: ", kSettleLimit);
+  why = text + last;
+  return std::nullopt;
+}
+
 RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress) {
   const auto t0 = Clock::now();
   RehearsalResult result;
@@ -142,10 +202,22 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   // and acts on each command its delay after it is due, as the robot does.
   const WorldModel calibrated = calibratedWorld(plan.world, plan.params);
   const RobotModel& full = calibrated.robots[0].model;
-  if (plan.start && (plan.start->jointPositions.size() != full.joints.size() ||
-                     plan.start->jointRates.size() != full.joints.size())) {
-    result.error = "the start state has " + std::to_string(plan.start->jointPositions.size()) +
-                   " joints, the robot " + std::to_string(full.joints.size());
+  std::optional<RehearsalStart> start = plan.start;
+  if (!start) {
+    // A world places its robot above the ground: judged there, before it
+    // has landed, every sequence failed at t = 0. It settles first.
+    std::string why;
+    const std::optional<SettledStart> settled = settleWorldStart(calibrated, plan.params, why);
+    if (!settled) {
+      result.error = why;
+      return result;
+    }
+    start = settled->state;
+    result.settled = settled->seconds;
+  }
+  if (start->jointPositions.size() != full.joints.size() || start->jointRates.size() != full.joints.size()) {
+    result.error = "the start state has " + std::to_string(start->jointPositions.size()) + " joints, the robot " +
+                   std::to_string(full.joints.size());
     return result;
   }
   // The joints the sequence leaves alone, welded where the start has them.
@@ -154,7 +226,7 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   if (plan.holdUnmoved) {
     const std::vector<int> held = unmovedJoints(full, plan.commands);
     std::string why;
-    const std::vector<double> at = plan.start ? plan.start->jointPositions : std::vector<double>(full.joints.size(), 0.0);
+    const std::vector<double>& at = start->jointPositions;
     if (!held.empty() && (rigid = holdRigid(full, at, held, why))) {
       model.robots[0].model = rigid->model;
       result.heldJoints = static_cast<int>(held.size());
@@ -168,11 +240,9 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   }
   const RobotModel& robot = world->robotModel(0);
   const RigidRobot* held = rigid ? &*rigid : nullptr;
-  if (plan.start) {
-    if (std::string why = placeRobot(*world, *plan.start, held); !why.empty()) {
-      result.error = "the start state does not fit: " + why;
-      return result;
-    }
+  if (std::string why = placeRobot(*world, *start, held); !why.empty()) {
+    result.error = "the start state does not fit: " + why;
+    return result;
   }
   result.duration = (plan.commands.empty() ? 0.0 : plan.commands.back().time) + plan.params.calDelay + plan.rules.settle;
   RuleMonitor monitor(plan.rules, robot);

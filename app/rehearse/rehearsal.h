@@ -47,7 +47,8 @@ struct RehearsalPlan {
   SimParams params;
   FlightRules rules;
   std::vector<TimedCommand> commands;  ///< times from the start, non-decreasing
-  /// nullopt = the world's own initial state (the stand-in at rest).
+  /// nullopt = the world's own initial state, settled first
+  /// (settleWorldStart; RehearsalResult::settled says how long).
   std::optional<RehearsalStart> start;
   /// Hold rigid the joints no command of the sequence moves (whole
   /// subtrees without drive joints: an arm, the head; sim/rigid.h), for
@@ -57,6 +58,20 @@ struct RehearsalPlan {
 
 class World;
 struct RigidRobot;
+
+/// A world's start settled: the robot let down onto the ground (worlds
+/// place it a little above) until it touches it and its base stays within
+/// kSettleDrift over kSettleStill, at most kSettleLimit of sim time.
+struct SettledStart {
+  RehearsalStart state;
+  double seconds = 0;  ///< [s] sim time it took
+};
+constexpr double kSettleLimit = 5;      ///< [s] a robot still moving then is its own verdict
+constexpr double kSettleStill = 0.5;    ///< [s] the window the base must stay within kSettleDrift over
+constexpr double kSettleDrift = 0.003;  ///< [m]
+/// nullopt and `why` (off the ground, or how fast the base still moves)
+/// when it does not settle, or the twin diverges.
+std::optional<SettledStart> settleWorldStart(const WorldModel& world, const SimParams& params, std::string& why);
 
 /// Puts robot 0 of `world` in `start` (links' poses and velocities, the
 /// objects named) with its controllers holding that pose: position joints
@@ -90,6 +105,9 @@ struct RehearsalResult {
   double wallSeconds = 0;  ///< what it took
   uint64_t endHash = 0;    ///< World::stateHash() at the end
   int heldJoints = 0;      ///< joints held rigid (plan.holdUnmoved)
+  /// [s] how long the robot settled from the world's start before t = 0
+  /// (0 when the plan gave a start).
+  double settled = 0;
   /// Commands the twin refused when due ("line N at T s: why"): a
   /// rehearsal with any does not pass (the robot would refuse them too).
   std::vector<std::string> refused;

@@ -74,7 +74,10 @@ constexpr const char* kUsage = R"(usage:
   simpartner-sim rehearse --world FILE --commands SEQ [options]
       Rehearses a command sequence on the twin from the world's start, as
       fast as it goes, checking the flight rules after every step, and prints
-      each rule's verdict (first violation, or closest approach).
+      each rule's verdict (first violation, or closest approach). The robot
+      first settles from where the world places it (until its base stays
+      within 3 mm for 0.5 s, at most 5 s: it says how long); t = 0 is then.
+      One that does not settle is refused (exit 1, saying why).
       --rules FILE      flight rules (default: built-in, see config/flight.rules)
       --params FILE, --set KEY=VALUE   as for run
       --robust N        also N perturbed rehearsals (ranges robust.* of the rules)
@@ -385,7 +388,8 @@ int rehearseCommand(const std::vector<std::string>& args) {
     return 1;
   }
   std::cout << "rehearsal of " << commandsFile << " (hash " << sp::sequenceHash(sp::sequenceText(*commands, &world->robots[0].model))
-            << ") on " << worldFile << ": " << r.duration << " s simulated in " << r.wallSeconds << " s\n";
+            << ") on " << worldFile << ": " << r.duration << " s simulated in " << r.wallSeconds << " s, after "
+            << r.settled << " s for the robot to settle from the world's start\n";
   for (const sp::RuleVerdict& v : r.verdicts) std::cout << "  " << (v.passed ? "pass  " : "FAIL  ") << v.message() << "\n";
   for (const std::string& why : r.refused) std::cerr << commandsFile << ": error: refused: " << why << "\n";
   std::cout << (r.passed ? "passed" : "failed: " + r.summary()) << "\n";
