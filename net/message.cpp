@@ -200,6 +200,7 @@ void forEachField(M& m, F& f) {
     f("pitch", m.pitch, R);
     f("rtt_ms", m.rttMs, R);
     f("lost", m.lost, R);
+    f("heard_ms", m.heardMs, Need::Optional);
     f("failsafe", m.failsafe, R);
     f("estop", m.estop, R);
     f("health", m.health, Need::Optional);
@@ -698,7 +699,8 @@ TelemetryFanOut::TelemetryFanOut(const TelemetryMsg& common) {
   tail_ = payload->substr(afterLost);
 }
 
-std::optional<std::string> TelemetryFanOut::frame(uint64_t seq, double rttMs, uint64_t lost, std::string& error) const {
+std::optional<std::string> TelemetryFanOut::frame(uint64_t seq, double rttMs, uint64_t lost, std::string& error,
+                                                  double heardMs) const {
   if (!error_.empty()) {
     error = error_;
     return std::nullopt;
@@ -713,6 +715,11 @@ std::optional<std::string> TelemetryFanOut::frame(uint64_t seq, double rttMs, ui
   payload += "\nlost=";
   appendNumber(payload, lost);
   payload += '\n';
+  if (heardMs > 0) {
+    payload += "heard_ms=";
+    appendNumber(payload, heardMs);
+    payload += '\n';
+  }
   payload += tail_;
   return frameOf(MessageType::Telemetry, payload, error);
 }

@@ -170,6 +170,10 @@ struct TelemetryMsg {
   double roll = 0, pitch = 0;  ///< [rad], body inclination
   double rttMs = 0;            ///< [ms] round trip to this client, as the robot measures it
   uint64_t lost = 0;           ///< telemetry frames the robot dropped for this client
+  /// [ms] the lease holder's frames only (optional key `heard_ms`): since the
+  /// robot last received its keep-alive or command, the gap the deadman
+  /// judges; 0 = absent (not the holder, or before its first after the grant).
+  double heardMs = 0;
   bool failsafe = false;       ///< the deadman failsafe is latched
   bool estop = false;          ///< an e-stop is latched
   std::string health;          ///< empty when healthy, else why the twin stopped
@@ -295,10 +299,12 @@ std::optional<std::string> encodeMessage(const Message& message, std::string& er
 /// monitors the controller's round trip (bench/bench_link).
 class TelemetryFanOut {
  public:
-  /// `common`'s seq, rttMs and lost are ignored.
+  /// `common`'s seq, rttMs, lost and heardMs are ignored.
   explicit TelemetryFanOut(const TelemetryMsg& common);
   /// The frame for one client; nullopt and `error` as encodeMessage().
-  std::optional<std::string> frame(uint64_t seq, double rttMs, uint64_t lost, std::string& error) const;
+  /// `heardMs` > 0 adds `heard_ms` (the lease holder's frames).
+  std::optional<std::string> frame(uint64_t seq, double rttMs, uint64_t lost, std::string& error,
+                                   double heardMs = 0) const;
 
  private:
   std::string error_;

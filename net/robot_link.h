@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -138,6 +139,13 @@ class RobotLink {
   bool authenticated(ClientId client) const;
   /// Clients that receive telemetry (every authenticated one).
   std::vector<ClientId> subscribers() const;
+  /// [ms] since the robot last heard a keep-alive or command from
+  /// `client` when it holds the lease and the deadman counts (the gap the
+  /// deadman judges); nullopt otherwise.
+  std::optional<double> heardMs(ClientId client, double now) const {
+    if (client != holder_ || !deadmanArmed_) return std::nullopt;
+    return (now - lastFromHolder_) * 1000;
+  }
   /// Round-trip time to a client from its heartbeat echoes [ms], 0 unknown.
   double rttMs(ClientId client) const;
   /// Counters for logs and tests.

@@ -486,7 +486,9 @@ void RobotServer::onTimer() {
     m.objects = std::move(st.objects);
     const TelemetryFanOut telemetry(m);
     fanOut(&Session::telemetrySeq, [&](Session& s, ClientId id, std::string& error) {
-      return telemetry.frame(s.telemetrySeq, link_.rttMs(id), s.lost, error);
+      // At least a microsecond: 0 would read as absent.
+      const std::optional<double> heard = link_.heardMs(id, t);
+      return telemetry.frame(s.telemetrySeq, link_.rttMs(id), s.lost, error, heard ? std::max(*heard, 1e-3) : 0);
     });
   }
   if (std::optional<LaserScanState> scan = robot_.laserAfter(lastLaser_)) {

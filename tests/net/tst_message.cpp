@@ -123,6 +123,16 @@ void TestMessage::fanOutEqualsEncodeMessage() {
     m.lost = lost;
     QCOMPARE(telemetryOut.frame(seq, rtt, lost, error).value_or(error), encodeMessage(m, error).value_or("?"));
   }
+  // The lease holder's frames add heard_ms (issue 30), and it reads back.
+  m.heardMs = 48.5;
+  const std::optional<std::string> holder = telemetryOut.frame(m.seq, m.rttMs, m.lost, error, m.heardMs);
+  QCOMPARE(holder.value_or(error), encodeMessage(m, error).value_or("?"));
+  FrameDecoder decoder;
+  decoder.feed(holder->data(), holder->size());
+  const std::optional<Message> back = decodeMessage(*decoder.next(), error);
+  QVERIFY2(back, error.c_str());
+  QCOMPARE(std::get<TelemetryMsg>(*back).heardMs, 48.5);
+  m.heardMs = 0;
   LaserMsg laser{0, 1.25, -2.356194490192345, 0.004363323129985824, {1.5, 0.25, 30}};
   const LaserFanOut laserOut(laser);
   for (uint64_t seq : {1u, 2u, 1000000u}) {

@@ -308,6 +308,46 @@ class TestRobotServer : public QObject {
     QVERIFY(states(monitor, 0.3).empty());
   }
 
+  // Issue 30: the lease holder learns how its keep-alives arrive: its
+  // TELEMETRY carries heard_ms, the gap the deadman judges (under 100 ms
+  // while it sends every 20 ms; past 150 ms once it stops, before the
+  // 500 ms deadman fires); a monitor's frames carry none.
+  void holderSeesWhatTheDeadmanSees() {
+    Robot robot({}, {}, [](RobotServerConfig& c) { c.link.deadman = 0.5; });
+    Client op(robot.server->port()), monitor(robot.server->port());
+    op.hello(Role::Control, "operator");
+    monitor.hello(Role::Monitor, "monitor");
+    op.send(LeaseAcquireMsg{});
+    const auto heard = [&](double seconds, bool keepAlive) {
+      std::vector<double> out;
+      const auto t0 = Clock::now();
+      while (::seconds(t0) < seconds) {
+        if (keepAlive) op.send(LeaseKeepaliveMsg{});
+        const auto slice = Clock::now();
+        while (::seconds(slice) < 0.02)
+          if (auto m = op.next(0.005); m && std::holds_alternative<TelemetryMsg>(*m))
+            out.push_back(std::get<TelemetryMsg>(*m).heardMs);
+      }
+      return out;
+    };
+    const std::vector<double> alive = heard(0.6, true);
+    QVERIFY(alive.size() > 10);
+    // The first frames may precede the first keep-alive's arrival.
+    const double worstAlive = *std::max_element(alive.begin() + 3, alive.end());
+    QVERIFY2(worstAlive > 0 && worstAlive < 100, qPrintable(QString::number(worstAlive)));
+    const std::vector<double> silent = heard(0.3, false);
+    QVERIFY(!silent.empty());
+    const double worstSilent = *std::max_element(silent.begin(), silent.end());
+    QVERIFY2(worstSilent > 150 && worstSilent < 500, qPrintable(QString::number(worstSilent)));
+    int monitorFrames = 0;
+    while (auto m = monitor.next(0.01))
+      if (const auto* t = std::get_if<TelemetryMsg>(&*m)) {
+        ++monitorFrames;
+        QCOMPARE(t->heardMs, 0.0);
+      }
+    QVERIFY(monitorFrames > 10);
+  }
+
   // Issue 30: a proof in upper-case hex opens the connection as the
   // lower-case one does; the same proof one digit off is refused.
   void proofInEitherCase() {
