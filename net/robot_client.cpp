@@ -6,6 +6,8 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <deque>
 #include <map>
 #include <mutex>
@@ -28,6 +30,21 @@ const char* toString(ConnectionState state) {
     case ConnectionState::Refused: return "refused";
   }
   return "?";
+}
+
+std::string linkAdvice(double deadman, double keepalive, double stretch) {
+  // Two seconds of frames underrate the worst a session meets (a link that
+  // keeps order also hides its shortest delays): half as much again.
+  const double needed = keepalive + 1.5 * stretch;
+  if (!(deadman > 0) || needed < deadman) return {};
+  const double suggest = std::ceil(1.5 * needed / 0.05) * 0.05;
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "this link's delay varies by %.0f ms: keep-alives every %.0f ms may arrive %.0f ms apart or more, and "
+                "the robot's deadman (%.0f ms) would fire now and then. Set link.deadman=%.2f on the robot "
+                "(docs/protocol.md, settings per link)",
+                stretch * 1000, keepalive * 1000, needed * 1000, deadman * 1000, suggest);
+  return text;
 }
 
 namespace {
@@ -464,6 +481,10 @@ class RobotClient::Impl {
     backoff_ = config_.reconnectMin;
     rateWindowStart_ = now();
     rateWindowCount_ = 0;
+    readyAt_ = now();
+    minOffset_ = INFINITY;
+    maxOffset_ = -INFINITY;
+    linkChecked_ = false;
     updateStats([&](RobotClientStats& s) {
       s.robot = m.robot;
       s.telemetryRateAnnounced = m.telemetryRate;
@@ -498,6 +519,7 @@ class RobotClient::Impl {
   }
 
   void handle(const TelemetryMsg& m) {
+    checkLink(m.time);
     uint64_t lost = 0;
     if (haveTelemetrySeq_ && m.seq > lastTelemetrySeq_ + 1) lost = m.seq - lastTelemetrySeq_ - 1;
     if (!haveTelemetrySeq_ || m.seq > lastTelemetrySeq_) lastTelemetrySeq_ = m.seq;
@@ -510,6 +532,30 @@ class RobotClient::Impl {
       s.robotDropped = m.lost;
     });
     if (cb_.telemetry) cb_.telemetry(m);
+  }
+
+  // The first kLinkCheckSeconds of telemetry after WELCOME: arrival minus
+  // the frame's robot time is the one-way delay plus a constant, so its
+  // spread is what the link's jitter can add to a gap between two frames
+  // (gaps between arrivals alone underrate it: the link keeps order). Then,
+  // once, whether our keep-alives so stretched fit the robot's deadman.
+  void checkLink(double robotTime) {
+    const double t = now();
+    if (linkChecked_ || !ready_) return;
+    const double offset = t - robotTime;
+    minOffset_ = std::min(minOffset_, offset);
+    maxOffset_ = std::max(maxOffset_, offset);
+    if (t - readyAt_ < kLinkCheckSeconds) return;
+    linkChecked_ = true;
+    const RobotClientStats s = stats();
+    // Our own emulated link's jitter stretches what we send, not what we get.
+    const double stretch = std::max(maxOffset_ - minOffset_, 2 * config_.emulation.jitter);
+    const std::string advice = linkAdvice(s.robotDeadman, keepaliveInterval_, std::max(0.0, stretch));
+    updateStats([&](RobotClientStats& st) {
+      st.delaySpreadMs = std::max(0.0, stretch) * 1000;
+      st.linkWarning = advice;
+    });
+    if (!advice.empty() && cb_.error) cb_.error(ErrorMsg{"client: " + advice});
   }
 
   void handle(const LaserMsg& m) {
@@ -638,6 +684,8 @@ class RobotClient::Impl {
   uint64_t lastTelemetrySeq_ = 0;
   double rateWindowStart_ = 0;
   uint64_t rateWindowCount_ = 0;
+  double readyAt_ = 0, minOffset_ = INFINITY, maxOffset_ = -INFINITY;  // [s] the link check (checkLink)
+  bool linkChecked_ = false;
 };
 
 RobotClient::RobotClient(RobotClientConfig config, RobotClientCallbacks callbacks)

@@ -110,7 +110,25 @@ struct RobotClientStats {
   uint64_t commandsSent = 0;          ///< COMMANDs written (or handed to the emulated link)
   uint64_t repliesReceived = 0;       ///< REPLYs from the robot that matched a pending command
   std::string lastError;              ///< the last connection problem or robot ERROR, for the operator
+  /// [ms] the spread of the one-way delay (arrival minus robot time) of
+  /// the telemetry over the first kLinkCheckSeconds of this connection: as
+  /// much as the link's jitter can stretch a gap between two frames sent
+  /// at a steady rate (our keep-alives too, the other way); 0 before.
+  double delaySpreadMs = 0;
+  /// "" or, once per connection after kLinkCheckSeconds, why this link
+  /// cannot carry the robot's deadman and the setting that would
+  /// (linkAdvice); also sent as a `client: ` notice through `error`.
+  std::string linkWarning;
 };
+
+/// [s] telemetry looked at after WELCOME before the link is judged.
+constexpr double kLinkCheckSeconds = 2.0;
+/// "" when keep-alives every `keepalive` [s], on a link whose one-way delay
+/// was seen to vary by `stretch` [s] (1.5 times that taken as its worst),
+/// stay within the robot's `deadman` [s]; else what will happen and the
+/// setting to use (`link.deadman` at 1.5 times what the gaps need, rounded
+/// up to 50 ms). `deadman` 0 (not announced): "".
+std::string linkAdvice(double deadman, double keepalive, double stretch);
 
 /// Callbacks of a RobotClient, each optional (empty = not called). All run
 /// on the client's worker thread (see the file comment); a callback must

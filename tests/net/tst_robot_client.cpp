@@ -51,10 +51,11 @@ class RobotProcess {
   // Starts it (--port 0: the robot picks a free port and prints it; no
   // session log) and waits for `listening on 127.0.0.1:PORT`; "" on
   // success, else why not.
-  QString start() {
+  QString start(const QStringList& extra = {}) {
     process_.setProgram(robotExecutable());
-    process_.setArguments({"--world", SP_SOURCE_DIR "/terrains/flat.world.xml", "--port", "0", "--token",
-                           QString::fromStdString(kToken), "--no-log"});
+    process_.setArguments(QStringList{"--world", SP_SOURCE_DIR "/terrains/flat.world.xml", "--port", "0", "--token",
+                                      QString::fromStdString(kToken), "--no-log"} +
+                          extra);
     process_.setWorkingDirectory(SP_SOURCE_DIR);
     process_.start();
     if (!process_.waitForStarted(10000)) return "cannot start " + robotExecutable() + ": " + process_.errorString();
@@ -262,7 +263,7 @@ class TestRobotClient : public QObject {
  private slots:
   void init() {
     const QString fn = QTest::currentTestFunction();
-    if (fn.startsWith("fake") || fn == "backoffWithoutRobot") return;  // no robot needed
+    if (fn.startsWith("fake") || fn == "backoffWithoutRobot" || fn.startsWith("link")) return;  // none, or its own
     robot_ = std::make_unique<RobotProcess>();
     const QString error = robot_->start();
     QVERIFY2(error.isEmpty(), qPrintable(error));
@@ -311,6 +312,46 @@ class TestRobotClient : public QObject {
     const RobotClientStats s = c.client.stats();
     QVERIFY2(std::abs(s.telemetryRateHz - s.telemetryRateAnnounced) < 0.2 * s.telemetryRateAnnounced,
              qPrintable(QString("measured %1 Hz, announced %2").arg(s.telemetryRateHz).arg(s.telemetryRateAnnounced)));
+  }
+
+  // Issue 30: over a planetary link (the robot emulating 1 s +- 0.1 each
+  // way) with the LAN's 200 ms deadman, the client says at connect time,
+  // before any failsafe, that the deadman will fire and which setting
+  // carries the link; with the table's 0.5 s it says nothing (the control).
+  void linkTooJitteryForTheDeadman() {
+    for (const char* deadman : {"0.2", "0.5"}) {
+      RobotProcess robot;
+      const QString error = robot.start({"--delay", "1", "--jitter", "0.1", "--set", QString("link.deadman=") + deadman});
+      QVERIFY2(error.isEmpty(), qPrintable(error));
+      Client c(clientConfig(robot.port(), "far", Role::Monitor));
+      QVERIFY(c.waitReady(8000ms));
+      std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(kLinkCheckSeconds * 1000) + 500));
+      const RobotClientStats s = c.client.stats();
+      qInfo("deadman %s s: delay spread %.0f ms; %s", deadman, s.delaySpreadMs, s.linkWarning.c_str());
+      QVERIFY2(s.delaySpreadMs > 100 && s.delaySpreadMs < 300, qPrintable(QString::number(s.delaySpreadMs)));
+      const bool warned = c.rec.read([&] {
+        return std::any_of(c.rec.errors.begin(), c.rec.errors.end(),
+                           [](const ErrorMsg& e) { return e.reason.rfind("client: this link's delay varies", 0) == 0; });
+      });
+      if (std::string(deadman) == "0.2") {
+        QVERIFY(warned);
+        QVERIFY2(s.linkWarning.find("Set link.deadman=0.") != std::string::npos, s.linkWarning.c_str());
+      } else {
+        QVERIFY(!warned);
+        QVERIFY(s.linkWarning.empty());
+      }
+    }
+  }
+
+  // The advice's arithmetic: keep-alives every 50 ms on a delay seen to
+  // vary by 140 ms need 50 + 1.5 x 140 = 260 ms; at 1.5 times that,
+  // rounded up to 50 ms: 0.40 s.
+  void linkAdviceNamesTheSetting() {
+    QVERIFY(linkAdvice(0.2, 0.05, 0.09).empty());  // 185 ms < 200: fits
+    QVERIFY(linkAdvice(0, 0.05, 5).empty());       // no deadman announced
+    const std::string a = linkAdvice(0.2, 0.05, 0.14);
+    QVERIFY2(a.find("Set link.deadman=0.40 on the robot") != std::string::npos, a.c_str());
+    QVERIFY2(a.find("may arrive 260 ms apart") != std::string::npos, a.c_str());
   }
 
   // Round trips are measured from our heartbeats' echoes, and the robot
