@@ -734,6 +734,17 @@ void readContact(const XMLElement* e, WorldModel& world, std::string_view file, 
   r.within("soft_erp", 0, 1);
   c.softCfm = r.number("soft_cfm", -1);
   r.nonNegative("soft_cfm");
+  c.stiffness = r.number("stiffness", 0);
+  r.nonNegative("stiffness");
+  c.damping = r.number("damping", 0);
+  r.nonNegative("damping");
+  // A spring without its damper rings for ever, a damper alone holds nothing.
+  if ((e->Attribute("stiffness") != nullptr) != (e->Attribute("damping") != nullptr))
+    r.error("stiffness and damping go together: give both or neither");
+  else if (e->Attribute("stiffness") && (c.stiffness <= 0 || c.damping <= 0))
+    r.error("stiffness and damping must both be > 0");
+  if (e->Attribute("stiffness") && (e->Attribute("soft_erp") || e->Attribute("soft_cfm")))
+    r.error("stiffness and damping set soft_erp and soft_cfm: give one or the other");
   c.rollingResistance = r.number("rolling_resistance", 0);
   r.nonNegative("rolling_resistance");
   c.motionResistance = r.number("motion_resistance", 0);

@@ -143,6 +143,10 @@ struct ContactSpec {
   double bounceVelocity = 0.1;  ///< minimum speed for a bounce [m/s]
   double softErp = -1;    ///< < 0: the world's ERP
   double softCfm = -1;    ///< < 0: the world's CFM
+  /// A compliant contact, per contact point: a spring [N/m] and damper
+  /// [N s/m] (a tyre's), set as ODE's soft ERP and CFM for the step; 0:
+  /// none (soft_erp, soft_cfm or the world's). Both or neither.
+  double stiffness = 0, damping = 0;
   double rollingResistance = 0;  ///< [m], resisting torque = this x normal force
   /// Motion resistance of a wheel on the surface (snow, sand): a force C x
   /// normal force against the wheel's travel. On a robot's cylinder or

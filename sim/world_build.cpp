@@ -43,7 +43,7 @@ dMass massOf(const std::vector<GeomSpec>& geoms, double total) {
   return sum;
 }
 
-dSurfaceParameters toSurface(const ContactSpec& c) {
+dSurfaceParameters toSurface(const ContactSpec& c, double step) {
   dSurfaceParameters s{};
   s.mode = dContactApprox1;
   s.mu = c.mu;
@@ -59,6 +59,14 @@ dSurfaceParameters toSurface(const ContactSpec& c) {
   if (c.softCfm >= 0) {
     s.mode |= dContactSoftCFM;
     s.soft_cfm = c.softCfm;
+  }
+  if (c.stiffness > 0) {
+    // The spring-damper a step of h makes of ERP and CFM (ODE's manual,
+    // "Soft constraint and constraint force mixing").
+    const double hk = step * c.stiffness;
+    s.mode |= dContactSoftERP | dContactSoftCFM;
+    s.soft_erp = hk / (hk + c.damping);
+    s.soft_cfm = 1 / (hk + c.damping);
   }
   if (c.rollingResistance > 0) {
     // Without dContactAxisDep ODE applies rho about all three axes, the
@@ -174,7 +182,7 @@ bool World::build(Diagnostics& diag) {
       const std::string& na = a < 0 ? std::string() : model_.materials[a];
       const std::string& nb = b < 0 ? std::string() : model_.materials[b];
       const ContactSpec& c = model_.contactFor(na, nb);
-      m.surfaces[static_cast<size_t>((a + 1) * n + (b + 1))] = toSurface(c);
+      m.surfaces[static_cast<size_t>((a + 1) * n + (b + 1))] = toSurface(c, params_.step);
       m.resistances[static_cast<size_t>((a + 1) * n + (b + 1))] = {c.motionResistance, c.motionResistanceSliding};
     }
 

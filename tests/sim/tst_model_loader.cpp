@@ -431,6 +431,16 @@ void TestModelLoader::testWorldErrors_data() {
   <terrain type="plane"/>
   <contact default="true" mu="-0.1"/>
 </world>)") << "w.xml:3: error: <contact>: mu must be >= 0, got -0.1\n";
+  QTest::newRow("stiffness without damping") << QByteArray(R"(<world name="w">
+  <terrain type="plane"/>
+  <contact default="true" stiffness="75000"/>
+</world>)") << "w.xml:3: error: <contact>: stiffness and damping go together: give both or neither\n";
+  QTest::newRow("stiffness with soft_cfm, negative damping") << QByteArray(R"(<world name="w">
+  <terrain type="plane"/>
+  <contact default="true" stiffness="75000" damping="-1" soft_cfm="0.001"/>
+</world>)") << "w.xml:3: error: <contact>: damping must be >= 0, got -1\n"
+               "w.xml:3: error: <contact>: stiffness and damping must both be > 0\n"
+               "w.xml:3: error: <contact>: stiffness and damping set soft_erp and soft_cfm: give one or the other\n";
   QTest::newRow("contact with one material") << QByteArray(R"(<world name="w">
   <material name="ice"/>
   <terrain type="plane"/>

@@ -3,7 +3,10 @@
 
 #include <QtTest>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "sim/model_loader.h"
 #include "sim/world.h"
@@ -33,6 +36,50 @@ class TestWorkPartner : public QObject {
   Q_OBJECT
 
  private slots:
+  // Issue 30: with compliant tyres (contact stiffness and damping, 75 kN/m
+  // and 900 N s/m per contact point) each wheel carries its static share
+  // within +-5 % on flat ground at a steady 0.25 m/s: the compliance makes
+  // the four-wheel load determinate. The shipped world's rigid contacts
+  // swing the loads between the diagonals (234-911 N about 510-620): the
+  // control, and what the worlds still do (docs/formats.md says why).
+  void wheelLoadsSteadyAtConstantSpeed() {
+    Diagnostics diag;
+    std::optional<WorldModel> model = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
+    QVERIFY2(model, diag.format().c_str());
+    const auto worst = [](const WorldModel& m) {
+      Diagnostics d;
+      auto world = World::create(m, SimParams{}, d);
+      const RobotModel& robot = world->robotModel(0);
+      std::vector<int> sensors;
+      for (size_t i = 0; i < robot.sensors.size(); ++i)
+        if (robot.sensors[i].type == SensorType::WheelForce) sensors.push_back(static_cast<int>(i));
+      const auto normal = [&](int k) { return std::get<WheelForceReading>(world->sensorSample(0, sensors[k]).value).normal; };
+      std::vector<double> standing(sensors.size(), 0);
+      stepFor(*world, 2);
+      for (int i = 0; i < 100; ++i) {  // the static share: a second standing
+        stepFor(*world, 0.01);
+        for (size_t k = 0; k < sensors.size(); ++k) standing[k] += normal(static_cast<int>(k)) / 100;
+      }
+      world->submit(DriveCmd{0.25, 0});
+      stepFor(*world, 3);
+      double off = 0;
+      for (int i = 0; i < 500; ++i) {
+        stepFor(*world, 0.01);
+        for (size_t k = 0; k < sensors.size(); ++k) off = std::max(off, std::abs(normal(static_cast<int>(k)) / standing[k] - 1));
+      }
+      return std::make_pair(off, sensors.size());
+    };
+    const double rigid = worst(*model).first;
+    for (ContactSpec& c : model->contacts)
+      if (c.a == "rubber" || c.b == "rubber") c.stiffness = 75000, c.damping = 900;
+    const auto [compliant, wheels] = worst(*model);
+    QCOMPARE(wheels, size_t{4});
+    qInfo("largest wheel load off its static share over 5 s at 0.25 m/s: %.1f %% (rigid contacts: %.1f %%)",
+          compliant * 100, rigid * 100);
+    QVERIFY2(compliant <= 0.05, qPrintable(QString::number(compliant)));
+    QVERIFY2(rigid > 0.2, qPrintable(QString::number(rigid)));  // the control
+  }
+
   // About 230 kg, and the front axle carries more than the rear (55/45 by
   // design: the torso and arms sit on the front half).
   void massAndBalance() {
