@@ -319,6 +319,10 @@ void TestMessage::decodeErrors_data() {
   row("missing reason", 15, "", "ERROR: missing key 'reason'");
   row("negative integer", 7, "seq=-1\nexpires_ms=5\ncommand=stop\n",
       "COMMAND: key 'seq': expected an unsigned integer, got '-1'");
+  // An optional number sent empty is refused (an optional text sent empty
+  // counts as absent: docs/protocol.md, Errors).
+  row("empty optional number", 7, "seq=1\nexpires_ms=5\nsent_ms=\ncommand=stop\n",
+      "COMMAND: key 'sent_ms': expected an unsigned integer, got ''");
   row("integer with plus", 7, "seq=+1\nexpires_ms=5\ncommand=stop\n",
       "COMMAND: key 'seq': expected an unsigned integer, got '+1'");
   row("integer overflow", 7, "seq=18446744073709551616\nexpires_ms=5\ncommand=stop\n",
