@@ -33,6 +33,24 @@ ConsoleMonitor::ConsoleMonitor(RobotConnection* connection, LiveLinkFeed* live, 
       emit robotStopped();
     notify();
   });
+  // An e-stop or re-arm in flight: shown at once, the ghost stops where the
+  // robot will, the controls go back to a stopped robot (they wait for it).
+  const auto landsIn = [this] {
+    const net::RobotClientStats s = connection_->stats();
+    return (s.rttMeanMs > 0 ? s.rttMeanMs : s.rttMs) / 2000;
+  };
+  connect(connection, &RobotConnection::estopSent, this, [this, landsIn] {
+    if (!state_.connected()) return;
+    state_.estopSent(landsIn());
+    session_->estopSent();
+    emit robotStopped();
+    notify();
+  });
+  connect(connection, &RobotConnection::rearmSent, this, [this, landsIn] {
+    if (!state_.connected()) return;
+    state_.rearmSent(landsIn());
+    notify();
+  });
   connect(live, &RobotFeed::frame, this, [this](const RobotFrame& f) {
     if (!session_->robot()) return;
     const FrameChanges changes = state_.frame(f, wallSeconds(), session_->edgeDistance(f.base));

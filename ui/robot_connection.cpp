@@ -94,12 +94,18 @@ void RobotConnection::abortSequence(const QString& hash, const QString& reason) 
 }
 
 void RobotConnection::estop(const QString& reason) {
-  if (client_) client_->estop(reason.toStdString());
-  else emit linkError(tr("console: not connected: the e-stop could not be sent"));
+  if (!client_) {
+    emit linkError(tr("console: not connected: the e-stop could not be sent"));
+    return;
+  }
+  client_->estop(reason.toStdString());
+  emit estopSent();
 }
 
 void RobotConnection::rearm() {
-  if (client_) client_->rearm();
+  if (!client_) return;
+  client_->rearm();
+  emit rearmSent();
 }
 
 void RobotConnection::dropConnection() {

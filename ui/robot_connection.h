@@ -61,6 +61,9 @@ class RobotConnection : public QObject {
   void guardTripped(const QString& hash, const sp::GuardDeparture& departure);
   void connectionChanged(sp::net::ConnectionState state, const QString& detail);
   void linkError(const QString& reason);
+  /// An ESTOP (a REARM) went out to the robot (not when not connected).
+  void estopSent();
+  void rearmSent();
 
  private:
   /// Runs `emitIt` on the GUI thread, unless this object is gone by then.

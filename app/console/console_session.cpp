@@ -281,6 +281,15 @@ void ConsoleSession::commandSent(const Command& command) {
   }
 }
 
+void ConsoleSession::estopSent() {
+  // The robot's e-stop stops every motor as `stop` does, when it lands: the
+  // ghost and the fit see it arrive then, as any command (not logged as
+  // one: the log has the e-stop's event).
+  if (!ghost_) return;
+  if (calibrator_) calibrator_->command(StopCmd{}, ghost_->ghostTime(Ghost::now()));
+  ghost_->commandSent(StopCmd{});
+}
+
 bool ConsoleSession::terrainEdited(const TerrainPatchCmd& patch) {
   if (!terrain_ || !patchFits(&world_->terrain.grid, patch).empty()) return false;
   commandSent(patch);

@@ -172,6 +172,9 @@ class ConsoleSession {
   /// A command went out: logged when the robot is remote (the stand-in logs
   /// what it applies itself), and handed to the ghost.
   void commandSent(const Command& command);
+  /// An e-stop went out: the ghost (and the calibration) stop the robot
+  /// where it lands, as a `stop` sent now.
+  void estopSent();
   /// The console's terrain: the editor of the world's heightfield, which
   /// edits world()'s heights in place (what is drawn, rehearsed and saved),
   /// with its undo history; null on a plane. Replaced with the world.

@@ -25,6 +25,8 @@ bool ConsoleState::connection(net::ConnectionState state, std::string detail) {
     lease_ = false;
     // Staleness is a connected robot that went quiet; a dropped link says so itself.
     stale_ = false;
+    // What was in flight may never land: the banner says the link is down.
+    estopInFlight_ = rearmInFlight_ = false;
   }
   ++revision_;
   return lost;
@@ -73,6 +75,12 @@ FrameChanges ConsoleState::frame(const RobotFrame& f, double wall, std::optional
     shownEdge_ = edge_.value_or(0);
     changes.banner = true;
   }
+  // What was in flight has landed once the robot reports it.
+  if ((estopInFlight_ && f.estop) || (rearmInFlight_ && !f.estop && !f.failsafe)) {
+    estopInFlight_ = estopInFlight_ && !f.estop;
+    rearmInFlight_ = rearmInFlight_ && (f.estop || f.failsafe);
+    changes.banner = true;
+  }
   if (f.failsafe != failsafe_ || f.estop != estop_ || f.health != health_) {
     changes.latchedNow = (f.failsafe && !failsafe_) || (f.estop && !estop_);
     failsafe_ = f.failsafe;
@@ -83,6 +91,20 @@ FrameChanges ConsoleState::frame(const RobotFrame& f, double wall, std::optional
   }
   if (changes.banner) ++revision_;
   return changes;
+}
+
+void ConsoleState::estopSent(double landsIn) {
+  estopInFlight_ = true;
+  rearmInFlight_ = false;
+  estopLandsIn_ = landsIn;
+  ++revision_;
+}
+
+void ConsoleState::rearmSent(double landsIn) {
+  if (!latched()) return;
+  rearmInFlight_ = true;
+  rearmLandsIn_ = landsIn;
+  ++revision_;
 }
 
 bool ConsoleState::tick(double wall) {
@@ -121,8 +143,17 @@ std::vector<std::string> ConsoleState::bannerLines() const {
     lines.push_back("Replay of " + replay_ + ": the live robot is not shown and the drive keys act on nothing. "
                     "Close the replay to drive.");
   if (!health_.empty()) lines.push_back(live + "The twin diverged and stopped: " + health_);
-  if (estop_) lines.push_back(live + "E-STOP latched: the robot is stopped. Re-arm to continue.");
-  if (failsafe_)
+  // In flight first: the operator must see at once that the stop is on
+  // its way, not two seconds later when the robot reports it.
+  if (estopInFlight_)
+    lines.push_back(live + "E-STOP in flight: lands in ~" + fixed(estopLandsIn_, 1) +
+                    " s; the robot drives on until then (the ghost shows where it stops).");
+  if (estop_)
+    lines.push_back(live + (rearmInFlight_ ? "E-STOP latched, re-arm pending: lands in ~" + fixed(rearmLandsIn_, 1) + " s."
+                                           : std::string("E-STOP latched: the robot is stopped. Re-arm to continue.")));
+  if (failsafe_ && rearmInFlight_)
+    lines.push_back(live + "FAILSAFE latched, re-arm pending: lands in ~" + fixed(rearmLandsIn_, 1) + " s.");
+  else if (failsafe_)
     lines.push_back(live + (failsafeReason_.empty()
                                 ? "FAILSAFE latched: the robot stopped itself. Re-arm to continue."
                                 : "FAILSAFE latched: " + failsafeReason_ + "; the robot stopped. Re-arm to continue."));
@@ -143,6 +174,8 @@ std::string ConsoleState::controlsRefusal() const {
   if (replaying()) return "A replay is shown: close it (File ▸ Close replay) to drive the live robot";
   if (!connected()) return "Not connected to the robot";
   if (!lease_) return "Take control first (Robot ▸ Take control)";
+  if (estopInFlight_) return "E-STOP in flight: the robot stops in ~" + fixed(estopLandsIn_, 1) + " s";
+  if (latched() && rearmInFlight_) return "Re-arm pending: it lands in ~" + fixed(rearmLandsIn_, 1) + " s";
   if (latched()) return "The robot is stopped and latched: re-arm first";
   return {};
 }

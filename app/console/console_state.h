@@ -82,6 +82,14 @@ class ConsoleState {
   void clearFrames();
   /// A replay (named `label`) is shown instead of the live robot, or ("") not.
   void replay(std::string label);
+  /// This console sent an e-stop (a re-arm) that lands on the robot in
+  /// about `landsIn` [s] (half the round trip): until a frame shows the
+  /// latch on (off), or the link drops, the banner says it is in flight
+  /// and the controls wait for it.
+  void estopSent(double landsIn);
+  void rearmSent(double landsIn);
+  bool estopInFlight() const { return estopInFlight_; }
+  bool rearmInFlight() const { return rearmInFlight_; }
 
   // --- What the console shows and allows ----------------------------------
   net::ConnectionState connectionState() const { return connection_; }
@@ -131,6 +139,8 @@ class ConsoleState {
   std::string connectionDetail_;
   bool lease_ = false;
   bool failsafe_ = false, estop_ = false;
+  bool estopInFlight_ = false, rearmInFlight_ = false;
+  double estopLandsIn_ = 0, rearmLandsIn_ = 0;  // [s] as said when sent
   std::string health_;
   std::string failsafeReason_;
   std::string filesMismatch_;

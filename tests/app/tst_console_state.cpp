@@ -103,6 +103,36 @@ class TestConsoleState : public QObject {
     QVERIFY(s.bannerLines().empty());
   }
 
+  // An e-stop sent is in flight until a frame shows the latch (issue 31):
+  // the banner says so at once and the controls wait; a re-arm sent is
+  // pending until a frame shows the latch off. A dropped link ends both
+  // (they may never land; the banner says the link is down).
+  void inFlight() {
+    ConsoleState s = driving();
+    s.estopSent(1.04);
+    QVERIFY(s.estopInFlight());
+    QVERIFY(anyLineHas(s.bannerLines(), "E-STOP in flight: lands in ~1.0 s"));
+    QCOMPARE(s.controlsRefusal(), std::string("E-STOP in flight: the robot stops in ~1.0 s"));
+    QVERIFY(!s.frame(frameWith(false, false), 0.5, std::nullopt).latchedNow);  // not landed yet
+    QVERIFY(s.estopInFlight());
+    QVERIFY(s.frame(frameWith(false, true), 2.1, std::nullopt).latchedNow);
+    QVERIFY(!s.estopInFlight());
+    QVERIFY(!anyLineHas(s.bannerLines(), "in flight"));
+    QVERIFY(anyLineHas(s.bannerLines(), "E-STOP latched: the robot is stopped"));
+    s.rearmSent(1.0);
+    QVERIFY(anyLineHas(s.bannerLines(), "E-STOP latched, re-arm pending: lands in ~1.0 s."));
+    QCOMPARE(s.controlsRefusal(), std::string("Re-arm pending: it lands in ~1.0 s"));
+    s.frame(frameWith(false, false), 4.2, std::nullopt);
+    QVERIFY(!s.rearmInFlight());
+    QVERIFY(s.bannerLines().empty());
+    QCOMPARE(s.controlsRefusal(), std::string());
+    s.rearmSent(1.0);  // nothing latched: nothing pending
+    QVERIFY(!s.rearmInFlight());
+    s.estopSent(1.0);
+    s.connection(ConnectionState::Waiting, "timeout");
+    QVERIFY(!s.estopInFlight());
+  }
+
   // Stale: connected, a frame seen, none for longer than staleAfter. The
   // next frame ends it; a replay shown hides the stale line (issue 27: a
   // replay showed "no data 4.8 s" while telemetry arrived at 50 Hz).

@@ -444,6 +444,35 @@ class TestConsole : public QObject {
     QVERIFY(median);
     QVERIFY2(median->first < 0.05, qPrintable(QString::number(median->first)));
 
+    // Esc over the link (issue 31): at once the banner says the e-stop is
+    // in flight, the speed box reads 0 and the controls wait, while the
+    // robot, a one-way trip away, does not know yet; the ghost stops where
+    // the robot will, so that when the robot reports its stop the two
+    // stand together (the ghost used to drive on: 45-125 cm apart).
+    QVERIFY(w.controlPanel()->speed() > 0.3);
+    QTest::keyClick(scene, Qt::Key_Escape);
+    QTRY_VERIFY_WITH_TIMEOUT(w.bannerText().contains(QLatin1String("E-STOP in flight: lands in ~1.0 s")), 300);
+    QCOMPARE(w.controlPanel()->speed(), 0.0);
+    QVERIFY(!w.controlPanel()->controlsEnabled());
+    QVERIFY(!w.lastTelemetry()->estop);
+    const auto still = [&](const std::function<Pose()>& pose) {
+      const Pose a = pose();
+      QTest::qWait(200);
+      return apart(a, pose()) < 0.002;
+    };
+    // The ghost comes to rest before the robot's telemetry reports the stop
+    // (a round trip after Esc), where the robot then stands.
+    QTRY_VERIFY_WITH_TIMEOUT(still([&] { return scene->drawnGhostBasePose(); }), 3000);
+    QVERIFY2(!w.lastTelemetry()->estop, "the ghost stopped only when the robot's report came");
+    const Pose ghostStop = scene->drawnGhostBasePose();
+    QTRY_VERIFY_WITH_TIMEOUT(w.lastTelemetry()->estop, 5000);
+    QTRY_VERIFY(w.bannerText().contains(QLatin1String("E-STOP latched")));
+    QVERIFY(!w.bannerText().contains(QLatin1String("in flight")));
+    QTRY_VERIFY_WITH_TIMEOUT(still([&] { return scene->drawnBasePose(); }), 5000);
+    const double stoppedApart = apart(ghostStop, scene->drawnBasePose());
+    qInfo("the ghost's stop and the robot's: %.3f m apart", stoppedApart);
+    QVERIFY2(stoppedApart < 0.10, qPrintable(QString::number(stoppedApart)));
+
     // View > Ghost hides it and its trail.
     w.ghostAction()->setChecked(false);
     QTest::qWait(100);
