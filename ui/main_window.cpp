@@ -11,6 +11,7 @@
 #include <QKeyEvent>
 #include <QLabel>
 #include <QLineEdit>
+#include <QMenu>
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QScrollArea>
@@ -557,10 +558,17 @@ void MainWindow::refreshStatus() {
 
 bool MainWindow::eventFilter(QObject* watched, QEvent* event) {
   if (event->type() == QEvent::KeyPress && static_cast<QKeyEvent*>(event)->key() == Qt::Key_Escape) {
-    // An open list or menu takes its Esc to close (a replay's signal list
-    // closed with Esc e-stopped the live robot); everywhere else Esc is
-    // the e-stop, dialogs included.
-    if (QApplication::activePopupWidget()) return QMainWindow::eventFilter(watched, event);
+    // An open list (a combo box's) takes its Esc to close: a replay's
+    // signal list closed with Esc e-stopped the live robot.
+    QWidget* popup = QApplication::activePopupWidget();
+    if (popup && !qobject_cast<QMenu*>(popup)) return QMainWindow::eventFilter(watched, event);
+    // A menu open, or the menu bar taking keys, is closed as the robot is
+    // stopped: left open, the next keystrokes went into it (and wrote a
+    // junk note into the session log).
+    for (int i = 0; i < 8; ++i)  // a submenu over its menu: each closes
+      if (auto* menu = qobject_cast<QMenu*>(QApplication::activePopupWidget())) menu->close();
+    if (menuBar()->activeAction()) menuBar()->setActiveAction(nullptr);
+    if (menuBar()->hasFocus()) setFocus();
     if (!static_cast<QKeyEvent*>(event)->isAutoRepeat()) context_->emergencyStop();
     return true;
   }

@@ -5,6 +5,8 @@
 #include <QComboBox>
 #include <QDockWidget>
 #include <QLineEdit>
+#include <QMenu>
+#include <QMenuBar>
 #include <QElapsedTimer>
 #include <QLabel>
 #include <QPlainTextEdit>
@@ -223,6 +225,29 @@ class TestConsole : public QObject {
     QTRY_VERIFY(w.bannerText().isEmpty());
     // Re-arming does not restart the motion.
     QVERIFY(planarSpeedOver(w, 500) < 0.02);
+  }
+
+  // Esc with a menu open (issue 31) both stops the robot and closes the
+  // menu: the keys typed next ("n" for Note) go nowhere near a menu, so no
+  // note dialog opens. Re-armed after.
+  void escClosesAMenuAndStops() {
+    MainWindow& w = *window_;
+    QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->estop, 3000);
+    QMenu* file = w.menuBar()->actions().first()->menu();
+    QVERIFY(file);
+    w.menuBar()->setActiveAction(w.menuBar()->actions().first());
+    QTRY_VERIFY(qobject_cast<QMenu*>(QApplication::activePopupWidget()));
+    QTest::keyClick(QApplication::activePopupWidget(), Qt::Key_Escape);
+    QTRY_VERIFY(!QApplication::activePopupWidget());
+    QVERIFY(!w.menuBar()->activeAction());
+    QTRY_VERIFY_WITH_TIMEOUT(w.bannerText().contains(QLatin1String("E-STOP")), 3000);
+    QTRY_VERIFY_WITH_TIMEOUT(w.lastTelemetry()->estop, 3000);
+    for (Qt::Key key : {Qt::Key_N, Qt::Key_O, Qt::Key_T, Qt::Key_E}) QTest::keyClick(&w, key);
+    QTest::qWait(200);
+    QVERIFY(!QApplication::activeModalWidget());
+    QVERIFY(!QApplication::activePopupWidget());
+    answerRearm([&] { w.linkPanel()->rearmRequested(); }, true);
+    QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->estop, 3000);
   }
 
   // A lost link while in control: the robot's deadman latches the failsafe,

@@ -49,7 +49,7 @@ void DriveJob::install(ConsoleContext& context) {
   auto* keys = new QAction(tr("&Keys"), context.window());
   connect(keys, &QAction::triggered, this, [this] {
     QMessageBox::information(context_->window(), tr("Keys"),
-                             tr("Esc\temergency stop (anywhere; an open list or menu closes first)\n"
+                             tr("Esc\temergency stop (anywhere; an open menu closes too, an open list only closes)\n"
                                 "Up/Down, W/S\tspeed ± 0.05 m/s\n"
                                 "Left/Right, A/D\tarticulation ± 2°\n"
                                 "Space\tstop driving\n"
