@@ -534,10 +534,12 @@ void MainWindow::stateChanged() {
   for (const std::string& line : now.bannerLines()) lines << qs(line);
   banner_->setText(lines.join(QLatin1Char('\n')));
   banner_->setVisible(!lines.isEmpty());
-  // Replay: a calm banner, the live robot's alarms still red below it.
-  banner_->setStyleSheet(now.replaying() && !now.latched() && now.healthReport().empty()
-                             ? QStringLiteral("QLabel { background: #1565c0; color: white; font-weight: bold; padding: 6px; }")
-                             : QStringLiteral("QLabel { background: #c62828; color: white; font-weight: bold; padding: 6px; }"));
+  // Red for an alarm (the latch's colour), amber for a warning, blue for
+  // a replay shown without alarms.
+  const char* background = now.bannerAlarm() ? "#c62828" : now.replaying() ? "#1565c0" : "#e65100";
+  banner_->setStyleSheet(
+      QStringLiteral("QLabel { background: %1; color: white; font-weight: bold; padding: 6px; }").arg(QLatin1String(background)));
+  banner_->setProperty("alarm", now.bannerAlarm());
   emit context_->stateChanged();
 }
 

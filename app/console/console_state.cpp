@@ -160,7 +160,7 @@ std::vector<std::string> ConsoleState::bannerLines() const {
   if (nearEdge() && !replaying()) {
     lines.push_back(*edge_ < 0 ? "The robot is off the terrain (" + fixed(-*edge_, 1) +
                                      " m beyond its edge): Robot ▸ Reset puts it back."
-                               : "Near the terrain's edge: " + fixed(*edge_, 1) + " m left of the " +
+                               : "Near the terrain's edge: " + fixed(*edge_, 1) + " m to the edge of the " +
                                      fixed(terrainWidth_, 1) + " × " + fixed(terrainDepth_, 1) +
                                      " m heightfield; beyond it the robot falls.");
   }
@@ -168,6 +168,11 @@ std::vector<std::string> ConsoleState::bannerLines() const {
   if (connection_ == net::ConnectionState::Waiting || connection_ == net::ConnectionState::Refused)
     lines.push_back(live + "Robot link down (" + connectionDetail_ + "): the robot's own deadman stops it; reconnecting.");
   return lines;
+}
+
+bool ConsoleState::bannerAlarm() const {
+  return latched() || estopInFlight_ || !health_.empty() || (nearEdge() && *edge_ < 0) ||
+         connection_ == net::ConnectionState::Waiting || connection_ == net::ConnectionState::Refused;
 }
 
 std::string ConsoleState::controlsRefusal() const {

@@ -115,6 +115,11 @@ class ConsoleState {
 
   /// The banner over the 3D view, a line each; empty when nothing is wrong.
   std::vector<std::string> bannerLines() const;
+  /// Whether a line of the banner is an alarm (a latch, an e-stop in
+  /// flight, a diverged twin, the robot off the terrain, the link down),
+  /// drawn in the latch's red; else its lines are warnings (near an edge,
+  /// other files), drawn in amber.
+  bool bannerAlarm() const;
   /// "" when the drive controls and keys may command the live robot now,
   /// else why not, for the operator (a replay shown comes first).
   std::string controlsRefusal() const;

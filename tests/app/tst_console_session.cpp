@@ -12,6 +12,7 @@
 #include <mutex>
 
 #include "app/console/console_session.h"
+#include "app/console/console_state.h"
 #include "app/log/session_log.h"
 #include "app/log/session_recorder.h"
 #include "app/robot/stand_in.h"
@@ -215,6 +216,27 @@ class TestConsoleSession : public QObject {
     ConsoleSession remote(o);
     QCOMPARE(QString::fromStdString(remote.start()), QString());
     QVERIFY(!remote.resetRobot().empty());
+  }
+
+  // Every shipped heightfield world starts its robot with room: no edge
+  // warning from the first frame (issue 31: the test track's start sat
+  // 0.1 m from its edge, and the console warned in red at once).
+  void shippedWorldsStartWithRoom() {
+    for (const char* file : {"bumpy", "test_track"}) {
+      ConsoleSessionOptions o = options(file);
+      o.world = std::string(SP_SOURCE_DIR "/terrains/") + file + ".world.xml";
+      o.connectTo = "127.0.0.1:9";
+      o.token = "00112233445566778899aabbccddeeff";
+      o.log = false;
+      ConsoleSession session(o);
+      QCOMPARE(QString::fromStdString(session.start()), QString());
+      const RobotInstance& robot = session.world()->robots[0];
+      Pose base = robot.pose;
+      base.p = robot.pose.p + rotate(robot.pose.q, robot.model.links[0].pose.p);
+      const double room = session.edgeDistance(base).value_or(-1);
+      qInfo("%s: the robot starts %.2f m from the terrain's edge", file, room);
+      QVERIFY2(room > ConsoleState::Config{}.edgeWarning, file);
+    }
   }
 
   // The distance to a heightfield's edge, in the terrain's own frame; none

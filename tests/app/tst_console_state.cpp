@@ -167,10 +167,12 @@ class TestConsoleState : public QObject {
     s.terrain(true, 20, 10);
     QVERIFY(!s.frame(frameWith(false, false), 0.1, 3.0).banner);
     QVERIFY(s.frame(frameWith(false, false), 0.2, 1.4).banner);
-    QVERIFY(anyLineHas(s.bannerLines(), "Near the terrain's edge: 1.4 m left of the 20.0 × 10.0 m heightfield"));
+    QVERIFY(anyLineHas(s.bannerLines(), "Near the terrain's edge: 1.4 m to the edge of the 20.0 × 10.0 m heightfield"));
+    QVERIFY(!s.bannerAlarm());  // a warning: amber, not the latch's red (issue 31)
     QVERIFY(!s.frame(frameWith(false, false), 0.3, 1.35).banner);  // under 0.1 m: unchanged
     QVERIFY(s.frame(frameWith(false, false), 0.4, -0.5).banner);
     QVERIFY(anyLineHas(s.bannerLines(), "off the terrain (0.5 m beyond its edge)"));
+    QVERIFY(s.bannerAlarm());  // off the terrain: an alarm
     s.clearFrames();
     QVERIFY(s.bannerLines().empty());
   }

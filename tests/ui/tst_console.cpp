@@ -641,6 +641,10 @@ class TestConsole : public QObject {
     QVERIFY(terrain);
     QCOMPARE(terrain->text(), QStringLiteral("terrain 20.0 × 20.0 m"));
     QTRY_VERIFY_WITH_TIMEOUT(w.bannerText().contains(QLatin1String("Near the terrain's edge")), 3000);
+    // A warning, not a latch: amber, not the e-stop's red (issue 31).
+    auto* banner = w.findChild<QLabel*>(QStringLiteral("banner"));
+    QVERIFY(banner && !banner->property("alarm").toBool());
+    QVERIFY2(banner->styleSheet().contains(QLatin1String("#e65100")), qPrintable(banner->styleSheet()));
     const QString firstLog = w.logPath();
     w.resetRobot();
     QVERIFY(w.logPath() != firstLog);
