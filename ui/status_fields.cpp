@@ -68,8 +68,12 @@ void StatusFields::refresh(const ConsoleState& state, const ConsoleSession& sess
     ghost_->setText(tr("ghost –"));
   } else {
     QString g = tr("ghost +%1 s").arg(v.span, 0, 'f', 2);
-    if (const auto median = ghost->errorMedian())
+    if (const auto median = ghost->errorMedian()) {
       g += tr(", %1 cm / %2°").arg(median->first * 100, 0, 'f', 1).arg(radToDeg(median->second), 0, 'f', 2);
+      // The median over 10 s hid jumps of a metre: the worst is shown too.
+      if (const auto worst = ghost->errorWorst())
+        g += *worst < 1 ? tr(" (max %1 cm)").arg(*worst * 100, 0, 'f', 1) : tr(" (max %1 m)").arg(*worst, 0, 'f', 2);
+    }
     ghost_->setText(g);
   }
 

@@ -191,6 +191,11 @@ std::optional<std::pair<double, double>> Ghost::errorMedian() const {
   return record_.median();
 }
 
+std::optional<double> Ghost::errorWorst() const {
+  std::lock_guard lock(mutex_);
+  return record_.worstPosition();
+}
+
 GhostStats Ghost::stats() const {
   std::lock_guard lock(mutex_);
   return stats_;

@@ -152,6 +152,8 @@ class Ghost {
   /// Median of the position and heading errors over the last 10 s of robot
   /// time; nullopt before the first comparison.
   std::optional<std::pair<double, double>> errorMedian() const;
+  /// [m] the largest position error over the same 10 s.
+  std::optional<double> errorWorst() const;
   GhostStats stats() const;
   /// Robot time the ghost shows at wall time `wall` (steady clock [s]).
   double ghostTime(double wall) const;

@@ -53,6 +53,13 @@ std::optional<std::pair<double, double>> PredictionRecord::median() const {
   return std::pair{sp::median(std::move(position)), sp::median(std::move(heading))};
 }
 
+std::optional<double> PredictionRecord::worstPosition() const {
+  if (errors_.empty()) return std::nullopt;
+  double worst = 0;
+  for (const GhostError& e : errors_) worst = std::max(worst, e.position);
+  return worst;
+}
+
 void PredictionRecord::clear() {
   shown_.clear();
   errors_.clear();

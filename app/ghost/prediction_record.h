@@ -39,6 +39,9 @@ class PredictionRecord {
   std::optional<GhostError> compare(const RobotFrame& frame);
   /// Median position and heading errors over the last kErrorWindow; nullopt before the first.
   std::optional<std::pair<double, double>> median() const;
+  /// [m] the largest position error over the same window (a median hides
+  /// a jump of a metre); nullopt before the first.
+  std::optional<double> worstPosition() const;
   /// Forgets everything (the robot was reset).
   void clear();
 

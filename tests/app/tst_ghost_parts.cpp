@@ -125,7 +125,7 @@ class TestGhostParts : public QObject {
 
   // The record: a frame between two shown states is compared with their
   // interpolation; one with nothing shown within 0.1 s is not compared;
-  // the median is over the last 10 s of robot time.
+  // the median and the worst are over the last 10 s of robot time.
   void predictionRecord() {
     PredictionRecord r;
     QVERIFY(!r.median());
@@ -145,6 +145,15 @@ class TestGhostParts : public QObject {
     const auto m = r.median();
     QVERIFY(m);
     QVERIFY(std::abs(m->first - 0.1) < 1e-12);  // the 1.02 s error is over 10 s old
+    // The worst over the same window: one jump of 1.2 m among small errors
+    // leaves the median small and shows in the worst (issue 31).
+    for (int i = 0; i < 5; ++i) {
+      r.shown(31 + i, 30, a);
+      r.shown(31.05 + i, 30, a);
+      QVERIFY(r.compare(frameAt(31.02 + i, {}, i == 2 ? 1.2 : 0.01)));
+    }
+    QVERIFY(r.median()->first < 0.11);
+    QVERIFY(std::abs(*r.worstPosition() - 1.2) < 1e-12);
   }
 };
 
