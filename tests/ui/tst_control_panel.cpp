@@ -97,6 +97,22 @@ class TestControlPanel : public QObject {
     QCOMPARE(panel_->speed(), 0.0);
   }
 
+  // A key held down steps faster the longer it is held (issue 31: 0.6 m/s
+  // took 12 presses): one press and eight auto-repeats reach 0.6 m/s; nine
+  // separate presses reach 0.45 (the control); a new press is one step.
+  void heldKeysAccelerate() {
+    panel_->handleKey(Qt::Key_Space);
+    QVERIFY(panel_->handleKey(Qt::Key_Up));
+    for (int i = 0; i < 8; ++i) QVERIFY(panel_->handleKey(Qt::Key_Up, true));
+    QVERIFY2(panel_->speed() >= 0.6 - 1e-9, qPrintable(QString::number(panel_->speed())));
+    panel_->handleKey(Qt::Key_Space);
+    for (int i = 0; i < 9; ++i) panel_->handleKey(Qt::Key_Up);
+    QVERIFY(std::abs(panel_->speed() - 0.45) < 1e-9);
+    panel_->handleKey(Qt::Key_Down);
+    QVERIFY(std::abs(panel_->speed() - 0.40) < 1e-9);
+    panel_->handleKey(Qt::Key_Space);
+  }
+
   // A joint's target is sent in SI units: degrees on screen, radians on the
   // link; millimetres for the grippers' sliders, metres on the link.
   void jointTargetsInSiUnits() {

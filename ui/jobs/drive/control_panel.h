@@ -42,8 +42,9 @@ class ControlPanel : public QWidget {
   /// Keyboard driving (the console routes these keys here wherever the
   /// focus is, except in text and number fields): Up/Down (W/S) step
   /// the speed by 0.05 m/s, Left/Right (A/D) the articulation by 2 degrees,
-  /// Space stops. Returns whether the key was one of these.
-  bool handleKey(int key);
+  /// Space stops. A key held down (`autoRepeat`) steps faster the longer it
+  /// is held, up to four times the step. Returns whether the key was one of these.
+  bool handleKey(int key, bool autoRepeat = false);
 
   /// Shows the measured joint positions (robot.joints order) beside the targets.
   void showMeasured(const std::vector<double>& jointPositions);
@@ -88,6 +89,7 @@ class ControlPanel : public QWidget {
 
   const RobotModel* robot_ = nullptr;
   RobotModel model_;
+  int heldKey_ = 0, repeats_ = 0;  // the key held down and its auto-repeats so far
   double maxSpeed_ = 0, maxArticulationDeg_ = 0;
   QSlider* speedSlider_ = nullptr;      // [cm/s]
   LimitSpinBox* speedSpin_ = nullptr;  // [m/s]

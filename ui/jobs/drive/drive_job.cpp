@@ -50,7 +50,7 @@ void DriveJob::install(ConsoleContext& context) {
   connect(keys, &QAction::triggered, this, [this] {
     QMessageBox::information(context_->window(), tr("Keys"),
                              tr("Esc\temergency stop (anywhere; an open menu closes too, an open list only closes)\n"
-                                "Up/Down, W/S\tspeed ± 0.05 m/s\n"
+                                "Up/Down, W/S\tspeed ± 0.05 m/s (held: faster)\n"
                                 "Left/Right, A/D\tarticulation ± 2°\n"
                                 "Space\tstop driving\n"
                                 "F\tfollow the robot (3D view focused)\nHome\treset the view\n"
@@ -76,7 +76,7 @@ bool DriveJob::eventFilter(QObject* watched, QEvent* event) {
   const bool typing = qobject_cast<QAbstractSpinBox*>(watched) || (line && !line->isReadOnly()) ||
                       (plain && !plain->isReadOnly()) || (rich && !rich->isReadOnly());
   if (!widget || widget->window() != context_->window() || typing || QApplication::activePopupWidget()) return false;
-  if (panel_->controlsEnabled()) panel_->handleKey(key->key());
+  if (panel_->controlsEnabled()) panel_->handleKey(key->key(), key->isAutoRepeat());
   else if (!key->isAutoRepeat()) context_->status(panel_->toolTipWhenDisabled(), 3000);
   return true;
 }
