@@ -30,6 +30,29 @@ class TestCalibrationDock : public QObject {
   Q_OBJECT
 
  private slots:
+  // A robot standing still has every fit refused for want of driving: the
+  // event list says so once, not every 3 s (three refusals, one line).
+  void standingStillSaysItOnce() {
+    QTemporaryDir dir;
+    QVERIFY(dir.isValid());
+    ConsoleOptions options;
+    std::unique_ptr<MainWindow> window;
+    const QString error = test::startConsole(dir, QStringLiteral("terrains/flat.world.xml"), options, window);
+    QVERIFY2(error.isEmpty(), qPrintable(error));
+    MainWindow& w = *window;
+    int said = 0;
+    connect(&w.context(), &ConsoleContext::eventShown, this, [&](const QString& text) {
+      said += text.startsWith(QLatin1String("Calibration fit refused"));
+    });
+    LiveCalibrator* calibrator = w.context().session().calibrator();
+    QVERIFY(calibrator);
+    QTRY_VERIFY_WITH_TIMEOUT(calibrator->state().refusals >= 3, 30000);
+    QTest::qWait(300);  // a panel tick
+    qInfo("%d refusals standing still, %d said", calibrator->state().refusals, said);
+    QVERIFY2(calibrator->state().lastRefusal.rfind("not enough driving", 0) == 0, calibrator->state().lastRefusal.c_str());
+    QCOMPARE(said, 1);
+  }
+
   void fitsShowFreezeResetSave() {
     QTemporaryDir dir;
     QVERIFY(dir.isValid());

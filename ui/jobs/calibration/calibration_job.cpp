@@ -111,8 +111,14 @@ void CalibrationJob::refresh() {
   seen_ = s.version;
   panel_->setLive(&s);
   if (s.refusals > refusalsSeen_) {
-    context_->event(QStringLiteral("calibration"), tr("Calibration fit refused, the values kept: %1").arg(QString::fromStdString(s.lastRefusal)),
-                    false);  // the session logs the fit itself
+    const std::string kind = s.lastRefusal.substr(0, s.lastRefusal.find(':'));
+    const int accepted = s.fits - s.refusals;
+    if (kind != refusalSaid_ || accepted != acceptedWhenSaid_)
+      context_->event(QStringLiteral("calibration"),
+                      tr("Calibration fit refused, the values kept: %1").arg(QString::fromStdString(s.lastRefusal)),
+                      false);  // the session logs the fit itself
+    refusalSaid_ = kind;
+    acceptedWhenSaid_ = accepted;
     refusalsSeen_ = s.refusals;
   }
 }
