@@ -661,6 +661,26 @@ class TestConsole : public QObject {
     w.close();
   }
 
+  // --sequence FILE opens the Sequence dock's tab in front (issue 31);
+  // without it the Controls tab is in front (the control).
+  void sequenceOptionBringsItsTab() {
+    for (const bool withSequence : {true, false}) {
+      QSettings().clear();
+      ConsoleOptions o = options_;
+      o.log = false;
+      if (withSequence) o.sequence = QStringLiteral(SP_SOURCE_DIR "/terrains/demo.seq");
+      MainWindow w(o);
+      QCOMPARE(w.start(), QString());
+      w.resize(1280, 800);
+      w.show();
+      QVERIFY(QTest::qWaitForWindowExposed(&w));
+      auto* dock = w.findChild<QDockWidget*>(QStringLiteral("sequenceDock"));
+      QVERIFY(dock);
+      QTRY_COMPARE(!dock->visibleRegion().isEmpty(), withSequence);
+      w.close();
+    }
+  }
+
   // The 3D view gets the space: at 1280x800 on a first run it has at least
   // half the window; a layout saved squeezed does not come back squeezed.
   void viewGetsTheSpace() {

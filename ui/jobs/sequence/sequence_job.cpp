@@ -2,6 +2,7 @@
 
 #include <QDockWidget>
 #include <QFile>
+#include <QTimer>
 
 #include "app/console/console_session.h"
 #include "sim/diagnostics.h"
@@ -84,6 +85,12 @@ QString SequenceJob::start() {
     if (!f.open(QIODevice::ReadOnly) || f.size() > 1 << 20)
       return tr("%1: error: cannot read sequence file (or larger than 1 MiB)").arg(sequence_);
     panel_->setText(QString::fromUtf8(f.readAll()));
+    // Opened on the command line to be rehearsed: its tab in front, once
+    // the window has laid out its docks.
+    QTimer::singleShot(0, dock_, [this] {
+      dock_->show();
+      dock_->raise();
+    });
   }
   return {};
 }
