@@ -8,6 +8,7 @@
 #include <QFile>
 #include <QFileInfo>
 #include <QSettings>
+#include <QSlider>
 #include <QSurfaceFormat>
 #include <QTemporaryDir>
 #include <QTreeWidget>
@@ -66,6 +67,15 @@ class TestReplay : public QObject {
     const auto note = std::find_if(events.begin(), events.end(), [](const LogEvent& e) { return e.kind == "note"; });
     QVERIFY(note != events.end());
     const double noteTime = note->time;  // the player (and its events) goes with the replay
+    // A click on the timeline seeks there (issue 31: only dragging the
+    // handle did; a click paged a step towards it).
+    auto* timeline = r->findChild<QSlider*>();
+    QVERIFY(timeline);
+    const double span = r->player()->endTime() - r->player()->startTime();
+    QTest::mouseClick(timeline, Qt::LeftButton, Qt::NoModifier, QPoint(timeline->width() * 3 / 4, timeline->height() / 2));
+    const double clicked = (r->cursor() - r->player()->startTime()) / span;
+    qInfo("a click at 3/4 of the timeline: the cursor at %.2f of the log", clicked);
+    QVERIFY2(std::abs(clicked - 0.75) < 0.05, qPrintable(QString::number(clicked)));
     r->seekToEvent(static_cast<int>(note - events.begin()));
     QCOMPARE(r->cursor(), note->time);
 
@@ -131,9 +141,15 @@ class TestReplay : public QObject {
     const double at = std::round(noteTime * 1000) / 1000;
     r->seek(at);
     const QString oldLog = w.logPath();
+    QStringList said;
+    const QMetaObject::Connection listening =
+        connect(&w.context(), &ConsoleContext::eventShown, this, [&](const QString& text) { said << text; });
     r->branchHere();  // "Simulate from here"
     QTRY_VERIFY_WITH_TIMEOUT(w.logPath() != oldLog, 20000);
     QVERIFY(!w.replaying());
+    // The replay closes saying so, and how to see it again (issue 31).
+    QTRY_VERIFY(said.join('\n').contains(QLatin1String("in a new stand-in session; the replay closed")));
+    disconnect(listening);
     QTRY_VERIFY_WITH_TIMEOUT(w.lastTelemetry().has_value() && w.lastTelemetry()->time >= at, 20000);
     const net::TelemetryMsg first = *w.lastTelemetry();
     const Pose parent = reference->frameAt(first.time)->base;

@@ -26,8 +26,16 @@ void ReplayJob::install(ConsoleContext& context) {
   connect(panel_, &ReplayPanel::opened, this, &ReplayJob::opened);
   connect(panel_, &ReplayPanel::closed, this, &ReplayJob::closed);
   connect(panel_, &ReplayPanel::branchReady, this, [this](const QString& log, std::shared_ptr<const BranchPoint> point) {
-    // The branch runs live now: the replay it came from closes.
-    if (context_->host().startBranch(log, *point, false).isEmpty()) panel_->close();
+    // The branch runs live now: the replay it came from closes, saying so
+    // (it closed without a word) and how to see it again.
+    if (!context_->host().startBranch(log, *point, false).isEmpty()) return;
+    panel_->close();
+    const QString text = tr("Simulating from %1 s of %2 in a new stand-in session; the replay closed "
+                            "(File ▸ Open session log… shows it again)")
+                             .arg(static_cast<double>(point->step) * point->logged.params.step, 0, 'f', 1)
+                             .arg(QFileInfo(log).fileName());
+    context_->event(QStringLiteral("replay"), text, false);
+    context_->status(text, 10000);
   });
   connect(panel_, &ReplayPanel::failed, this, [this](const QString& message) {
     if (!panel_->isOpen()) dock_->hide();  // a log that did not open

@@ -18,6 +18,7 @@
 #include <QMouseEvent>
 #include <QPainter>
 #include <QProgressBar>
+#include <QProxyStyle>
 #include <QPushButton>
 #include <QSignalBlocker>
 #include <QSlider>
@@ -73,6 +74,17 @@ class ReplayPanel::Marks : public QWidget {
   ReplayPanel* panel_;
 };
 
+// A click on the timeline's groove seeks there, as a click on a media
+// player's timeline does (QSlider pages a step towards it by default).
+class JumpToClick : public QProxyStyle {
+ public:
+  int styleHint(StyleHint hint, const QStyleOption* option, const QWidget* widget,
+                QStyleHintReturn* returned) const override {
+    if (hint == QStyle::SH_Slider_AbsoluteSetButtons) return Qt::LeftButton;
+    return QProxyStyle::styleHint(hint, option, widget, returned);
+  }
+};
+
 ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   setBackground(new BackgroundJobs(this));  // until given the console's
   auto* layout = new QVBoxLayout(this);
@@ -90,6 +102,9 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   for (double s : {0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0}) speedBox_->addItem(QStringLiteral("%1×").arg(s), s);
   speedBox_->setCurrentIndex(3);
   slider_ = new QSlider(Qt::Horizontal, this);
+  auto* jump = new JumpToClick;
+  jump->setParent(slider_);
+  slider_->setStyle(jump);
   timeLabel_ = new QLabel(this);
   timeLabel_->setMinimumWidth(130);
   row->addWidget(back);
