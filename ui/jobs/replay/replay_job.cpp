@@ -1,12 +1,16 @@
 #include "ui/jobs/replay/replay_job.h"
 
+#include <algorithm>
+
 #include <QAction>
 #include <QDockWidget>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QKeySequence>
+#include <QMainWindow>
 #include <QMenu>
 #include <QSettings>
+#include <QTimer>
 
 #include "app/console/console_session.h"
 #include "ui/jobs/replay/replay_panel.h"
@@ -84,6 +88,15 @@ void ReplayJob::opened() {
   recent.prepend(path);
   QSettings().setValue(QStringLiteral("replay/recent"), recent.mid(0, kRecent));
   context_->feeds().show(feed_);
+  // Room for the timeline, the plot and the events without scrolling: the
+  // default bottom dock (the live plots') is too low for them.
+  // (After the window has laid out its docks: a log opened at start-up
+  // would be laid out again.)
+  QTimer::singleShot(0, dock_, [this] {
+    QMainWindow* window = context_->window();
+    const int wanted = std::max(panel_->minimumSizeHint().height() + 40, window->height() * 2 / 5);
+    window->resizeDocks({dock_}, {wanted}, Qt::Vertical);
+  });
   context_->status(tr("Replaying %1: the live robot goes on unseen; close the replay to see it again")
                        .arg(QFileInfo(path).fileName()),
                    0);

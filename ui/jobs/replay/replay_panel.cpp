@@ -176,9 +176,14 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   chart_ = new QChartView(chart, this);
   chart_->setRubberBand(QChartView::HorizontalRubberBand);
   chart_->setMinimumHeight(110);
-  layout->addWidget(chart_, 2);
+  // The events beside the plot, not under it: under it the plot got 15 px
+  // of a 1280x800 window's dock.
+  auto* plotAndEvents = new QHBoxLayout;
+  plotAndEvents->addWidget(chart_, 3);
   events_ = new QListWidget(this);
-  layout->addWidget(events_, 1);
+  events_->setMinimumWidth(160);
+  plotAndEvents->addWidget(events_, 1);
+  layout->addLayout(plotAndEvents, 1);
   replotTimer_ = new QTimer(this);
   replotTimer_->setSingleShot(true);
   replotTimer_->setInterval(100);
