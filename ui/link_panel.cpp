@@ -93,6 +93,7 @@ LinkPanel::LinkPanel(QWidget* parent) : QWidget(parent) {
   events_->setReadOnly(true);
   events_->setMaximumBlockCount(1000);  // a long session keeps its latest events
   events_->setPlaceholderText(tr("link events"));
+  events_->setMinimumHeight(48);  // the rest of the height goes to the dock above when it needs it
   layout->addWidget(events_, 1);
 
   connect(connect_, &QPushButton::clicked, this, [this] { emit open_ ? disconnectRequested() : connectRequested(); });

@@ -12,6 +12,8 @@
 #include <QPlainTextEdit>
 #include <QPushButton>
 #include <QRegularExpression>
+#include <QScrollArea>
+#include <QScrollBar>
 #include <QStatusBar>
 #include <QDoubleSpinBox>
 #include <QMessageBox>
@@ -677,6 +679,19 @@ class TestConsole : public QObject {
       auto* dock = w.findChild<QDockWidget*>(QStringLiteral("sequenceDock"));
       QVERIFY(dock);
       QTRY_COMPARE(!dock->visibleRegion().isEmpty(), withSequence);
+      if (withSequence) {
+        // At 1280x800 every control of the dock shows without scrolling,
+        // either way (issue 31: Rehearse, the verdicts, Watch and Send were
+        // below the fold, and a rehearsal scrolled it sideways).
+        auto* scroll = dock->findChild<QScrollArea*>();
+        QVERIFY(scroll);
+        const auto fits = [&] {
+          return !scroll->verticalScrollBar()->isVisible() && !scroll->horizontalScrollBar()->isVisible();
+        };
+        QTRY_VERIFY_WITH_TIMEOUT(fits(), 2000);
+        qInfo("the Sequence dock %dx%d, its panel needs %dx%d", dock->width(), dock->height(),
+              scroll->widget()->minimumSizeHint().width(), scroll->widget()->minimumSizeHint().height());
+      }
       w.close();
     }
   }

@@ -13,6 +13,7 @@
 #include <QSurfaceFormat>
 #include <QTemporaryDir>
 #include <QTreeWidget>
+#include <QLabel>
 #include <QtTest>
 
 #include <chrono>
@@ -166,6 +167,12 @@ class TestSequencePanel : public QObject {
              qPrintable(p->errors().join('\n')));
     QVERIFY(!p->rehearse());
     QVERIFY(p->status().contains("line 2"));
+    // Disabled means disabled, with the reason beside it (issue 31: the
+    // button looked enabled and its refusal landed out of view).
+    QVERIFY(!p->rehearseButton()->isEnabled());
+    auto* why = p->findChild<QLabel*>(QStringLiteral("sequenceWhy"));
+    QVERIFY(why && why->isVisibleTo(p));
+    QVERIFY2(why->text().contains(QLatin1String("line 2: unknown command 'drvie'")), qPrintable(why->text()));
     // Fixed, the limits are checked next: knee_fl's range is [-40, 80] deg.
     p->setText(QStringLiteral("1.0 drive 0.5 0\n2.0 drive 0.5 0\n3.0 target knee_fl 120\n"));
     QCOMPARE(p->markedLines(), (QList<int>{3}));

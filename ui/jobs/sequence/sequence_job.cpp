@@ -1,7 +1,10 @@
 #include "ui/jobs/sequence/sequence_job.h"
 
+#include <algorithm>
+
 #include <QDockWidget>
 #include <QFile>
+#include <QMainWindow>
 #include <QTimer>
 
 #include "app/console/console_session.h"
@@ -56,6 +59,12 @@ void SequenceJob::install(ConsoleContext& context) {
     dock_->raise();
   });
 
+  // Shown (its tab raised): room for all its controls without scrolling,
+  // taken from the link dock under it (at 1280x800 half the height left
+  // Rehearse, the verdicts, Watch and Send below the fold).
+  connect(dock_, &QDockWidget::visibilityChanged, this, [this](bool visible) {
+    if (visible) QTimer::singleShot(0, dock_, [this] { fitDock(); });
+  });
   connect(&context, &ConsoleContext::stateChanged, this,
           [this] { panel_->setLinkReady(context_->state().controlsRefusal().empty()); });
   connect(&context, &ConsoleContext::worldChanged, this, [this](const WorldModel&, bool fresh) {
@@ -71,6 +80,15 @@ void SequenceJob::install(ConsoleContext& context) {
             dock_->raise();
             context_->status(tr("The Sequence dock rehearses from %1 now").arg(label), 8000);
           });
+}
+
+void SequenceJob::fitDock() {
+  if (!dock_->isVisible() || dock_->isFloating()) return;
+  QMainWindow* window = context_->window();
+  // The panel's least height, its dock's title and the scroll area's frame.
+  const int wanted = std::min(panel_->minimumSizeHint().height() + dock_->height() - dock_->widget()->height() + 4,
+                              window->height() * 7 / 10);
+  if (dock_->height() < wanted) window->resizeDocks({dock_}, {wanted}, Qt::Vertical);
 }
 
 QString SequenceJob::start() {
@@ -90,6 +108,7 @@ QString SequenceJob::start() {
     QTimer::singleShot(0, dock_, [this] {
       dock_->show();
       dock_->raise();
+      fitDock();
     });
   }
   return {};

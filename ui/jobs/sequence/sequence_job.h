@@ -30,6 +30,8 @@ class SequenceJob : public ConsoleJob {
   SequencePanel* panel() const { return panel_; }
 
  private:
+  /// Grows the dock, when shown, to what its panel needs without scrolling.
+  void fitDock();
   ConsoleContext* context_ = nullptr;
   SequencePanel* panel_ = nullptr;
   QDockWidget* dock_ = nullptr;

@@ -14,7 +14,9 @@
 #include <QProgressBar>
 #include <QStandardPaths>
 #include <QPushButton>
+#include <QResizeEvent>
 #include <QSlider>
+#include <QTabWidget>
 #include <QTextBlock>
 #include <QTimer>
 #include <QToolButton>
@@ -52,6 +54,30 @@ constexpr Template kTemplates[] = {
 
 QString seconds(double t) { return QString::number(t, 'f', 2) + " s"; }
 
+// A word-wrapped label that does not ask for height for its width: one
+// that does makes the dock's scroll area size the whole panel by its
+// preferred heights (593 px where 317 are enough). It wraps in the height
+// the layout gives it, a line at least.
+class WrappedLabel : public QLabel {
+ public:
+  explicit WrappedLabel(QWidget* parent) : QLabel(parent) {
+    setWordWrap(true);
+    setMinimumHeight(fontMetrics().lineSpacing());
+  }
+  bool hasHeightForWidth() const override { return false; }
+  // The height its text takes at its present width (not a guessed one).
+  QSize sizeHint() const override {
+    const QSize hint = QLabel::sizeHint();
+    return {hint.width(), QLabel::heightForWidth(width() > 50 ? width() : hint.width())};
+  }
+
+ protected:
+  void resizeEvent(QResizeEvent* event) override {
+    QLabel::resizeEvent(event);
+    if (event->size().width() != event->oldSize().width()) updateGeometry();
+  }
+};
+
 }  // namespace
 
 SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
@@ -78,6 +104,7 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   editor_->setFont(QFontDatabase::systemFont(QFontDatabase::FixedFont));
   editor_->setPlaceholderText(tr("# time [s]  command  arguments\n1.0  drive 0.5 0\n5.0  stop"));
   editor_->setLineWrapMode(QPlainTextEdit::NoWrap);
+  editor_->setMinimumHeight(48);
   layout->addWidget(editor_, 2);
   errorList_ = new QListWidget(this);
   errorList_->setMaximumHeight(70);
@@ -102,7 +129,7 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   });
 
   auto* startRow = new QHBoxLayout;
-  startLabel_ = new QLabel(this);
+  startLabel_ = new WrappedLabel(this);
   startLabel_->setWordWrap(true);
   unpinButton_ = new QPushButton(tr("From the robot"), this);
   unpinButton_->setToolTip(tr("Rehearse from the robot's state now again"));
@@ -123,12 +150,26 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   progress_ = new QProgressBar(this);
   progress_->setRange(0, 1000);
   progress_->setTextVisible(false);
+  // Two rows: in one the dock's width (370 px at 1280x800) scrolled
+  // sideways and cut the buttons' names.
   runRow->addWidget(rehearseButton_);
   runRow->addWidget(robustButton_);
   runRow->addWidget(clusterButton_);
-  runRow->addWidget(progress_, 1);
-  runRow->addWidget(cancelButton_);
+  runRow->addStretch();
   layout->addLayout(runRow);
+  // The progress and Cancel only while something runs.
+  progressRow_ = new QWidget(this);
+  auto* progressRow = new QHBoxLayout(progressRow_);
+  progressRow->setContentsMargins(0, 0, 0, 0);
+  progressRow->addWidget(progress_, 1);
+  progressRow->addWidget(cancelButton_);
+  layout->addWidget(progressRow_);
+  // Why a button is disabled, beside it (not a status line out of view).
+  whyLabel_ = new WrappedLabel(this);
+  whyLabel_->setObjectName(QStringLiteral("sequenceWhy"));
+  whyLabel_->setWordWrap(true);
+  whyLabel_->setStyleSheet(QStringLiteral("color: #8a6d00"));
+  layout->addWidget(whyLabel_);
   connect(rehearseButton_, &QPushButton::clicked, this, &SequencePanel::rehearse);
   connect(robustButton_, &QPushButton::clicked, this, &SequencePanel::checkRobustness);
   connect(clusterButton_, &QPushButton::clicked, this, [this] {
@@ -145,8 +186,12 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   verdicts_->setColumnCount(2);
   verdicts_->setHeaderLabels({tr("Rule"), tr("Verdict")});
   verdicts_->setRootIsDecorated(false);
-  verdicts_->setMinimumHeight(120);
-  layout->addWidget(verdicts_, 1);
+  verdicts_->setMinimumHeight(60);
+  // The verdicts and the margins' plot share one place, as tabs: stacked,
+  // they pushed Watch and Send below the fold of a 1280x800 window.
+  results_ = new QTabWidget(this);
+  results_->addTab(verdicts_, tr("Verdicts"));
+  layout->addWidget(results_, 1);
   connect(verdicts_, &QTreeWidget::itemClicked, this, [this](QTreeWidgetItem* item) {
     const QVariant t = item->data(0, Qt::UserRole);
     if (t.isValid()) scrubTo(t.toDouble());
@@ -177,8 +222,8 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   for (QLineSeries* s : {marginSeries_, rollSeries_, pitchSeries_, cursor_}) chart->addSeries(s);
   chart->createDefaultAxes();
   chart_ = new QChartView(chart, this);
-  chart_->setMinimumHeight(140);
-  layout->addWidget(chart_, 1);
+  chart_->setMinimumHeight(60);
+  results_->addTab(chart_, tr("Margins"));
 
   auto* relayRow = new QHBoxLayout;
   sendButton_ = new QPushButton(tr("Send to robot"), this);
@@ -192,8 +237,8 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   connect(sendButton_, &QPushButton::clicked, this, &SequencePanel::send);
   connect(abortButton_, &QPushButton::clicked, this, [this] { abort(tr("the operator pressed Abort")); });
 
-  status_ = new QLabel(this);
-  status_->setWordWrap(true);
+  status_ = new WrappedLabel(this);
+  status_->hide();
   layout->addWidget(status_);
   updateButtons();
 }
@@ -290,7 +335,7 @@ void SequencePanel::checkNow() {
     const std::string text = editor_->toPlainText().toStdString();
     Diagnostics diag;
     const auto commands = parseCommandSequence(text, "sequence", diag, &robot);
-    if (commands) checkCommands(*commands, robot, "sequence", diag);
+    if (commands) checkCommands(*commands, *world, "sequence", diag);  // terrain edits against its grid
     for (const Diagnostic& d : diag.items()) {
       if (d.severity != Severity::Error) continue;
       const QString message = QString::fromStdString(d.message);
@@ -635,16 +680,31 @@ void SequencePanel::onGuardTripped(const QString& hash, const GuardDeparture& d)
 
 QString SequencePanel::status() const { return status_->text(); }
 
-void SequencePanel::setStatus(const QString& text) { status_->setText(text); }
+void SequencePanel::setStatus(const QString& text) {
+  status_->setText(text);
+  status_->setVisible(!text.isEmpty());
+}
 
 void SequencePanel::updateButtons() {
   const SequenceRelay::Phase phase = relay().phase();
   const bool running = phase == SequenceRelay::Phase::Running || phase == SequenceRelay::Phase::Sent;
-  rehearseButton_->setEnabled(!busy_);
-  robustButton_->setEnabled(!busy_ && rehearsalCurrent());
-  clusterButton_->setEnabled(!busy_ && rehearsalCurrent());
+  const bool current = rehearsalCurrent();
+  rehearseButton_->setEnabled(!busy_ && errors_.isEmpty());
+  robustButton_->setEnabled(!busy_ && current);
+  clusterButton_->setEnabled(!busy_ && current);
   cancelButton_->setEnabled(busy_);
-  sendButton_->setEnabled(!busy_ && linkReady_ && rehearsalCurrent() && result_->passed && !running && !planPinned_);
+  sendButton_->setEnabled(!busy_ && linkReady_ && current && result_->passed && !running && !planPinned_);
+  QString why;
+  if (busy_) why.clear();
+  else if (!errors_.isEmpty()) why = tr("Rehearse waits for the sequence to be fixed: %1").arg(errors_.front());
+  else if (editor_->toPlainText().trimmed().isEmpty()) why = tr("Write or open a sequence to rehearse.");
+  else if (!current) why = tr("Send needs a rehearsal of this text%1.").arg(terrainEditedSince_ ? tr(" since the terrain edit") : QString());
+  else if (!result_->passed) why = tr("Send: the rehearsal failed (%1).").arg(QString::fromStdString(result_->summary()));
+  else if (planPinned_) why = tr("Send: a what-if from a pinned start cannot be sent.");
+  else if (!linkReady_) why = tr("Send: take control of the robot first.");
+  whyLabel_->setText(why);
+  whyLabel_->setVisible(!why.isEmpty());
+  progressRow_->setVisible(busy_);
   startLabel_->setText(pinned_ ? tr("Start: %1 (a what-if: it cannot be sent)").arg(pinned_->label)
                                : tr("Start: the robot's state when Rehearse is pressed"));
   unpinButton_->setVisible(pinned_.has_value());

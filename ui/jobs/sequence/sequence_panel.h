@@ -52,6 +52,7 @@ class QProgressBar;
 class QPushButton;
 class QSlider;
 class QTimer;
+class QTabWidget;
 class QTreeWidget;
 class QToolButton;
 QT_FORWARD_DECLARE_CLASS(QChartView)
@@ -209,6 +210,9 @@ class SequencePanel : public QWidget {
   QPushButton* sendButton_ = nullptr;
   QPushButton* abortButton_ = nullptr;
   QLabel* status_ = nullptr;
+  QLabel* whyLabel_ = nullptr;       // why Rehearse or Send is disabled, beside them
+  QTabWidget* results_ = nullptr;    // the verdicts and the margins' plot
+  QWidget* progressRow_ = nullptr;   // the progress and Cancel, shown while busy
 
   bool busy_ = false;
   BackgroundJobs* jobs_ = nullptr;  // the console's runner, or the panel's own
