@@ -499,6 +499,12 @@ struct SceneView::Impl {
   // opaque line in `line`) under root.
   void buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line);
   void syncPhantom(Phantom& p);
+  /// Whether `p` stands where the robot is drawn (kCoincide): then it is not drawn.
+  bool coincides(const Phantom& p) const;
+  struct Coincide {
+    double position, angle;  // [m]; [rad] of the base and of every joint
+  };
+  static constexpr Coincide kCoincide{0.03, 0.035};
   void buildLaser();
   void updateLaser();
   void sync();
@@ -685,13 +691,28 @@ void SceneView::Impl::buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line) {
   root->addChild(p.pathNode);
 }
 
+bool SceneView::Impl::coincides(const Phantom& p) const {
+  // Within a few centimetres and degrees of the robot a phantom only
+  // z-fights with it (striped flicker over body and torso): not drawn then.
+  // Its trail or path still is.
+  if (norm(p.base.p - base.p) > kCoincide.position) return false;
+  const Quat& a = p.base.q;
+  const Quat& b = base.q;
+  const double cosHalf = std::abs(a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z);
+  if (2 * std::acos(std::min(1.0, cosHalf)) > kCoincide.angle) return false;
+  if (p.joints.size() != joints.size()) return false;
+  for (size_t j = 0; j < joints.size(); ++j)
+    if (std::abs(p.joints[j] - joints[j]) > kCoincide.angle) return false;
+  return true;
+}
+
 void SceneView::Impl::syncPhantom(Phantom& p) {
   if (p.dirty) {
     const std::vector<Pose> poses = linkPoses(robot, p.base, p.joints);
     for (size_t i = 0; i < p.links.size() && i < poses.size(); ++i) p.links[i]->setMatrix(toMatrix(poses[i]));
     p.dirty = false;
   }
-  p.node->setNodeMask(p.visible && hasRobot ? ~0u : 0u);
+  p.node->setNodeMask(p.visible && hasRobot && !coincides(p) ? ~0u : 0u);
   if (p.pathDirty) {
     for (auto [geometry, points] : {std::pair{p.path.get(), &p.pathPoints}, std::pair{p.envelope.get(), &p.envelopePoints}}) {
       auto* v = static_cast<osg::Vec3Array*>(geometry->getVertexArray());

@@ -192,6 +192,23 @@ class TstSceneView : public QObject {
     view->setGhostVisible(false);
     QVERIFY(waitFrames(*view, 2));
     QVERIFY(countDiffering(alone, frame(*view), region) < region.width() * region.height() / 2000);
+
+    // Issue 31: a ghost where the robot is (within 3 cm and 2 degrees)
+    // would only z-fight with it: not drawn. Control: 10 cm away it is.
+    view->setGhostVisible(true);
+    sp::Pose near = base;
+    near.p.x += 0.01;
+    view->setGhostState(near, joints);
+    QVERIFY(waitFrames(*view, 2));
+    const int coinciding = countDiffering(alone, frame(*view), region);
+    near.p.x += 0.09;
+    view->setGhostState(near, joints);
+    QVERIFY(waitFrames(*view, 2));
+    const int apart = countDiffering(alone, frame(*view), region);
+    qInfo("pixels changed by a ghost 1 cm off the robot: %d; 10 cm off: %d", coinciding, apart);
+    QVERIFY2(coinciding < region.width() * region.height() / 2000, qPrintable(QString::number(coinciding)));
+    QVERIFY2(apart > region.width() * region.height() / 200, qPrintable(QString::number(apart)));
+    view->setGhostVisible(false);
   }
 
   // Issue 27: the ghost is a clean translucent silhouette of one colour.
