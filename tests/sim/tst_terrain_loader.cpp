@@ -514,15 +514,15 @@ class TestTerrainLoader : public QObject {
     QVERIFY(r.grid->maxHeight() <= 0.08);
   }
 
-  // terrains/test_track.csv: a ~22 m profile whose highest bump is 0.30 m,
-  // flat at both ends.
+  // terrains/test_track.csv: a 24 m profile (2 m of level snow before the
+  // 22 m track) whose highest bump is 0.30 m, flat at both ends.
   void shippedTestTrack() {
     sp::TerrainSource s = makeSource(QStringLiteral(SP_SOURCE_DIR "/terrains/test_track.csv"),
                                      sp::TerrainFormat::Profile, 0, 2);
     const Loaded r = load(s);
     QCOMPARE(r.diagnostics, QString());
     QVERIFY(r.grid);
-    QVERIFY(r.grid->width > 21 && r.grid->width < 23);
+    QVERIFY(r.grid->width > 23.9 && r.grid->width < 24.1);
     QCOMPARE(r.grid->rows, 41);
     QVERIFY(std::abs(r.grid->maxHeight() - 0.30) < 0.05);
     QCOMPARE(r.grid->heightAt(-r.grid->width / 2, 0), 0.0);
