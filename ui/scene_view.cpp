@@ -431,6 +431,7 @@ struct SceneView::Impl {
     std::vector<double> joints;
     bool dirty = false;
     bool visible = false;
+    bool bodyShown = true;  // false: only its path (the rehearsal's robot after the run)
   };
   Phantom ghost, rehearsal;
   osg::ref_ptr<osg::Geode> laserNode;
@@ -712,7 +713,7 @@ void SceneView::Impl::syncPhantom(Phantom& p) {
     for (size_t i = 0; i < p.links.size() && i < poses.size(); ++i) p.links[i]->setMatrix(toMatrix(poses[i]));
     p.dirty = false;
   }
-  p.node->setNodeMask(p.visible && hasRobot && !coincides(p) ? ~0u : 0u);
+  p.node->setNodeMask(p.visible && p.bodyShown && hasRobot && !coincides(p) ? ~0u : 0u);
   if (p.pathDirty) {
     for (auto [geometry, points] : {std::pair{p.path.get(), &p.pathPoints}, std::pair{p.envelope.get(), &p.envelopePoints}}) {
       auto* v = static_cast<osg::Vec3Array*>(geometry->getVertexArray());
@@ -964,6 +965,8 @@ void SceneView::setRehearsalEnvelope(const std::vector<Vec3>& points) {
 }
 void SceneView::setRehearsalVisible(bool visible) { m_->rehearsal.visible = visible; }
 bool SceneView::rehearsalVisible() const { return m_->rehearsal.visible; }
+void SceneView::setRehearsalRobotShown(bool shown) { m_->rehearsal.bodyShown = shown; }
+bool SceneView::rehearsalRobotDrawn() const { return m_->rehearsal.node->getNodeMask() != 0; }
 size_t SceneView::drawnRehearsalPathPoints() const {
   return m_->rehearsal.pathNode->getNodeMask() ? m_->rehearsal.pathPoints.size() : 0;
 }

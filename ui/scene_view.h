@@ -95,6 +95,10 @@ class SceneView : public QOpenGLWidget {
   void setRehearsalEnvelope(const std::vector<Vec3>& points);
   void setRehearsalVisible(bool visible);
   bool rehearsalVisible() const;
+  /// The amber robot itself (its path stays): hidden once the rehearsed
+  /// sequence has run, shown again when scrubbed.
+  void setRehearsalRobotShown(bool shown);
+  bool rehearsalRobotDrawn() const;  ///< at the last frame
   size_t drawnRehearsalPathPoints() const;
   Pose drawnRehearsalBasePose() const;
 

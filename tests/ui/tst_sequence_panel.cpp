@@ -203,6 +203,7 @@ class TestSequencePanel : public QObject {
     QVERIFY(at);
     QTRY_VERIFY(std::hypot(scene->drawnRehearsalBasePose().p.x - at->base.p.x,
                            scene->drawnRehearsalBasePose().p.y - at->base.p.y) < 1e-3);
+    QTRY_VERIFY(scene->rehearsalRobotDrawn());  // scrubbed 2 s ahead of the robot: drawn
 
     // Robustness on cluster: the same perturbed rehearsals written as a sweep
     // (app/sweep/sweep.h), from the robot's state; no cluster answers here, so the
@@ -233,6 +234,10 @@ class TestSequencePanel : public QObject {
     QVERIFY2(p->relay().compared() > 50, qPrintable(QString::number(p->relay().compared())));
     QVERIFY(p->relay().worstPosition() < 0.05);
     QVERIFY(p->status().contains("done on the robot"));
+    // The run ended: the amber robot is not drawn any more, its path is
+    // (issue 31: it stood where last scrubbed, in the follow camera's way).
+    QTRY_VERIFY(!scene->rehearsalRobotDrawn());
+    QVERIFY(scene->drawnRehearsalPathPoints() > 10);
 
     // The log: the rehearsals, the relay, the robot's run of it.
     const QString log = window_->logPath();

@@ -43,8 +43,12 @@ void SequenceJob::install(ConsoleContext& context) {
   SceneView& scene = context.scene();
   connect(panel_, &SequencePanel::scrubbed, &scene, [&scene](const Pose& base, const std::vector<double>& joints) {
     scene.setRehearsalState(base, joints);
+    scene.setRehearsalRobotShown(true);
     scene.setRehearsalVisible(true);
   });
+  // After the run the amber robot stood where it was last scrubbed, in the
+  // follow camera's way: its path stays, the robot goes (scrubbing shows it).
+  connect(panel_, &SequencePanel::runEnded, &scene, [&scene] { scene.setRehearsalRobotShown(false); });
   connect(panel_, &SequencePanel::pathChanged, &scene,
           [&scene](const std::vector<Vec3>& path, const std::vector<Vec3>& envelope) {
             scene.setRehearsalPath(path);

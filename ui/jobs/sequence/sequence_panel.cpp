@@ -660,6 +660,9 @@ void SequencePanel::onSequenceState(const net::SequenceStateMsg& state) {
     }
     default: break;
   }
+  const bool ended = r.phase() == SequenceRelay::Phase::Done || r.phase() == SequenceRelay::Phase::Aborted ||
+                     r.phase() == SequenceRelay::Phase::Refused;
+  if (ended && shownPhase_ != r.phase()) emit runEnded();
   shownPhase_ = r.phase();
   updateButtons();
 }

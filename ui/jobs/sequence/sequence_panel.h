@@ -159,6 +159,9 @@ class SequencePanel : public QWidget {
   void abortRequested(const QString& hash, const QString& reason);
   /// The scrubber moved: draw the rehearsed robot here.
   void scrubbed(const sp::Pose& base, const std::vector<double>& jointPositions);
+  /// The sent sequence ended on the robot (done, aborted or refused): the
+  /// rehearsed robot is not needed in the view any more.
+  void runEnded();
   /// A new rehearsal path (base positions on the ground) and the robustness
   /// envelope (hull of end positions; empty for none).
   void pathChanged(const std::vector<sp::Vec3>& path, const std::vector<sp::Vec3>& envelope);
