@@ -14,12 +14,14 @@
 #include <QMenu>
 #include <QMenuBar>
 #include <QMessageBox>
+#include <QPushButton>
 #include <QScrollArea>
 #include <QSettings>
 #include <QStandardPaths>
 #include <QStatusBar>
 #include <QTimer>
 #include <QUrl>
+#include <QHBoxLayout>
 #include <QVBoxLayout>
 
 #include "app/console/console_session.h"
@@ -86,7 +88,20 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   banner_->setObjectName(QStringLiteral("banner"));
   banner_->setWordWrap(true);
   banner_->setStyleSheet(QStringLiteral("QLabel { background: #c62828; color: white; font-weight: bold; padding: 6px; }"));
-  banner_->hide();
+  // The way out of a diverged twin or a robot off the terrain, beside the
+  // banner that says so (it was only in the Robot menu).
+  bannerReset_ = new QPushButton(tr("Reset to the start"));
+  bannerReset_->setObjectName(QStringLiteral("bannerReset"));
+  bannerReset_->setToolTip(tr("Robot ▸ Reset to the start: the stand-in restarts with the robot where the world puts it"));
+  bannerReset_->setFocusPolicy(Qt::NoFocus);
+  connect(bannerReset_, &QPushButton::clicked, this, [this] { resetRobot(); });
+  bannerRow_ = new QWidget;
+  auto* bannerLayout = new QHBoxLayout(bannerRow_);
+  bannerLayout->setContentsMargins(0, 0, 0, 0);
+  bannerLayout->setSpacing(0);
+  bannerLayout->addWidget(banner_, 1);
+  bannerLayout->addWidget(bannerReset_);
+  bannerRow_->hide();
   scene_ = new SceneView;
   scene_->setFocusPolicy(Qt::StrongFocus);
   scene_->setToolTip(tr("Drag to orbit, wheel to zoom, right-drag to pan. Keys: arrows or WASD drive, Space stops, F follows, Esc e-stops."));
@@ -94,7 +109,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   staleLabel_->setObjectName(QStringLiteral("staleLabel"));
   staleLabel_->setStyleSheet(QStringLiteral("QLabel { background: #616161; color: white; font-weight: bold; padding: 4px; }"));
   staleLabel_->hide();
-  layout->addWidget(banner_);
+  layout->addWidget(bannerRow_);
   layout->addWidget(staleLabel_);
   layout->addWidget(scene_, 1);
   setCentralWidget(central);
@@ -534,6 +549,9 @@ void MainWindow::stateChanged() {
   for (const std::string& line : now.bannerLines()) lines << qs(line);
   banner_->setText(lines.join(QLatin1Char('\n')));
   banner_->setVisible(!lines.isEmpty());
+  bannerRow_->setVisible(!lines.isEmpty());
+  const bool stuck = !now.healthReport().empty() || (now.edgeDistance() && *now.edgeDistance() < 0);
+  bannerReset_->setVisible(stuck && !now.replaying() && session_->standIn());
   // Red for an alarm (the latch's colour), amber for a warning, blue for
   // a replay shown without alarms.
   const char* background = now.bannerAlarm() ? "#c62828" : now.replaying() ? "#1565c0" : "#e65100";

@@ -37,6 +37,7 @@
 
 class QAction;
 class QLabel;
+class QPushButton;
 class QDockWidget;
 class QMenu;
 
@@ -229,6 +230,8 @@ class MainWindow : public QMainWindow, public ConsoleHost {
   QAction* ghostAction_ = nullptr;
   bool ghostShownBeforeReplay_ = false;
   QLabel* banner_ = nullptr;
+  QWidget* bannerRow_ = nullptr;        // the banner and its Reset button
+  QPushButton* bannerReset_ = nullptr;  // shown when the twin diverged or the robot is off the terrain
   QLabel* staleLabel_ = nullptr;
   StatusFields* status_ = nullptr;
   int64_t panelTicks_ = 0;

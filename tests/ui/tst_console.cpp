@@ -456,9 +456,14 @@ class TestConsole : public QObject {
     QVERIFY2(apart(scene->drawnBasePose(), robot0) < 0.002, qPrintable(QString::number(apart(scene->drawnBasePose(), robot0))));
     // The trail: the path ahead of the ghost under the commands sent.
     QTRY_VERIFY_WITH_TIMEOUT(scene->drawnTrailPoints() > 40, 3000);
-    const GhostView v = ghost->view();
-    const Vec3 end = v.trail.back();
-    QVERIFY2(std::hypot(end.x - v.base.p.x, end.y - v.base.p.y) > 2.0, qPrintable(QString::number(end.x - v.base.p.x)));
+    // Its 5 s at 0.5 m/s reach over 2 m once a trail runs from a state at
+    // full speed (under load the first may still start from the ghost
+    // speeding up: 1.985 m was seen).
+    const auto trailReach = [&] {
+      const GhostView v = ghost->view();
+      return v.trail.empty() ? 0.0 : std::hypot(v.trail.back().x - v.base.p.x, v.trail.back().y - v.base.p.y);
+    };
+    QTRY_VERIFY2_WITH_TIMEOUT(trailReach() > 2.0, qPrintable(QString::number(trailReach())), 3000);
     // Once the robot drives, telemetry meets the ghost's predictions.
     QTRY_VERIFY_WITH_TIMEOUT(apart(scene->drawnBasePose(), robot0) > 0.3, 5000);
     PredictionErrorPlot* plot = w.predictionErrorPlot();
@@ -643,10 +648,13 @@ class TestConsole : public QObject {
     QVERIFY(terrain);
     QCOMPARE(terrain->text(), QStringLiteral("terrain 20.0 × 20.0 m"));
     QTRY_VERIFY_WITH_TIMEOUT(w.bannerText().contains(QLatin1String("Near the terrain's edge")), 3000);
-    // A warning, not a latch: amber, not the e-stop's red (issue 31).
+    // A warning, not a latch: amber, not the e-stop's red (issue 31), and
+    // no Reset offered for it.
     auto* banner = w.findChild<QLabel*>(QStringLiteral("banner"));
     QVERIFY(banner && !banner->property("alarm").toBool());
     QVERIFY2(banner->styleSheet().contains(QLatin1String("#e65100")), qPrintable(banner->styleSheet()));
+    auto* reset = w.findChild<QPushButton*>(QStringLiteral("bannerReset"));
+    QVERIFY(reset && !reset->isVisible());
     const QString firstLog = w.logPath();
     w.resetRobot();
     QVERIFY(w.logPath() != firstLog);
@@ -661,6 +669,30 @@ class TestConsole : public QObject {
     // The control: on the flat world (a plane) there is no edge to warn of.
     QVERIFY(!window_->bannerText().contains(QLatin1String("edge")));
     w.close();
+
+    // Off the terrain (the robot placed 2 m beyond its edge): an alarm, and
+    // the banner offers the way out beside it (issue 31); it resets.
+    const QString off = dir_.filePath(QStringLiteral("off.world.xml"));
+    std::ofstream(off.toStdString())
+        << "<world name=\"off\" version=\"1\">\n  <material name=\"ground\"/>\n  <material name=\"rubber\"/>\n"
+        << "  <contact default=\"true\" mu=\"0.7\"/>\n"
+        << "  <terrain type=\"heightfield\" file=\"" SP_SOURCE_DIR "/terrains/bumpy.asc\" material=\"ground\"/>\n"
+        << "  <robot name=\"workpartner\" file=\"" SP_SOURCE_DIR "/robots/workpartner.xml\" xyz=\"12.5 0 0.3\"/>\n</world>\n";
+    ConsoleOptions o2 = options_;
+    o2.world = off;
+    o2.logDir = dir_.filePath(QStringLiteral("off"));
+    MainWindow away(o2);
+    QCOMPARE(away.start(), QString());
+    away.show();
+    QTRY_VERIFY_WITH_TIMEOUT(away.bannerText().contains(QLatin1String("off the terrain")), 5000);
+    auto* offReset = away.findChild<QPushButton*>(QStringLiteral("bannerReset"));
+    QVERIFY(offReset);
+    QTRY_VERIFY(offReset->isVisible());
+    QVERIFY(away.findChild<QLabel*>(QStringLiteral("banner"))->property("alarm").toBool());
+    const QString offLog = away.logPath();
+    QTest::mouseClick(offReset, Qt::LeftButton);
+    QTRY_VERIFY_WITH_TIMEOUT(away.logPath() != offLog, 10000);
+    away.close();
   }
 
   // --sequence FILE opens the Sequence dock's tab in front (issue 31);
