@@ -631,16 +631,21 @@ class TestConsole : public QObject {
   // warns near its edge; Robot > Reset restarts the robot at its start
   // (a new log; the old one says why it ends) and the warning stays true.
   void terrainEdgeWarnedAndReset() {
-    const QString world = dir_.filePath(QStringLiteral("edge.world.xml"));
-    std::ofstream(world.toStdString())
-        << "<world name=\"edge\" version=\"1\">\n  <material name=\"ground\"/>\n  <material name=\"rubber\"/>\n"
-        << "  <contact default=\"true\" mu=\"0.7\"/>\n"
-        << "  <terrain type=\"heightfield\" file=\"" SP_SOURCE_DIR "/terrains/bumpy.asc\" material=\"ground\"/>\n"
-        << "  <robot name=\"workpartner\" file=\"" SP_SOURCE_DIR "/robots/workpartner.xml\" xyz=\"9 0 0.3\"/>\n</world>\n";
-    ConsoleOptions o = options_;
-    o.world = world;
-    o.logDir = dir_.filePath(QStringLiteral("edge"));
-    MainWindow w(o);
+    // The bumpy field (20 x 20 m) with the robot at x; a console on it.
+    const auto onBumpy = [&](const char* name, const char* x) {
+      const QString world = dir_.filePath(QString::fromLatin1(name) + ".world.xml");
+      std::ofstream(world.toStdString())
+          << "<world name=\"" << name << "\" version=\"1\">\n  <material name=\"ground\"/>\n"
+          << "  <material name=\"rubber\"/>\n  <contact default=\"true\" mu=\"0.7\"/>\n"
+          << "  <terrain type=\"heightfield\" file=\"" SP_SOURCE_DIR "/terrains/bumpy.asc\" material=\"ground\"/>\n"
+          << "  <robot name=\"workpartner\" file=\"" SP_SOURCE_DIR "/robots/workpartner.xml\" xyz=\"" << x
+          << " 0 0.3\"/>\n</world>\n";
+      ConsoleOptions o = options_;
+      o.world = world;
+      o.logDir = dir_.filePath(QString::fromLatin1(name));
+      return o;
+    };
+    MainWindow w(onBumpy("edge", "9"));
     QCOMPARE(w.start(), QString());
     w.show();
     QTRY_VERIFY_WITH_TIMEOUT(w.telemetryReceived() > 5, 5000);
@@ -672,16 +677,7 @@ class TestConsole : public QObject {
 
     // Off the terrain (the robot placed 2 m beyond its edge): an alarm, and
     // the banner offers the way out beside it (issue 31); it resets.
-    const QString off = dir_.filePath(QStringLiteral("off.world.xml"));
-    std::ofstream(off.toStdString())
-        << "<world name=\"off\" version=\"1\">\n  <material name=\"ground\"/>\n  <material name=\"rubber\"/>\n"
-        << "  <contact default=\"true\" mu=\"0.7\"/>\n"
-        << "  <terrain type=\"heightfield\" file=\"" SP_SOURCE_DIR "/terrains/bumpy.asc\" material=\"ground\"/>\n"
-        << "  <robot name=\"workpartner\" file=\"" SP_SOURCE_DIR "/robots/workpartner.xml\" xyz=\"12.5 0 0.3\"/>\n</world>\n";
-    ConsoleOptions o2 = options_;
-    o2.world = off;
-    o2.logDir = dir_.filePath(QStringLiteral("off"));
-    MainWindow away(o2);
+    MainWindow away(onBumpy("off", "12.5"));
     QCOMPARE(away.start(), QString());
     away.show();
     QTRY_VERIFY_WITH_TIMEOUT(away.bannerText().contains(QLatin1String("off the terrain")), 5000);
