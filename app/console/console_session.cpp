@@ -247,7 +247,11 @@ RobotFrame ConsoleSession::telemetry(const net::TelemetryMsg& t, double wall, do
   RobotFrame f = frameFromTelemetry(t, robot(), positions_, rates_);
   if (const RobotModel* model = robot()) {
     if (recorder_) recorder_->telemetry(t, *model);
-    if (ghost_) {
+    if (ghost_ && !f.health.empty()) {
+      // A diverged robot twin reports no state to predict from.
+      ghost_->halt("the robot's twin diverged: " + f.health);
+      lastPrediction_.reset();
+    } else if (ghost_) {
       lastPrediction_ = ghost_->anchor(f, roundTrip > 0 ? roundTrip : t.rttMs / 1000);
       if (lastPrediction_) logPrediction(*lastPrediction_);
     }

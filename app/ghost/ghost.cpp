@@ -149,6 +149,7 @@ std::optional<GhostError> Ghost::anchor(const RobotFrame& frame, double roundTri
     error = record_.compare(frame);
     frame_ = frame;
     ++frameVersion_;
+    halted_.clear();
   }
   anchorWake_.notify_one();
   return error;
@@ -199,6 +200,14 @@ std::optional<double> Ghost::errorWorst() const {
 GhostStats Ghost::stats() const {
   std::lock_guard lock(mutex_);
   return stats_;
+}
+
+void Ghost::halt(const std::string& why) {
+  std::lock_guard lock(mutex_);
+  if (halted_ == why) return;
+  halted_ = why;
+  view_.problem = why;
+  ++view_.version;
 }
 
 void Ghost::setProblem(const std::string& problem) {

@@ -154,6 +154,10 @@ class Ghost {
   std::optional<std::pair<double, double>> errorMedian() const;
   /// [m] the largest position error over the same 10 s.
   std::optional<double> errorWorst() const;
+  /// The robot reported its twin diverged (`why`): the ghost stops
+  /// predicting (its view keeps the last prediction, with `why` as its
+  /// problem) until the next anchor().
+  void halt(const std::string& why);
   GhostStats stats() const;
   /// Robot time the ghost shows at wall time `wall` (steady clock [s]).
   double ghostTime(double wall) const;
@@ -218,6 +222,7 @@ class Ghost {
   std::shared_ptr<const TrailRequest> trailRequest_;
   uint64_t trailVersion_ = 0;
   GhostView view_;
+  std::string halted_;  // why the ghost does not predict (halt()); "" while it does
   PredictionRecord record_;  // what was shown against what came
   GhostStats stats_;
 

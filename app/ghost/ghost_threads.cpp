@@ -221,6 +221,7 @@ void Ghost::presentLoop() {
     }
     {
       std::lock_guard lock(mutex_);
+      if (!halted_.empty()) continue;  // the robot's twin diverged: nothing to predict until it reports again
       GhostView& v = view_;
       ++v.version;
       v.time = t;

@@ -12,6 +12,7 @@
 #include <mutex>
 
 #include "app/console/console_session.h"
+#include "app/ghost/ghost.h"
 #include "app/console/console_state.h"
 #include "app/log/session_log.h"
 #include "app/log/session_recorder.h"
@@ -312,6 +313,30 @@ class TestConsoleSession : public QObject {
     QVERIFY2(std::abs(session.realTimeFactor() - 2.0) < 1e-9, qPrintable(QString::number(session.realTimeFactor())));
     for (int i = 0; i <= 100; ++i) session.telemetry(telemetryAt(0.5 * 0.02 * i, {}, {}), 60.0 + 0.02 * i);
     QVERIFY2(std::abs(session.realTimeFactor() - 0.5) < 1e-9, qPrintable(QString::number(session.realTimeFactor())));
+  }
+
+  // A frame whose twin diverged halts the ghost (issue 31): it says why and
+  // predicts nothing more (its view stays as it was), until a healthy frame.
+  void divergedRobotHaltsTheGhost() {
+    ConsoleSessionOptions o = options("halt");
+    o.connectTo = "127.0.0.1:9";
+    o.token = "00112233445566778899aabbccddeeff";
+    o.log = false;
+    ConsoleSession session(o);
+    QCOMPARE(QString::fromStdString(session.start()), QString());
+    const Ghost* ghost = session.ghost();
+    QVERIFY(ghost);
+    net::TelemetryMsg t = telemetryAt(1.0, {}, {});
+    t.health = "angular speed 512 rad/s exceeds 200";
+    session.telemetry(t, 20.0);
+    const std::string why = "the robot's twin diverged: angular speed 512 rad/s exceeds 200";
+    QCOMPARE(ghost->view().problem, why);
+    const uint64_t version = ghost->view().version;
+    QTest::qWait(300);  // its threads publish nothing meanwhile
+    QCOMPARE(ghost->view().version, version);
+    QCOMPARE(ghost->view().problem, why);
+    session.telemetry(telemetryAt(1.1, {}, {}), 20.1);  // healthy again: it anchors
+    QTRY_VERIFY_WITH_TIMEOUT(ghost->view().problem != why, 3000);
   }
 
   // Only the lease holder commands.
