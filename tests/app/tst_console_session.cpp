@@ -56,6 +56,15 @@ class TestConsoleSession : public QObject {
     o.rtf = 1;
     return o;
   }
+  // A console for a remote robot that is not there (nothing listens on port
+  // 9), without a log: its telemetry is fed by hand.
+  ConsoleSessionOptions unlogged(const std::string& sub) const {
+    ConsoleSessionOptions o = options(sub);
+    o.connectTo = "127.0.0.1:9";
+    o.token = "00112233445566778899aabbccddeeff";
+    o.log = false;
+    return o;
+  }
   std::string write(const std::string& name, const char* text) const {
     const std::string path = dir_.filePath(QString::fromStdString(name)).toStdString();
     QFile f(QString::fromStdString(path));
@@ -302,11 +311,7 @@ class TestConsoleSession : public QObject {
   // The real-time factor is robot time over wall time across the last
   // second; a robot time that goes back (a new session) starts it over.
   void realTimeFactor() {
-    ConsoleSessionOptions o = options("rtf");
-    o.connectTo = "127.0.0.1:9";
-    o.token = "00112233445566778899aabbccddeeff";
-    o.log = false;
-    ConsoleSession session(o);
+    ConsoleSession session(unlogged("rtf"));
     QCOMPARE(QString::fromStdString(session.start()), QString());
     QCOMPARE(session.realTimeFactor(), 0.0);
     for (int i = 0; i <= 100; ++i) session.telemetry(telemetryAt(2.0 * 0.02 * i, {}, {}), 50.0 + 0.02 * i);
@@ -318,11 +323,7 @@ class TestConsoleSession : public QObject {
   // A frame whose twin diverged halts the ghost (issue 31): it says why and
   // predicts nothing more (its view stays as it was), until a healthy frame.
   void divergedRobotHaltsTheGhost() {
-    ConsoleSessionOptions o = options("halt");
-    o.connectTo = "127.0.0.1:9";
-    o.token = "00112233445566778899aabbccddeeff";
-    o.log = false;
-    ConsoleSession session(o);
+    ConsoleSession session(unlogged("halt"));
     QCOMPARE(QString::fromStdString(session.start()), QString());
     const Ghost* ghost = session.ghost();
     QVERIFY(ghost);
