@@ -540,8 +540,8 @@ class RobotClient::Impl {
   // (gaps between arrivals alone underrate it: the link keeps order). Then,
   // once, whether our keep-alives so stretched fit the robot's deadman.
   void checkLink(double robotTime) {
+    if (linkChecked_ || !ready_) return;  // once per connection: nothing more per frame
     const double t = now();
-    if (linkChecked_ || !ready_) return;
     const double offset = t - robotTime;
     minOffset_ = std::min(minOffset_, offset);
     maxOffset_ = std::max(maxOffset_, offset);

@@ -107,11 +107,9 @@ class RobotLink {
     std::vector<TimedCommand> commands;
   };
   std::vector<SequenceRequest> takeSequences();
-  /// The robot refused `client`'s sequence `hash` (`reason`): SEQUENCE_STATE
-  /// refused to that client alone, as the link's own refusals.
-  void refuseSequenceOf(ClientId client, const std::string& hash, const std::string& reason) {
-    refuseSequence(client, hash, reason);
-  }
+  /// `client`'s sequence `hash` is refused (`reason`; the link's own checks
+  /// or the robot's): SEQUENCE_STATE refused to that client alone.
+  void refuseSequence(ClientId client, const std::string& hash, const std::string& reason);
   /// Why running sequences must stop, in order: an ABORT, an e-stop, the
   /// failsafe, the lease given up or taken back (each also queued a stop).
   std::vector<std::string> takeAborts();
@@ -182,7 +180,6 @@ class RobotLink {
   void stopEverything(EventKind why, const std::string& text, double now);
   /// Queues a stop and aborts any running sequence, for `why`.
   void stopRobot(const std::string& why);
-  void refuseSequence(ClientId client, const std::string& hash, const std::string& reason);
   /// A keep-alive or command from the holder arrived: the deadman counts from now.
   void heardFromHolder(double now);
   void close(ClientId client, const std::string& reason);

@@ -268,7 +268,7 @@ void RobotServer::flush() {
     const std::string why = robot_.startSequence(
         {m.hash, std::move(r.commands), m.start, m.startPosition, m.startHeading});
     if (!why.empty()) {
-      link_.refuseSequenceOf(r.client, m.hash, why);
+      link_.refuseSequence(r.client, m.hash, why);
       continue;
     }
     link_.sequenceState({m.hash, SequenceStateKind::Accepted, 0, 0, 0, ""});
