@@ -13,8 +13,8 @@
 #include "sim/kinematics.h"
 #include "sim/perturbation.h"
 #include "sim/random.h"
+#include "sim/readout.h"
 #include "sim/rigid.h"
-#include "sim/perturbation.h"
 #include "sim/runner.h"
 #include "sim/text.h"
 #include "sim/world.h"
@@ -134,19 +134,12 @@ std::string placeRobot(World& world, const RehearsalStart& s, const RigidRobot* 
 
 namespace {
 
-// The state rehearsals start from, read off `w` (robot 0, the objects).
+// The state rehearsals start from, read off `w` (robot 0, its dynamic objects).
 RehearsalStart stateOf(const World& w) {
-  const RobotModel& robot = w.robotModel(0);
-  RehearsalStart s;
-  s.base = w.linkPose(0, 0);
-  s.baseLinear = w.linkLinearVelocity(0, 0);
-  s.baseAngular = w.linkAngularVelocity(0, 0);
-  for (size_t j = 0; j < robot.joints.size(); ++j) {
-    s.jointPositions.push_back(w.jointPosition(0, static_cast<int>(j)));
-    s.jointRates.push_back(w.jointRate(0, static_cast<int>(j)));
-  }
-  for (size_t o = 0; o < w.model().objects.size(); ++o)
-    s.objects.emplace_back(w.model().objects[o].name, w.objectPose(static_cast<int>(o)));
+  RobotReadout r = readRobot(w);
+  RehearsalStart s{r.base, r.baseLinearVelocity, r.baseAngularVelocity, std::move(r.jointPositions),
+                   std::move(r.jointRates), {}};
+  for (ObjectReadout& o : r.objects) s.objects.emplace_back(std::move(o.name), o.pose);
   return s;
 }
 
