@@ -556,6 +556,13 @@ void readDrive(const XMLElement* e, RobotModel& robot, std::string_view file, Di
   const std::string art = r.text("articulation", true).value_or("");
   d.wheelRadius = r.number("wheel_radius", 0, true);
   r.positive("wheel_radius");
+  d.tyreStiffness = r.number("tyre_stiffness", 0);
+  d.tyreDamping = r.number("tyre_damping", 0);
+  // As for a contact's stiffness and damping: a spring rings without its damper.
+  if ((e->Attribute("tyre_stiffness") != nullptr) != (e->Attribute("tyre_damping") != nullptr))
+    r.error("tyre_stiffness and tyre_damping go together: give both or neither");
+  else if (e->Attribute("tyre_stiffness") && (d.tyreStiffness <= 0 || d.tyreDamping <= 0))
+    r.error("tyre_stiffness and tyre_damping must both be > 0");
   r.finish();
   if (!art.empty()) {
     d.articulation = robot.findJoint(art);

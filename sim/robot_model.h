@@ -116,6 +116,9 @@ struct DriveSpec {
   int articulation = -1;            ///< hinge joint between front and rear body
   std::array<int, 4> wheels{-1, -1, -1, -1};  ///< FL, FR, RL, RR wheel joints
   double wheelRadius = 0;           ///< [m]
+  /// The tyres' vertical compliance [N/m, N s/m], per wheel; 0 = rigid.
+  /// A world's contact with its own stiffness or softness overrides it.
+  double tyreStiffness = 0, tyreDamping = 0;
   int line = 0;
 };
 

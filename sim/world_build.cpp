@@ -4,6 +4,7 @@
 #include "sim/world_impl.h"
 
 #include <algorithm>
+#include <tuple>
 
 namespace sp {
 using namespace world_detail;
@@ -61,12 +62,8 @@ dSurfaceParameters toSurface(const ContactSpec& c, double step) {
     s.soft_cfm = c.softCfm;
   }
   if (c.stiffness > 0) {
-    // The spring-damper a step of h makes of ERP and CFM (ODE's manual,
-    // "Soft constraint and constraint force mixing").
-    const double hk = step * c.stiffness;
     s.mode |= dContactSoftERP | dContactSoftCFM;
-    s.soft_erp = hk / (hk + c.damping);
-    s.soft_cfm = 1 / (hk + c.damping);
+    std::tie(s.soft_erp, s.soft_cfm) = springDamper(c.stiffness, c.damping, step);
   }
   if (c.rollingResistance > 0) {
     // Without dContactAxisDep ODE applies rho about all three axes, the
@@ -136,6 +133,7 @@ World::~World() {
   if (m.resistanceJoints) dJointGroupDestroy(m.resistanceJoints);
   dSpaceDestroy(m.space);  // destroys the geoms too (cleanup mode on)
   dGeomDestroy(m.ray);
+  dGeomDestroy(m.tyreProxy);
   if (m.heightData) dGeomHeightfieldDataDestroy(m.heightData);
   dWorldSetStepThreadingImplementation(m.world, nullptr, nullptr);
   dWorldDestroy(m.world);
@@ -160,6 +158,7 @@ bool World::build(Diagnostics& diag) {
   m.randState = static_cast<unsigned long>(params_.seed & 0xffffffffu);
   m.random.reseed(params_.seed);
   m.ray = dCreateRay(nullptr, 1.0);
+  m.tyreProxy = dCreateSphere(nullptr, 1.0);
   dGeomRaySetClosestHit(m.ray, 1);
   m.perThreadRandom = odeRandomIsPerThread();
   m.scratch.resize(static_cast<size_t>(std::max(1, params_.maxContacts)));
@@ -256,6 +255,10 @@ bool World::build(Diagnostics& diag) {
     std::vector<int> wheelSensorOfLink(robot.links.size(), -1);
     for (size_t si = 0; si < robot.sensors.size(); ++si)
       if (robot.sensors[si].type == SensorType::WheelForce) wheelSensorOfLink[robot.sensors[si].link] = static_cast<int>(si);
+    std::vector<bool> wheelLink(robot.links.size(), false);
+    if (robot.drive)
+      for (int j : robot.drive->wheels)
+        if (j >= 0) wheelLink[static_cast<size_t>(robot.joints[j].child)] = true;
     const std::string prefix = model_.robots.size() > 1 ? "robot '" + inst.name + "' " : "";
     for (size_t li = 0; li < robot.links.size(); ++li) {
       const LinkSpec& link = robot.links[li];
@@ -274,6 +277,12 @@ bool World::build(Diagnostics& diag) {
             m.newInfo(materialIndex(model_, g.material), static_cast<int>(r), static_cast<int>(li));
         info.wheelSensor = wheelSensorOfLink[li];
         if (g.type == GeomType::Cylinder || g.type == GeomType::Sphere) info.rollRadius = g.radius;
+        if (g.type == GeomType::Cylinder && wheelLink[li]) {
+          info.tyre = true;
+          if (robot.drive->tyreStiffness > 0)
+            std::tie(info.tyreErp, info.tyreCfm) =
+                springDamper(robot.drive->tyreStiffness, robot.drive->tyreDamping, params_.step);
+        }
         dGeomSetData(geom, &info);
         dGeomSetBody(geom, body);
         setGeomOffset(geom, Pose{-com, {}} * g.pose);

@@ -56,7 +56,15 @@ struct GeomInfo {
   int object = -1;
   int wheelSensor = -1;  // a wheel_force sensor on this geom's link
   double rollRadius = 0;  // a robot's cylinder or sphere: the radius it rolls on (motion resistance)
+  bool tyre = false;      // a cylinder on a drive wheel: one contact per surface it touches
+  double tyreErp = -1, tyreCfm = -1;  // its drive's tyre compliance for this step (-1: rigid)
 };
+
+/// ODE's soft ERP and CFM that make a spring k and damper c for a step h
+/// (ODE's manual, "Soft constraint and constraint force mixing").
+inline std::pair<double, double> springDamper(double k, double c, double h) {
+  return {h * k / (h * k + c), 1 / (h * k + c)};
+}
 
 inline bool finite(const dReal* v, int n) {
   for (int i = 0; i < n; ++i)
@@ -132,6 +140,7 @@ struct World::Impl {
   }
   double planeHeight = 0;
   dGeomID ray = nullptr;  // for castRay(); in no space
+  dGeomID tyreProxy = nullptr;  // collidePair(): a tyre against a heightfield, as a sphere; in no space
   struct RayTarget {
     dGeomID geom;
     std::array<double, 6> box;  // ODE's AABB: min x, max x, min y, ...
@@ -198,6 +207,12 @@ struct World::Impl {
   // ODE's broad-phase callback and the narrow phase of one pair; they
   // gather contact candidates (world_contacts.cpp).
   static void nearCallback(void* data, dGeomID g1, dGeomID g2);
+  /// dCollide, except that a tyre meets a heightfield as a sphere of its
+  /// radius (world_contacts.cpp says why); the contacts name g1 and g2.
+  int collidePair(dGeomID g1, dGeomID g2, dContactGeom* out, int max);
+  /// How deep each geom of `bodies` reaches into the terrain (0: not
+  /// touching), in the bodies' geom order (world.cpp).
+  std::vector<double> terrainDepths(const std::vector<dBodyID>& bodies);
   void near(dGeomID g1, dGeomID g2);
 };
 

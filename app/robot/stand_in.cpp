@@ -167,15 +167,19 @@ bool StandInRobot::shutdown(const std::string& reason, double maxWait) {
   asio::post(server_->io, [s = server_.get(), reason] { s->server->shutdown(reason); });
   // The stop is applied at the twin's next step; then it comes to rest. At
   // rest: the base slower than 5 mm/s and 0.01 rad/s (what telemetry
-  // reports, so a real robot's adapter can wait the same way).
+  // reports, so a real robot's adapter can wait the same way) throughout
+  // `settle`: a body rocking on its tyres after braking passes through
+  // zero speed on every swing.
   const Clock::time_point start = Clock::now();
   const auto until = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(maxWait));
   const auto settle = std::chrono::duration<double>(std::max(0.1, 3.0 / params_.logRate));
+  Clock::time_point moving = start;  // when it was last seen moving
   bool rest = false;
   while (Clock::now() < until && !rest) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     const net::RobotState s = host_->state();
-    rest = Clock::now() - start >= settle && norm(s.baseLinearVelocity) < 0.005 && norm(s.baseAngularVelocity) < 0.01;
+    if (norm(s.baseLinearVelocity) >= 0.005 || norm(s.baseAngularVelocity) >= 0.01) moving = Clock::now();
+    rest = Clock::now() - moving >= settle;
   }
   // Logged samples of it at rest (at the logging rate), then the end.
   if (rest) std::this_thread::sleep_for(settle);

@@ -41,9 +41,9 @@ const RuleVerdict& verdict(const RehearsalResult& r, Rule rule) { return r.verdi
 // to their limits at t = 3 s: the left side loses its wheels.
 constexpr const char* kTip =
     "0.5 drive 0.4 0\n"
-    "3.0 target knee_fl 80\n"
+    "3.0 target knee_fl -40\n"
     "3.0 target hip_fl 45\n"
-    "3.0 target knee_rl -80\n"
+    "3.0 target knee_rl -40\n"
     "3.0 target hip_rl -45\n";
 constexpr const char* kDrive = "0.5 drive 0.4 0\n";
 

@@ -321,6 +321,29 @@ void TestModelLoader::testRobotErrors_data() {
   </drive>
 </robot>)") << "r.xml:5: error: <drive>: needs exactly 4 <wheel> elements, got 3\n";
 
+  QTest::newRow("tyre stiffness without damping, zero") << QByteArray(R"(<robot name="r">
+  <link name="a" mass="1"><geom type="sphere" radius="0.1"/></link>
+  <link name="b" mass="1"><geom type="sphere" radius="0.1"/></link>
+  <joint name="w" type="hinge" parent="a" child="b"/>
+  <drive articulation="w" wheel_radius="0.1" tyre_stiffness="0">
+    <wheel joint="w" position="front_left"/>
+    <wheel joint="w" position="front_right"/>
+    <wheel joint="w" position="rear_left"/>
+    <wheel joint="w" position="rear_right"/>
+  </drive>
+</robot>)") << "r.xml:5: error: <drive>: tyre_stiffness and tyre_damping go together: give both or neither\n";
+  QTest::newRow("tyre damping zero") << QByteArray(R"(<robot name="r">
+  <link name="a" mass="1"><geom type="sphere" radius="0.1"/></link>
+  <link name="b" mass="1"><geom type="sphere" radius="0.1"/></link>
+  <joint name="w" type="hinge" parent="a" child="b"/>
+  <drive articulation="w" wheel_radius="0.1" tyre_stiffness="1e5" tyre_damping="0">
+    <wheel joint="w" position="front_left"/>
+    <wheel joint="w" position="front_right"/>
+    <wheel joint="w" position="rear_left"/>
+    <wheel joint="w" position="rear_right"/>
+  </drive>
+</robot>)") << "r.xml:5: error: <drive>: tyre_stiffness and tyre_damping must both be > 0\n";
+
   // --- Joint tree
   QTest::newRow("joint loop") << QByteArray(R"(<robot name="r">
   <link name="a" mass="1"><geom type="sphere" radius="0.1"/></link>
