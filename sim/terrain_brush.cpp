@@ -31,6 +31,12 @@ Vec2 gridPoint(const TerrainSpec& terrain, Vec2 world) {
   return {std::cos(yaw) * dx + std::sin(yaw) * dy, -std::sin(yaw) * dx + std::cos(yaw) * dy};
 }
 
+Vec2 worldPoint(const TerrainSpec& terrain, Vec2 grid) {
+  const double yaw = heading(terrain.pose.q);
+  return {terrain.pose.p.x + std::cos(yaw) * grid.x - std::sin(yaw) * grid.y,
+          terrain.pose.p.y + std::sin(yaw) * grid.x + std::cos(yaw) * grid.y};
+}
+
 namespace {
 
 // A value in [-1, 1] from the seed and the sample: splitmix64's finaliser,

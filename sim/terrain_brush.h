@@ -50,6 +50,8 @@ double brushWeight(double distance, double radius);
 /// A point in the grid frame [m] (as HeightGrid::heightAt takes it) from the
 /// world frame: the grid is centred on the terrain's pose, turned by its yaw.
 Vec2 gridPoint(const TerrainSpec& terrain, Vec2 world);
+/// The inverse: the world point of grid point `grid`.
+Vec2 worldPoint(const TerrainSpec& terrain, Vec2 grid);
 
 /// One dab at `centre` (grid frame [m]): the patch covering the samples
 /// within the radius, with their new heights; nullopt when no sample lies

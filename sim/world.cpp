@@ -5,6 +5,7 @@
 #include "sim/terrain_brush.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdarg>
 #include <cstdio>
 #include <mutex>
@@ -230,8 +231,32 @@ std::string patchFits(const HeightGrid* grid, const TerrainPatchCmd& c) {
   return {};
 }
 
+std::vector<double> World::Impl::terrainDepths(const std::vector<dBodyID>& bodies) {
+  std::vector<double> out;
+  std::array<dContactGeom, 16> found;
+  for (dBodyID b : bodies)
+    for (dGeomID g = b ? dBodyGetFirstGeom(b) : nullptr; g; g = dBodyGetNextGeom(g)) {
+      const int n = collidePair(g, terrainGeom, found.data(), static_cast<int>(found.size()));
+      double depth = 0;
+      for (int k = 0; k < n; ++k) depth = std::max(depth, static_cast<double>(found[k].depth));
+      out.push_back(depth);
+    }
+  return out;
+}
+
 void World::applyTerrainPatch(const TerrainPatchCmd& c) {
   Impl& m = *impl_;
+  // Each robot, and each dynamic object, is lifted by as much as the edit
+  // pushed the ground into it: a stroke under a robot lifts its wheels
+  // instead of burying them, which ODE would then resolve by driving them
+  // out sideways or not at all (issue 31: a wheel 0.16 m in the ground and
+  // the twin diverged).
+  std::vector<std::vector<dBodyID>> movers;
+  for (const Impl::Robot& r : m.robots) movers.push_back(r.bodies);
+  for (dBodyID b : m.objectBodies)
+    if (b) movers.push_back({b});
+  std::vector<std::vector<double>> before;
+  for (const auto& bodies : movers) before.push_back(m.terrainDepths(bodies));
   if (m.grid.use_count() > 1) m.grid = std::make_shared<HeightGrid>(*m.grid);  // a snapshot shares it
   // The bounds stay exact without reading the whole grid (0.3 ms for 512 x
   // 512): only when the patch replaces the lowest (highest) sample with
@@ -255,6 +280,16 @@ void World::applyTerrainPatch(const TerrainPatchCmd& c) {
   const dReal* pos = dGeomGetPosition(m.terrainGeom);
   dGeomSetPosition(m.terrainGeom, pos[0], pos[1], pos[2]);
   m.penetrationCheckFrom = steps_ + std::llround(1.0 / params_.step);
+  for (size_t k = 0; k < movers.size(); ++k) {
+    const std::vector<double> after = m.terrainDepths(movers[k]);
+    double lift = 0;
+    for (size_t g = 0; g < after.size(); ++g) lift = std::max(lift, after[g] - before[k][g]);
+    if (lift <= 1e-4) continue;  // a tenth of a millimetre: the contacts take it
+    for (dBodyID b : movers[k]) {
+      const dReal* p = dBodyGetPosition(b);
+      dBodySetPosition(b, p[0], p[1], p[2] + lift);
+    }
+  }
 }
 
 bool odeRandomIsPerThread() {

@@ -445,6 +445,7 @@ struct SceneView::Impl {
   // brush's footprint (a ring draped on the ground under the cursor).
   bool editing = false, painting = false, picking = false;
   double brushRadius = 1.0;
+  bool brushWarning = false;  // the ring amber: the next dab asks too much of the robot
   std::optional<Vec3> hover;
   bool footprintDirty = false;
   osg::ref_ptr<osg::Geode> footprintNode;
@@ -746,6 +747,9 @@ void SceneView::Impl::updateFootprint() {
     v->push_back({f(x), f(y), f(groundHeight(terrain, x, y) + 0.03)});
   }
   v->dirty();
+  auto* colour = static_cast<osg::Vec4Array*>(footprint->getColorArray());
+  (*colour)[0] = brushWarning ? osg::Vec4(1.0f, 0.45f, 0.0f, 1.0f) : osg::Vec4(1.0f, 0.85f, 0.1f, 1.0f);
+  colour->dirty();
   static_cast<osg::DrawArrays*>(footprint->getPrimitiveSet(0))->setCount(kSegments);
   footprint->dirtyBound();
 }
@@ -1091,6 +1095,7 @@ void SceneView::mouseMoveEvent(QMouseEvent* event) {
   if (m.editing) {
     m.hover = groundAt(event->position());
     m.footprintDirty = true;
+    if (m.hover) emit terrainHover(*m.hover);
     if (m.painting && m.hover) emit terrainDab(*m.hover);
   }
   if (m.dragButton == Qt::NoButton) return;
@@ -1152,6 +1157,13 @@ bool SceneView::terrainEditing() const { return m_->editing; }
 void SceneView::setBrushRadius(double radius) {
   m_->brushRadius = radius;
   m_->footprintDirty = true;
+}
+
+void SceneView::setBrushWarning(bool on) {
+  if (m_->brushWarning == on) return;
+  m_->brushWarning = on;
+  m_->footprintDirty = true;
+  update();
 }
 
 void SceneView::pickGround() {

@@ -150,6 +150,9 @@ class SceneView : public QOpenGLWidget {
   void setTerrainEditing(bool on);
   bool terrainEditing() const;
   void setBrushRadius(double radius);
+  /// The footprint ring in the warning colour (amber) instead of yellow:
+  /// the next dab asks more of the robot than it can drive.
+  void setBrushWarning(bool on);
   void pickGround();
   /// The ground under the view's point `pixel` (logical pixels): the first
   /// crossing of the camera ray with the terrain; nullopt when it misses.
@@ -177,6 +180,8 @@ class SceneView : public QOpenGLWidget {
   /// a direct connection and is drawn in this very frame.
   void frameStarting();
   void terrainDab(const sp::Vec3& ground);
+  /// Edit mode: the ground under the cursor as it moves (painting or not).
+  void terrainHover(const sp::Vec3& ground);
   void terrainStrokeEnded();
   void groundPicked(const sp::Vec3& ground);
 

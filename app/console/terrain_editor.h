@@ -40,6 +40,11 @@ class TerrainEditor {
   /// redo levels are dropped by a new stroke.
   void endStroke();
   bool inStroke() const { return stroke_.has_value(); }
+  /// How much the open stroke has changed the height at `at` (grid frame
+  /// [m]); 0 with no stroke open.
+  double strokeChange(Vec2 at) const {
+    return stroke_ ? grid_.heightAt(at.x, at.y) - stroke_->start.heightAt(at.x, at.y) : 0.0;
+  }
 
   /// The patch that takes the last stroke back (applied here), or nullopt.
   std::optional<TerrainPatchCmd> undo();

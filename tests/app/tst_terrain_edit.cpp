@@ -9,6 +9,7 @@
 #include <QtTest>
 
 #include <chrono>
+#include <cmath>
 #include <deque>
 #include <random>
 
@@ -16,6 +17,7 @@
 #include "app/log/resimulation.h"
 #include "app/robot/stand_in.h"
 #include "app/console/terrain_editor.h"
+#include "app/console/terrain_limits.h"
 #include "net/frame.h"
 #include "net/robot_client.h"
 #include "sim/command.h"
@@ -137,6 +139,111 @@ class TestTerrainEdit : public QObject {
       small.endStroke();
     }
     QCOMPARE(small.undoLevels(), size_t{3});
+  }
+
+  // Issue 31: what WorkPartner can drive over, from its files, and the
+  // stroke check built on it. The limits follow the formulas of
+  // app/console/terrain_limits.h: on flat.world (mu 1.0) the motors bind
+  // the slope (4 x 60 N m at 0.2 m for about 230 kg: about 32 deg, below
+  // grip's 45), on ice (mu 0.025) grip does (1.4 deg).
+  void drivableLimitsFromTheFiles() {
+    Diagnostics diag;
+    const auto flat = loadWorld(SP_SOURCE_DIR "/terrains/flat.world.xml", diag);
+    const auto ice = loadWorld(SP_SOURCE_DIR "/terrains/ice.world.xml", diag);
+    QVERIFY2(flat && ice, diag.format().c_str());
+    const auto onFlat = drivableLimits(*flat), onIce = drivableLimits(*ice);
+    QVERIFY(onFlat && onIce);
+    qInfo("flat: slope %.1f deg, step %.3f m (%s); ice: slope %.2f deg, step %.4f m", radToDeg(onFlat->maxSlope),
+          onFlat->maxStep, onFlat->basis.c_str(), radToDeg(onIce->maxSlope), onIce->maxStep);
+    QCOMPARE(onFlat->mu, 1.0);
+    QVERIFY(onFlat->motorBound);
+    QVERIFY(std::abs(radToDeg(onFlat->maxSlope) - 32) < 1.5);
+    QVERIFY(std::abs(onFlat->maxStep - 0.2 * (1 - std::cos(onFlat->maxSlope))) < 1e-12);
+    QVERIFY(!onIce->motorBound);
+    QVERIFY(std::abs(onIce->maxSlope - std::atan(0.025)) < 1e-12);
+    WorldModel none = *flat;
+    none.robots[0].model.drive.reset();
+    QVERIFY(!drivableLimits(none));
+  }
+
+  // The stroke check warns of a sharp ridge and not of what the robot
+  // drives: on level ground (0.1 m samples, flat.world's grip) a 0.3 m
+  // raise of 0.15 m is flagged (higher than a wheel rolls up, steeper than
+  // the robot climbs), a 2 m one of 0.15 m is not (a gentle hill), nor is a
+  // 0.3 m one of 0.02 m (a bump a wheel takes). A stroke beside a steep
+  // rise already there, not making it worse, is not flagged either. The
+  // grid is not touched.
+  void strokeRiskSeesRidgesNotHills() {
+    Diagnostics diag;
+    const auto flat = loadWorld(SP_SOURCE_DIR "/terrains/flat.world.xml", diag);
+    QVERIFY(flat);
+    const auto limits = drivableLimits(*flat);
+    QVERIFY(limits);
+    HeightGrid grid{101, 101, 10.0, 10.0, std::vector<double>(101 * 101, 0.0)};
+    const auto risk = [&](Vec2 at, double radius, double height) {
+      const auto patch = brushDab(grid, at, Brush{BrushKind::Raise, radius, height, 0, 1});
+      return patch ? strokeRisk(grid, *patch, *limits, 0.2) : std::nullopt;
+    };
+    const auto ridge = risk({2, 0}, 0.3, 0.15);
+    QVERIFY(ridge);
+    qInfo("ridge: %s", ridge->message(*limits).c_str());
+    QVERIFY(ridge->rise > limits->maxStep && ridge->grade() > limits->maxSlope);
+    QVERIFY(std::abs(ridge->at.x - 2) < 0.5);
+    QVERIFY(!risk({2, 0}, 2.0, 0.15));
+    QVERIFY(!risk({2, 0}, 0.3, 0.02));
+    // A 0.2 m wall along x = -3 (the terrain's own), a gentle stroke 1 m off.
+    for (int j = 0; j < 101; ++j)
+      for (int i = 0; i < 101; ++i) grid.at(i, j) = i >= 20 ? 0.0 : 0.2;
+    QVERIFY(!risk({-2.0, 0}, 0.5, 0.005));
+    QVERIFY(risk({-3.2, 0}, 0.3, 0.15));  // control: a ridge on top of it is the stroke's
+    QCOMPARE(grid.at(50, 50), 0.0);
+  }
+
+  // Verification of the warning against the twin: what the check lets
+  // pass, WorkPartner drives over. Criterion (before the run): on a flat
+  // heightfield (0.05 m samples) a step as high as 0.9 x the step limit
+  // across its path, driven at 0.3 m/s for 8 s, ends with both front
+  // wheels beyond it and the twin healthy; the control, a step of 0.18 m
+  // (flagged), is not crossed. Before tyres met heightfields as spheres
+  // (world_contacts.cpp) a step of 1 cm threw a wheel 9 cm into the ground.
+  void whatPassesTheCheckIsDriven() {
+    const WorldModel flat = [] {
+      Diagnostics diag;
+      return *loadWorld(SP_SOURCE_DIR "/terrains/flat.world.xml", diag);
+    }();
+    const auto limits = drivableLimits(flat);
+    QVERIFY(limits);
+    const auto crosses = [&](double step) {
+      WorldModel w = flat;
+      HeightGrid g{201, 41, 10.0, 2.0, {}};
+      g.heights.assign(201 * 41, 0.0);
+      const HeightGrid level = g;
+      for (int j = 0; j < 41; ++j)
+        for (int i = 0; i < 201; ++i)
+          if (-5.0 + 0.05 * i >= 1.2) g.at(i, j) = step;  // the step 0.65 m ahead of the front axle
+      w.terrain.kind = TerrainSpec::Kind::Heightfield;
+      w.terrain.grid = g;
+      Diagnostics diag;
+      auto world = World::create(w, {}, diag);
+      if (!world) qFatal("%s", diag.format().c_str());
+      const TerrainPatchCmd whole{0, 0, 201, 41, g.heights};
+      const bool flagged = strokeRisk(level, whole, *limits, 0.2).has_value();  // the step as a stroke on level ground
+      world->submit(DriveCmd{0.3, 0});
+      for (int k = 0; k < 8000; ++k) world->step();
+      const RobotModel& robot = world->robotModel(0);
+      const double fl = world->linkPose(0, robot.findLink("wheel_fl")).p.x;
+      const double fr = world->linkPose(0, robot.findLink("wheel_fr")).p.x;
+      qInfo("a %.3f m step: flagged %d, front wheels at x = %.2f, %.2f m (the step at 1.2 m), healthy %d", step, flagged,
+            fl, fr, world->health().healthy());
+      if (!world->health().healthy()) qInfo("%s", world->health().message().c_str());
+      return std::make_pair(flagged, std::min(fl, fr) > 1.2 + 0.2 && world->health().healthy());
+    };
+    const auto [smallFlagged, smallCrossed] = crosses(0.9 * limits->maxStep);
+    QVERIFY(!smallFlagged);
+    QVERIFY(smallCrossed);
+    const auto [bigFlagged, bigCrossed] = crosses(0.18);
+    QVERIFY(bigFlagged);
+    QVERIFY(!bigCrossed);
   }
 
   // Split into parts of at most 2000 heights, each part's COMMAND text fits

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <tuple>
 
 #include "sim/model_loader.h"
 #include "sim/terrain_brush.h"
@@ -144,6 +145,50 @@ class TestTerrainBrush : public QObject {
     QVERIFY(std::abs(rise - 0.1) < 0.005);
     QVERIFY(std::abs(farRise) < 0.001);
     QVERIFY(std::abs(world->terrainHeight(0, 0) - 0.1) < 1e-12);
+  }
+
+  // Issue 31: a stroke under the robot lifts its wheels, it does not bury
+  // them. Criterion (stated before the run): WorkPartner standing on a flat
+  // heightfield gets 0.12 m raised by a 0.5 m brush right under its front
+  // left wheel (steeper than a wheel climbs: buried, the wheel was driven
+  // out of the ground or the twin diverged); one step later no contact is
+  // deeper than 1 cm, the robot stands 2 s healthy and the wheel's centre
+  // ends within 2 cm of 0.32 m (0.2 + the 0.12 raised). The control: the
+  // same stroke 4 m away lifts nothing (base within 1 mm).
+  void strokeUnderTheRobotLiftsIt() {
+    const auto standing = [](Vec2 where) {
+      WorldFixture f;
+      QString rows;
+      for (int r = 0; r < 81; ++r) rows += QString("0") + QString(",0").repeated(80) + "\n";
+      f.write("flat.csv", rows.toStdString());
+      auto world = f.build("<world name=\"w\">\n"
+                           "  <material name=\"rubber\"/>\n"
+                           "  <terrain type=\"heightfield\" file=\"flat.csv\" width=\"10\" depth=\"10\"/>\n"
+                           "  <robot name=\"workpartner\" file=\"" SP_SOURCE_DIR "/robots/workpartner.xml\"/>\n"
+                           "</world>");
+      if (!world) return std::make_tuple(false, 0.0, 0.0, 0.0);
+      stepFor(*world, 1.0);
+      const double base0 = world->linkPose(0, 0).p.z;
+      const auto patch = brushDab(*world->terrainGrid(), where, Brush{BrushKind::Raise, 0.5, 0.12, 0, 1});
+      if (!patch || !world->submit(*patch).empty()) return std::make_tuple(false, 0.0, 0.0, 0.0);
+      world->step();
+      double deepest = 0;
+      for (const LinkContact& c : world->linkContacts()) deepest = std::max(deepest, c.depth);
+      stepFor(*world, 2.0);
+      const int wheel = world->robotModel(0).findLink("wheel_fl");
+      return std::make_tuple(world->health().healthy(), deepest, world->linkPose(0, wheel).p.z,
+                             world->linkPose(0, 0).p.z - base0);
+    };
+    const auto [healthy, deepest, wheelZ, rise] = standing({0.55, 0.42});
+    qInfo("raised 0.12 m under wheel_fl: deepest contact %.4f m a step later, wheel centre at %.3f m, healthy %d",
+          deepest, wheelZ, healthy);
+    QVERIFY(healthy);
+    QVERIFY2(deepest < 0.01, qPrintable(QString::number(deepest)));
+    QVERIFY2(std::abs(wheelZ - 0.32) < 0.02, qPrintable(QString::number(wheelZ)));
+    const auto [farHealthy, farDeepest, farWheel, farRise] = standing({4.0, 0.0});
+    qInfo("the same 4 m away: base moved %.5f m", farRise);
+    QVERIFY(farHealthy);
+    QVERIFY(std::abs(farRise) < 0.001);
   }
 
   // Saved and loaded again: .asc and .csv hold every height exactly; .pgm

@@ -7,6 +7,8 @@
 
 #include <QFile>
 #include <QMouseEvent>
+#include <QRegularExpression>
+#include <QSignalSpy>
 #include <QTemporaryDir>
 #include <QtTest>
 
@@ -134,6 +136,52 @@ class TestTerrainPanel : public QObject {
     QTRY_VERIFY_WITH_TIMEOUT(std::abs(w.lastTelemetry()->pose.p.z - z0) < 0.01, 10000);
     t->setEditing(false);
     QVERIFY(!view->terrainEditing());
+  }
+
+  // Issue 31: before painting, the dock says what a dab would do where the
+  // cursor is, and warns when it would make a rise the robot cannot drive.
+  // Criteria (before the run): hovering 2 m ahead of the robot with a sharp
+  // raise (0.3 m, 0.15 m a dab) shows "a dab +0.12..0.15 m" (the sample
+  // nearest the cursor: it is off the centre by up to half a sample), the amber warning
+  // and riskChanged(true), and leaves the heights alone; the same place
+  // with a gentle brush (2 m, 0.005 m) shows no warning (riskChanged(false)).
+  void hoverPreviewsAndWarns() {
+    MainWindow& w = *window_;
+    TerrainPanel* t = w.terrainPanel();
+    SceneView* view = w.sceneView();
+    const HeightGrid before = t->editor()->grid();
+    QSignalSpy risk(t, &TerrainPanel::riskChanged);
+    t->setBrush(Brush{BrushKind::Raise, 0.3, 0.15, 0, 1});
+    t->setEditing(true);
+    const Pose base = w.lastTelemetry()->pose;
+    const double heading = std::atan2(2 * (base.q.w * base.q.z + base.q.x * base.q.y),
+                                      1 - 2 * (base.q.y * base.q.y + base.q.z * base.q.z));
+    const Vec2 target{base.p.x + 2 * std::cos(heading), base.p.y + 2 * std::sin(heading)};
+    QPointF pixel;
+    double best = 1e9;
+    for (int y = 0; y < view->height(); y += 6)
+      for (int x = 0; x < view->width(); x += 6)
+        if (const std::optional<Vec3> g = view->groundAt(QPointF(x, y))) {
+          const double d = std::hypot(g->x - target.x, g->y - target.y);
+          if (d < best) best = d, pixel = QPointF(x, y);
+        }
+    QVERIFY(best < 0.3);
+    mouse(view, QEvent::MouseMove, pixel, Qt::NoButton);
+    qInfo("preview: %s | %s", qPrintable(t->previewText()), qPrintable(t->riskText()));
+    // The dab's change at the sample nearest the cursor: 0.15 m at the centre, less off it.
+    const QRegularExpressionMatch dab = QRegularExpression(QStringLiteral("a dab \\+(\\d\\.\\d+) m")).match(t->previewText());
+    QVERIFY2(dab.hasMatch(), qPrintable(t->previewText()));
+    QVERIFY(dab.captured(1).toDouble() > 0.12 && dab.captured(1).toDouble() <= 0.15);
+    QVERIFY(t->riskText().contains(QStringLiteral("A dab here would make")));
+    QCOMPARE(risk.count(), 1);
+    QCOMPARE(risk.last().at(0).toBool(), true);
+    QCOMPARE(t->editor()->grid().heights, before.heights);  // a preview paints nothing
+    t->setBrush(Brush{BrushKind::Raise, 2.0, 0.005, 0, 1});
+    mouse(view, QEvent::MouseMove, pixel + QPointF(1, 0), Qt::NoButton);
+    QVERIFY2(t->riskText().isEmpty(), qPrintable(t->riskText()));
+    QCOMPARE(risk.count(), 2);
+    QCOMPARE(risk.last().at(0).toBool(), false);
+    t->setEditing(false);
   }
 
   // New and Import write a terrain and a world that load: a flat 4 x 2 m

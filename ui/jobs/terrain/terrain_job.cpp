@@ -24,6 +24,8 @@ void TerrainJob::install(ConsoleContext& context) {
   connect(panel_, &TerrainPanel::pickRequested, &scene, &SceneView::pickGround);
   connect(&scene, &SceneView::groundPicked, panel_, [this](const Vec3& g) { panel_->setFlattenHeight(g.z); });
   connect(&scene, &SceneView::terrainDab, panel_, &TerrainPanel::dabAt);
+  connect(&scene, &SceneView::terrainHover, panel_, &TerrainPanel::hoverAt);
+  connect(panel_, &TerrainPanel::riskChanged, &scene, &SceneView::setBrushWarning);
   connect(&scene, &SceneView::terrainStrokeEnded, panel_, &TerrainPanel::endStroke);
   connect(panel_, &TerrainPanel::strokeEnded, &scene, &SceneView::finishTerrainEdit);
   connect(panel_, &TerrainPanel::patch, this, &TerrainJob::apply);

@@ -102,6 +102,14 @@ TerrainPanel::TerrainPanel(QWidget* parent) : QWidget(parent) {
   files->addWidget(importButton);
   files->addWidget(save_);
   layout->addLayout(files);
+  preview_ = new QLabel(tr("Point at the ground to see its height and what a dab adds."), this);
+  preview_->setWordWrap(true);
+  risk_ = new QLabel(this);
+  risk_->setWordWrap(true);
+  risk_->setStyleSheet(QStringLiteral("QLabel { background: #f0a030; color: black; padding: 3px; }"));
+  risk_->hide();
+  layout->addWidget(preview_);
+  layout->addWidget(risk_);
   state_ = new QLabel(this);
   state_->setWordWrap(true);
   reach_ = new QLabel(this);
@@ -140,6 +148,9 @@ void TerrainPanel::setTerrain(const WorldModel* world, TerrainEditor* editor) {
   world_ = world;
   editor_ = world ? editor : nullptr;
   lastDab_.reset();
+  limits_ = world ? drivableLimits(*world) : std::nullopt;
+  wheelRadius_ = limits_ ? world->robots[0].model.drive->wheelRadius : 0.0;
+  showRisk(std::nullopt, false);
   if (!editor_) setEditing(false);
   updateState();
 }
@@ -166,8 +177,55 @@ void TerrainPanel::dabAt(const Vec3& ground) {
   const Brush b = brush();
   if (lastDab_ && std::hypot(at.x - lastDab_->x, at.y - lastDab_->y) < b.radius / 4) return;
   lastDab_ = at;
-  if (std::optional<TerrainPatchCmd> p = editor_->dab(at, b)) emit patch(*p);
+  if (std::optional<TerrainPatchCmd> p = editor_->dab(at, b)) {
+    if (limits_) showRisk(strokeRisk(editor_->grid(), *p, *limits_, wheelRadius_), true);
+    emit patch(*p);
+  }
 }
+
+void TerrainPanel::hoverAt(const Vec3& ground) {
+  if (!editor_ || !world_) return;
+  const Vec2 at = gridPoint(world_->terrain, {ground.x, ground.y});
+  const HeightGrid& grid = editor_->grid();
+  const std::optional<TerrainPatchCmd> next = brushDab(grid, at, brush());
+  // What the dab would do at the sample nearest the cursor.
+  double dab = 0;
+  if (next) {
+    const int i = static_cast<int>(std::lround((at.x + grid.width / 2) / grid.spacingX())) - next->column;
+    const int j = static_cast<int>(std::lround((at.y + grid.depth / 2) / grid.spacingY())) - next->row;
+    if (i >= 0 && i < next->columns && j >= 0 && j < next->rows)
+      dab = next->heights[static_cast<size_t>(j * next->columns + i)] - grid.at(i + next->column, j + next->row);
+  }
+  const double here = grid.heightAt(at.x, at.y) + world_->terrain.pose.p.z;
+  QString text = tr("Here: ground %1 m").arg(here, 0, 'f', 3);
+  if (editor_->inStroke()) text += tr("; this stroke %1 m").arg(editor_->strokeChange(at), 0, 'f', 3, QLatin1Char(' '));
+  text += next ? tr("; a dab %1%2 m").arg(dab >= 0 ? "+" : "").arg(dab, 0, 'f', 3) : tr("; off the grid");
+  preview_->setText(text);
+  if (!limits_) return;
+  showRisk(next ? strokeRisk(grid, *next, *limits_, wheelRadius_) : std::nullopt, false);
+}
+
+void TerrainPanel::showRisk(const std::optional<TerrainRisk>& risk, bool made) {
+  if (risk) {
+    Vec2 w = worldPoint(world_->terrain, risk->at);
+    for (double* c : {&w.x, &w.y})
+      if (std::abs(*c) < 0.05) *c = 0;  // "-0.0" reads as a direction
+    risk_->setText((made ? tr("This stroke made %1, at (%2, %3) m.") : tr("A dab here would make %1, at (%2, %3) m."))
+                       .arg(QString::fromStdString(risk->message(*limits_)))
+                       .arg(w.x, 0, 'f', 1)
+                       .arg(w.y, 0, 'f', 1));
+    risk_->setToolTip(QString::fromStdString("From the robot's files: " + limits_->basis));
+  }
+  risk_->setVisible(risk.has_value());
+  if (risky_ != risk.has_value()) {
+    risky_ = risk.has_value();
+    emit riskChanged(risky_);
+  }
+}
+
+QString TerrainPanel::riskText() const { return risk_->isVisible() ? risk_->text() : QString(); }
+
+QString TerrainPanel::previewText() const { return preview_->text(); }
 
 void TerrainPanel::endStroke() {
   lastDab_.reset();

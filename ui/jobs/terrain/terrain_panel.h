@@ -17,6 +17,7 @@
 #include <optional>
 
 #include "app/console/terrain_editor.h"
+#include "app/console/terrain_limits.h"
 #include "sim/robot_model.h"
 
 class QCheckBox;
@@ -53,6 +54,15 @@ class TerrainPanel : public QWidget {
   /// one of the stroke are skipped, so strength is per distance painted,
   /// not per mouse event.
   void dabAt(const Vec3& ground);
+  /// The cursor over world point `ground` (from the view): the panel shows
+  /// the ground's height there, what the open stroke has added, what the
+  /// next dab would add, and warns (riskChanged) when that dab would make a
+  /// rise the robot cannot drive (app/console/terrain_limits.h).
+  void hoverAt(const Vec3& ground);
+  /// The warning shown, "" when none.
+  QString riskText() const;
+  /// The preview line ("Here: ground 0.23 m; this stroke +0.10 m; a dab +0.05 m").
+  QString previewText() const;
   void endStroke();
   void undo();
   void redo();
@@ -81,6 +91,9 @@ class TerrainPanel : public QWidget {
   void strokeEnded();
   void editingChanged(bool on);
   void brushRadiusChanged(double radius);
+  /// The next dab (hovered) or the last one (painted) makes a rise the
+  /// robot cannot drive, or no longer does.
+  void riskChanged(bool risky);
   /// Pick flatten's height: the next click on the ground.
   void pickRequested();
   /// A world file written by New or Import, to open.
@@ -88,6 +101,8 @@ class TerrainPanel : public QWidget {
 
  private:
   void updateState();
+  /// Shows `risk` (or clears it); `made`: the stroke has made it, else the next dab would.
+  void showRisk(const std::optional<TerrainRisk>& risk, bool made);
   void askNew();
   void askImport();
   void askSave();
@@ -98,6 +113,9 @@ class TerrainPanel : public QWidget {
   const WorldModel* world_ = nullptr;
   TerrainEditor* editor_ = nullptr;
   std::optional<Vec2> lastDab_;
+  std::optional<DrivableLimits> limits_;
+  double wheelRadius_ = 0;
+  bool risky_ = false;
   QPushButton* editButton_ = nullptr;
   QComboBox* kind_ = nullptr;
   QDoubleSpinBox* radius_ = nullptr;
@@ -108,6 +126,8 @@ class TerrainPanel : public QWidget {
   QPushButton* redo_ = nullptr;
   QPushButton* save_ = nullptr;
   QLabel* state_ = nullptr;
+  QLabel* preview_ = nullptr;
+  QLabel* risk_ = nullptr;
   QLabel* reach_ = nullptr;
   uint32_t seed_ = 1;
 };
