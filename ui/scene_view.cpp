@@ -11,6 +11,7 @@
 #include <QTimer>
 #include <QWheelEvent>
 
+#include <osg/BlendColor>
 #include <osg/BlendFunc>
 #include <osg/CullFace>
 #include <osg/Fog>
@@ -691,6 +692,19 @@ void SceneView::Impl::buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line) {
   s->setAttributeAndModes(new osg::LineWidth(4.0f));
   p.pathNode->setNodeMask(0);
   root->addChild(p.pathNode);
+  // Seen through whatever stands on it: at low speed the whole trail lies
+  // under the robot and its phantoms. The same lines again, after everything
+  // else, only where something nearer hides them, at half their
+  // strength (the node mask above shows and hides both).
+  auto* xray = new osg::Group;
+  xray->addChild(p.pathNode);
+  osg::StateSet* x = xray->getOrCreateStateSet();
+  x->setAttributeAndModes(new osg::Depth(osg::Depth::GREATER, 0.0, 1.0, false),
+                          osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+  x->setAttributeAndModes(new osg::BlendFunc(GL_CONSTANT_ALPHA, GL_ONE_MINUS_CONSTANT_ALPHA), osg::StateAttribute::ON);
+  x->setAttributeAndModes(new osg::BlendColor({0, 0, 0, 0.5f}), osg::StateAttribute::ON);
+  x->setRenderBinDetails(kPhantomBin + 1, "RenderBin");
+  root->addChild(xray);
 }
 
 bool SceneView::Impl::coincides(const Phantom& p) const {
