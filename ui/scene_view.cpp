@@ -500,7 +500,7 @@ struct SceneView::Impl {
   Impl();
   // Builds a phantom's node (tinted `body`, see-through) and its path (an
   // opaque line in `line`) under root.
-  void buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line);
+  void buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line, bool seeThrough);
   void syncPhantom(Phantom& p);
   /// Whether `p` stands where the robot is drawn (kCoincide): then it is not drawn.
   bool coincides(const Phantom& p) const;
@@ -523,8 +523,8 @@ SceneView::Impl::Impl() {
   // The ghost light blue; the rehearsal amber. The paths in the same hues,
   // saturated and opaque: a thin line in a pale tint vanishes against the
   // sky and light ground.
-  buildPhantom(ghost, {kGhostTint[0], kGhostTint[1], kGhostTint[2], kGhostTint[3]}, {0.05f, 0.45f, 1.00f, 1.0f});
-  buildPhantom(rehearsal, {1.00f, 0.70f, 0.15f, 0.50f}, {0.95f, 0.45f, 0.00f, 1.0f});
+  buildPhantom(ghost, {kGhostTint[0], kGhostTint[1], kGhostTint[2], kGhostTint[3]}, {0.05f, 0.45f, 1.00f, 1.0f}, true);
+  buildPhantom(rehearsal, {1.00f, 0.70f, 0.15f, 0.50f}, {0.95f, 0.45f, 0.00f, 1.0f}, false);
   buildLaser();
   root->addChild(laserNode);
   // The brush footprint: a yellow ring, unlit, drawn over the ground.
@@ -646,7 +646,7 @@ void SceneView::Impl::updateLaser() {
   hits->dirtyBound();
 }
 
-void SceneView::Impl::buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line) {
+void SceneView::Impl::buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line, bool seeThrough) {
   registerFrontToBackBin();
   p.node = new osg::Group;
   p.body = new osg::Group;
@@ -692,10 +692,12 @@ void SceneView::Impl::buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line) {
   s->setAttributeAndModes(new osg::LineWidth(4.0f));
   p.pathNode->setNodeMask(0);
   root->addChild(p.pathNode);
-  // Seen through whatever stands on it: at low speed the whole trail lies
-  // under the robot and its phantoms. The same lines again, after everything
-  // else, only where something nearer hides them, at half their
-  // strength (the node mask above shows and hides both).
+  // The ghost's trail is seen through whatever stands on it: at low speed
+  // it lies wholly under the robot and the ghost. The same lines again,
+  // after everything else, only where something nearer hides them, at half
+  // their strength (the node mask above shows and hides both). Not the
+  // rehearsed path: drawn through the amber robot it only cluttered it.
+  if (!seeThrough) return;
   auto* xray = new osg::Group;
   xray->addChild(p.pathNode);
   osg::StateSet* x = xray->getOrCreateStateSet();
