@@ -113,6 +113,20 @@ class TstSceneView : public QObject {
     return view;
   }
 
+  /// The flat world's view with a fixed camera, and the robot's start pose
+  /// (its base) with every joint at zero.
+  struct Fixed {
+    std::unique_ptr<SceneView> view;
+    sp::Pose base;
+    std::vector<double> joints;
+  };
+  Fixed fixedView() {
+    const sp::RobotModel& robot = flat_.robots[0].model;
+    Fixed f{shownView(flat_), flat_.robots[0].pose * robot.links[0].pose, std::vector<double>(robot.joints.size(), 0.0)};
+    if (f.view) f.view->setFollow(false);
+    return f;
+  }
+
  private slots:
   void initTestCase() {
     Q_UNUSED(kGl21Format);
@@ -165,12 +179,8 @@ class TstSceneView : public QObject {
   // robot it adds translucent pixels there (the robot stays visible through
   // and beside it), follows its own joints, and hiding it restores the image.
   void ghostDrawsASecondRobot() {
-    auto view = shownView(flat_);
+    auto [view, base, joints] = fixedView();
     QVERIFY(view);
-    view->setFollow(false);
-    const sp::RobotModel& robot = flat_.robots[0].model;
-    const sp::Pose base = flat_.robots[0].pose * robot.links[0].pose;
-    const std::vector<double> joints(robot.joints.size(), 0.0);
     view->setRobotState(base, joints);
     QVERIFY(waitFrames(*view, 2));
     const QImage alone = frame(*view);
@@ -295,12 +305,8 @@ class TstSceneView : public QObject {
   // with it 80 inside). Outside the silhouette, where the line shows
   // plainly, it changes pixels too (the control that it is drawn at all).
   void ghostTrailSeenThroughTheRobot() {
-    auto view = shownView(flat_);
+    auto [view, base, joints] = fixedView();
     QVERIFY(view);
-    view->setFollow(false);
-    const sp::RobotModel& robot = flat_.robots[0].model;
-    const sp::Pose base = flat_.robots[0].pose * robot.links[0].pose;
-    const std::vector<double> joints(robot.joints.size(), 0.0);
     sp::Pose away = base;
     away.p.x += 100;
     view->setRobotState(away, joints);
