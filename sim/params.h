@@ -47,6 +47,12 @@ struct SimParams {
   /// (2.2 s) twice over.
   double linkHelloTimeout = 5;
   double consoleStaleAfter = 0.5; ///< [s] console: no telemetry this long => the robot is drawn grey, "no data"
+  /// Rehearsals' fast profile (robustness samples, the console's first
+  /// verdicts; app/rehearse/rehearsal.h): a coarser step and fewer solver
+  /// iterations, the verdicts checked against the full profile's in
+  /// bench_rehearsal and tst_rehearsal.
+  double rehearsalFastStep = 0.002;
+  int rehearsalFastIterations = 40;
   double ghostStep = 0.004;       ///< [s] console's predictive ghost: its physics step
   int ghostIterations = 20;       ///< ghost: quick solver iterations
   double ghostHorizon = 5;        ///< [s] ghost: how far the trail looks ahead of the ghost

@@ -187,20 +187,26 @@ std::optional<SettledStart> settleWorldStart(const WorldModel& model, const SimP
 RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress) {
   const auto t0 = Clock::now();
   RehearsalResult result;
+  result.fast = plan.fast;
+  SimParams params = plan.params;
+  if (plan.fast) {
+    params.step = params.rehearsalFastStep;
+    params.iterations = params.rehearsalFastIterations;
+  }
   if (plan.world.robots.empty()) {
     result.error = "the world has no robot";
     return result;
   }
   // A twin calibrated to the robot (calibration.* keys) has its physics
   // and acts on each command its delay after it is due, as the robot does.
-  const WorldModel calibrated = calibratedWorld(plan.world, plan.params);
+  const WorldModel calibrated = calibratedWorld(plan.world, params);
   const RobotModel& full = calibrated.robots[0].model;
   std::optional<RehearsalStart> start = plan.start;
   if (!start) {
     // A world places its robot above the ground: judged there, before it
     // has landed, every sequence failed at t = 0. It settles first.
     std::string why;
-    const std::optional<SettledStart> settled = settleWorldStart(calibrated, plan.params, why);
+    const std::optional<SettledStart> settled = settleWorldStart(calibrated, params, why);
     if (!settled) {
       result.error = why;
       return result;
@@ -226,7 +232,7 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
     }
   }
   Diagnostics diag;
-  std::unique_ptr<World> world = World::create(model, plan.params, diag);
+  std::unique_ptr<World> world = World::create(model, params, diag);
   if (!world) {
     result.error = "cannot build the twin: " + diag.format();
     return result;
@@ -237,22 +243,26 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
     result.error = "the start state does not fit: " + why;
     return result;
   }
-  result.duration = (plan.commands.empty() ? 0.0 : plan.commands.back().time) + plan.params.calDelay + plan.rules.settle;
+  result.duration = (plan.commands.empty() ? 0.0 : plan.commands.back().time) + params.calDelay + plan.rules.settle;
   RuleMonitor monitor(plan.rules, robot);
   Runner runner(*world);
   std::vector<TimedCommand> acting = plan.commands;
-  for (TimedCommand& c : acting) c.time += plan.params.calDelay;
+  for (TimedCommand& c : acting) c.time += params.calDelay;
   runner.schedule(acting);
   runner.setSubmitHook([&](const ScheduledCommand& c, const std::string& why) {
     if (!why.empty())
       result.refused.push_back("line " + std::to_string(c.line) + " at " + shortestText(world->time()) + " s: " + why);
   });
-  const int64_t total = std::max<int64_t>(1, std::llround(result.duration / plan.params.step));
-  const int64_t sampleEvery = std::max<int64_t>(1, std::llround(RehearsalResult::kSampleInterval / plan.params.step));
+  const int64_t total = std::max<int64_t>(1, std::llround(result.duration / params.step));
+  const int64_t sampleEvery = std::max<int64_t>(1, std::llround(RehearsalResult::kSampleInterval / params.step));
   const int64_t progressEvery = std::max<int64_t>(1, total / 100);
   result.path.push_back(sampleOf(*world, 0, held));
   runner.setMonitor([&](const World& w) {
     monitor.check(w);
+    if (plan.stopAtFirstFailure && !monitor.passed()) {
+      result.stoppedEarly = true;
+      return false;
+    }
     const int64_t n = w.stepCount();
     if (n % sampleEvery == 0) result.path.push_back(sampleOf(w, monitor.margin(), held));
     if (progress && n % progressEvery == 0 && !progress(static_cast<double>(n) / static_cast<double>(total))) {
@@ -268,6 +278,30 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   result.endHash = world->stateHash();
   result.wallSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return result;
+}
+
+ProfileAgreement compareProfiles(const RehearsalResult& reference, const RehearsalResult& other) {
+  ProfileAgreement a;
+  const bool margins = !reference.stoppedEarly && !other.stoppedEarly;
+  for (const RuleVerdict& r : reference.verdicts)
+    for (const RuleVerdict& o : other.verdicts) {
+      if (o.rule != r.rule) continue;
+      if (o.passed != r.passed) {
+        a.sameVerdicts = false;
+        a.differ += std::string(a.differ.empty() ? "" : "; ") + toString(r.rule) + ": " +
+                    (r.passed ? "passed" : "failed") + ", " + (o.passed ? "passed" : "failed");
+      }
+      if (!margins) continue;
+      // Signed rules (roll, pitch, yaw rate) bound the magnitude: a closest
+      // approach of -21.5 deg/s is as near the 60 deg/s limit as +21.5.
+      const double ref = std::abs(std::abs(r.limit) - std::abs(r.worst)), oth = std::abs(std::abs(o.limit) - std::abs(o.worst));
+      const double change = std::abs(oth - ref) / std::max({ref, 0.01 * std::abs(r.limit), 1e-9});
+      if (change > a.largestChange) {
+        a.largestChange = change;
+        a.largestRule = toString(r.rule);
+      }
+    }
+  return a;
 }
 
 std::string sequenceText(const std::vector<TimedCommand>& commands, const RobotModel* robot) {
@@ -332,15 +366,19 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
   out.endPoses.resize(n);
   out.samplePassed.assign(n, false);
   out.failures.resize(n);
+  std::vector<char> ranToTheEnd(static_cast<size_t>(n), 0);
   std::atomic<int> next{0}, done{0};
   std::atomic<bool> cancelled{false};
   std::mutex progressMutex;
   auto work = [&] {
     for (int i; !cancelled && (i = next++) < n;) {
-      const RehearsalResult r = rehearse(perturbed(plan, seed + static_cast<uint64_t>(i)));
+      RehearsalPlan sample = perturbed(plan, seed + static_cast<uint64_t>(i));
+      sample.fast = sample.stopAtFirstFailure = true;
+      const RehearsalResult r = rehearse(sample);
       out.samplePassed[i] = r.passed;
       out.failures[i] = r.summary();
       if (!r.path.empty()) out.endPoses[i] = r.path.back().base;
+      ranToTheEnd[static_cast<size_t>(i)] = !r.stoppedEarly;
       const int d = ++done;
       if (progress) {
         std::lock_guard lock(progressMutex);
@@ -354,8 +392,12 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
   for (std::thread& t : pool) t.join();
   out.passed = static_cast<int>(std::count(out.samplePassed.begin(), out.samplePassed.end(), true));
   Vec3 mean;
-  for (const Pose& p : out.endPoses) mean = mean + (1.0 / n) * p.p;
-  for (const Pose& p : out.endPoses) out.spread = std::max(out.spread, std::hypot(p.p.x - mean.x, p.p.y - mean.y));
+  const auto ended = std::count(ranToTheEnd.begin(), ranToTheEnd.end(), 1);
+  for (size_t k = 0; k < out.endPoses.size(); ++k)
+    if (ranToTheEnd[k]) mean = mean + (1.0 / static_cast<double>(ended)) * out.endPoses[k].p;
+  for (size_t k = 0; k < out.endPoses.size(); ++k)
+    if (ranToTheEnd[k])
+      out.spread = std::max(out.spread, std::hypot(out.endPoses[k].p.x - mean.x, out.endPoses[k].p.y - mean.y));
   out.wallSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return out;
 }

@@ -54,6 +54,14 @@ struct RehearsalPlan {
   /// subtrees without drive joints: an arm, the head; sim/rigid.h), for
   /// speed: fewer bodies, the same mass and centre of mass.
   bool holdUnmoved = true;
+  /// The fast profile: params' rehearsal.fast_step and
+  /// rehearsal.fast_iterations instead of physics.step and .iterations
+  /// (about 2x faster; its verdicts against the full profile's:
+  /// docs/performance.md). A fast result is never relayed (sequenceMessage).
+  bool fast = false;
+  /// Stop at the first failed rule (the verdict is known; the other rules
+  /// are judged only up to then).
+  bool stopAtFirstFailure = false;
 };
 
 class World;
@@ -105,6 +113,8 @@ struct RehearsalResult {
   double wallSeconds = 0;  ///< what it took
   uint64_t endHash = 0;    ///< World::stateHash() at the end
   int heldJoints = 0;      ///< joints held rigid (plan.holdUnmoved)
+  bool fast = false;       ///< run in the fast profile (plan.fast)
+  bool stoppedEarly = false;  ///< a rule failed and plan.stopAtFirstFailure stopped the run there
   /// [s] how long the robot settled from the world's start before t = 0
   /// (0 when the plan gave a start).
   double settled = 0;
@@ -124,6 +134,23 @@ struct RehearsalResult {
 /// world that cannot be built or a start that does not fit is `error`.
 RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress = {});
 
+/// How a rehearsal in another profile (the fast one) agrees with a
+/// reference (the full one), rule by rule. A rule's margin is the distance
+/// of its closest approach from its limit (in magnitude: signed rules bound
+/// |value|); its change is relative to the
+/// reference's margin (at least 1 % of the limit, so a margin near zero
+/// does not divide by nothing).
+struct ProfileAgreement {
+  bool sameVerdicts = true;       ///< every rule passes or fails in both
+  double largestChange = 0;       ///< the largest margin change (0.1 = 10 %)
+  std::string largestRule;        ///< whose it is
+  std::string differ;             ///< "stability: passed, failed; ..." ("" when the same)
+  bool within(double tolerance) const { return sameVerdicts && largestChange <= tolerance; }
+};
+/// Rules compared over the part both judged: a run stopped at its first
+/// failure compares its verdicts only (margins of unfinished runs are partial).
+ProfileAgreement compareProfiles(const RehearsalResult& reference, const RehearsalResult& other);
+
 /// The canonical text of a sequence (`TIME COMMAND` per line, shortest
 /// times, toText() commands: what SEQUENCE carries) and its hash
 /// (FNV-1a 64, 16 hex digits).
@@ -135,14 +162,17 @@ std::string sequenceHash(const std::string& canonicalText);
 /// within the rules' ranges, heightfield samples moved, the start shifted.
 RehearsalPlan perturbed(const RehearsalPlan& plan, uint64_t seed);
 
-/// N perturbed rehearsals.
+/// N perturbed rehearsals, each in the fast profile and stopped at its
+/// first failed rule.
 struct RobustnessResult {
   int samples = 0, passed = 0;
   double probability() const { return samples ? static_cast<double>(passed) / samples : 0; }
   std::vector<Pose> endPoses;         ///< per sample
   std::vector<bool> samplePassed;     ///< per sample
   std::vector<std::string> failures;  ///< per sample: summary() ("passed" if it did)
-  double spread = 0;                  ///< [m] largest distance of an end position from their mean
+  /// [m] largest distance of an end position from their mean, over the
+  /// samples that ran to the end (a failed one stops where it failed)
+  double spread = 0;
   double wallSeconds = 0;
 };
 /// rules.robustSamples rehearsals of perturbed(plan, seed + i) on `threads`

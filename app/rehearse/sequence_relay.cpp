@@ -24,6 +24,12 @@ std::optional<net::SequenceMsg> sequenceMessage(const RehearsalPlan& plan, const
     why = "only a sequence that passed its rehearsal is sent (" + result.summary() + ")";
     return std::nullopt;
   }
+  if (result.fast || plan.fast) {
+    // The robot runs at the twin's full fidelity; a coarser twin's pass
+    // says where to look, not that it is safe.
+    why = "a fast-profile rehearsal is a preview: only a full-fidelity pass is sent";
+    return std::nullopt;
+  }
   if (plan.commands.empty()) {
     why = "the sequence is empty";
     return std::nullopt;

@@ -25,7 +25,7 @@
 namespace sp {
 
 /// The SEQUENCE for `plan` rehearsed as `result`; nullopt and `why` when
-/// the rehearsal did not pass (or did not run).
+/// the rehearsal did not pass (or did not run), or ran in the fast profile.
 std::optional<net::SequenceMsg> sequenceMessage(const RehearsalPlan& plan, const RehearsalResult& result,
                                                 std::string& why);
 

@@ -80,7 +80,11 @@ constexpr const char* kUsage = R"(usage:
       One that does not settle is refused (exit 1, saying why).
       --rules FILE      flight rules (default: built-in, see config/flight.rules)
       --params FILE, --set KEY=VALUE   as for run
-      --robust N        also N perturbed rehearsals (ranges robust.* of the rules)
+      --fast            in the fast profile (rehearsal.fast_step and
+                        .fast_iterations): about 2x faster, a preview
+      --robust N        also N perturbed rehearsals (ranges robust.* of the
+                        rules), each in the fast profile and stopped at its
+                        first failed rule
       Exits 0 when the sequence passed, 6 when a rule failed, 1 on bad input.
   simpartner-sim sweep --world FILE --commands SEQ --samples N --out DIR [options]
       Many rehearsals of one sequence, each with its own parameters and
@@ -340,8 +344,13 @@ int rehearseCommand(const std::vector<std::string>& args) {
   std::string worldFile, commandsFile, rulesFile, paramsFile;
   std::vector<std::string> overrides;
   int robust = 0;
+  bool fast = false;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
+    if (a == "--fast") {
+      fast = true;
+      continue;
+    }
     if (!knownWithValue(args, i, {"--world", "--commands", "--rules", "--params", "--set", "--robust"})) return 2;
     const std::string& v = args[++i];
     if (a == "--world") worldFile = v;
@@ -381,7 +390,8 @@ int rehearseCommand(const std::vector<std::string>& args) {
     return 1;
   }
   if (robust > 0) rules.robustSamples = robust;
-  const sp::RehearsalPlan plan{*world, params, rules, *commands, std::nullopt};
+  sp::RehearsalPlan plan{*world, params, rules, *commands, std::nullopt};
+  plan.fast = fast;
   const sp::RehearsalResult r = sp::rehearse(plan);
   if (!r.error.empty()) {
     std::cerr << "error: " << r.error << "\n";
@@ -389,7 +399,11 @@ int rehearseCommand(const std::vector<std::string>& args) {
   }
   std::cout << "rehearsal of " << commandsFile << " (hash " << sp::sequenceHash(sp::sequenceText(*commands, &world->robots[0].model))
             << ") on " << worldFile << ": " << r.duration << " s simulated in " << r.wallSeconds << " s, after "
-            << r.settled << " s for the robot to settle from the world's start\n";
+            << r.settled << " s for the robot to settle from the world's start"
+            << (fast ? " (fast profile: step " + std::to_string(params.rehearsalFastStep * 1000).substr(0, 4) + " ms, " +
+                           std::to_string(params.rehearsalFastIterations) + " iterations; a preview, not sendable)"
+                     : std::string())
+            << "\n";
   for (const sp::RuleVerdict& v : r.verdicts) std::cout << "  " << (v.passed ? "pass  " : "FAIL  ") << v.message() << "\n";
   for (const std::string& why : r.refused) std::cerr << commandsFile << ": error: refused: " << why << "\n";
   std::cout << (r.passed ? "passed" : "failed: " + r.summary()) << "\n";

@@ -179,7 +179,8 @@ class TestSequencePanel : public QObject {
     QVERIFY(p->errors()[0].contains("outside joint 'knee_fl' limits"));
   }
 
-  // Criterion: the rehearsal passes with ten verdicts, all passed; the 3D
+  // Criterion: the rehearsal passes with ten verdicts, all passed (after
+  // the fast profile's preview, which cannot be sent); the 3D
   // view draws its path (> 10 points) and the amber robot where the
   // scrubber is (within 1 mm of the rehearsed base there); an edit disables
   // Send; sent unchanged, the robot runs it to done with the guard quiet,
@@ -189,9 +190,25 @@ class TestSequencePanel : public QObject {
     p->setText(QStringLiteral("0.2 drive 0.5 10\n3.0 stop\n"));
     QVERIFY(p->errors().isEmpty());
     QSignalSpy rehearsed(p, &SequencePanel::rehearsed);
+    // Issue 32: the fast profile's verdicts come first, Send still off and
+    // the status saying the full-fidelity rehearsal runs; then the full one.
+    bool previewSendable = true, previewFast = false;
+    QString previewStatus;
+    int previewsBeforeFull = 0;
+    const QMetaObject::Connection seen = connect(p, &SequencePanel::previewed, this, [&] {
+      previewSendable = p->sendButton()->isEnabled();
+      previewFast = p->result() && p->result()->fast;
+      previewStatus = p->status();
+      previewsBeforeFull += rehearsed.isEmpty();
+    });
     QTest::mouseClick(p->rehearseButton(), Qt::LeftButton);
     QVERIFY(rehearsed.wait(30000));
+    disconnect(seen);
     QVERIFY2(rehearsed.at(0).at(0).toBool(), qPrintable(p->status()));
+    QCOMPARE(previewsBeforeFull, 1);
+    QVERIFY(previewFast && !previewSendable);
+    QVERIFY2(previewStatus.contains("full-fidelity rehearsal, the one Send relays, is running"), qPrintable(previewStatus));
+    QVERIFY(!p->result()->fast);
     QCOMPARE(p->verdictList()->topLevelItemCount(), kRuleCount);
     for (int i = 0; i < kRuleCount; ++i)
       QVERIFY2(p->result()->verdicts[i].passed, p->result()->verdicts[i].message().c_str());

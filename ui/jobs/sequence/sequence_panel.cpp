@@ -414,8 +414,18 @@ bool SequencePanel::rehearse() {
                          : tr("Rehearsing from the world's start…"));
   runTask(tr("Rehearsing"), [this, plan = std::move(plan), text, pinned, cancel = freshCancel()](
                                 const BackgroundJobs::Progress& progress) mutable -> std::function<void()> {
+    // First the fast profile, stopped at its first failure: its verdicts
+    // show within a fraction of the time while the full-fidelity rehearsal,
+    // the one Send relays, runs (issue 32).
+    auto preview = std::make_shared<RehearsalPlan>(plan);
+    preview->fast = preview->stopAtFirstFailure = true;
+    auto first = std::make_shared<RehearsalResult>(
+        sp::rehearse(*preview, [&](double f) { return progress(0.25 * f) && !cancel->load(); }));
+    if (!first->cancelled)
+      QMetaObject::invokeMethod(
+          this, [this, preview, first] { previewDone(std::move(*preview), std::move(*first)); }, Qt::QueuedConnection);
     auto r = std::make_shared<RehearsalResult>(
-        sp::rehearse(plan, [&](double f) { return progress(f) && !cancel->load(); }));
+        sp::rehearse(plan, [&](double f) { return progress(0.25 + 0.75 * f) && !cancel->load(); }));
     auto done = std::make_shared<RehearsalPlan>(std::move(plan));
     return [this, done, r, text, pinned] {
       rehearsedText_ = text;
@@ -427,6 +437,27 @@ bool SequencePanel::rehearse() {
   return true;
 }
 
+void SequencePanel::showResult() {
+  showVerdicts();
+  std::vector<Vec3> path;
+  for (const RehearsalSample& s : result_->path) path.push_back(s.base.p);
+  emit pathChanged(path, {});
+  updateButtons();
+}
+
+void SequencePanel::previewDone(RehearsalPlan plan, RehearsalResult result) {
+  if (!busy_) return;  // the full rehearsal came first (or was cancelled): nothing to preview
+  plan_ = std::move(plan);
+  result_ = std::move(result);
+  robust_.reset();
+  preview_ = QString::fromStdString(result_->summary());
+  setStatus(tr("Preview (fast profile, %1 s): %2. The full-fidelity rehearsal, the one Send relays, is running…")
+                .arg(result_->wallSeconds, 0, 'f', 2)
+                .arg(result_->passed ? tr("passed") : preview_));
+  showResult();
+  emit previewed(result_->passed);
+}
+
 void SequencePanel::rehearsalDone(RehearsalPlan plan, RehearsalResult result) {
   busy_ = false;
   progress_->setValue(1000);
@@ -436,20 +467,21 @@ void SequencePanel::rehearsalDone(RehearsalPlan plan, RehearsalResult result) {
   const RobotModel& robot = plan_->world.robots[0].model;
   const QString hash = QString::fromStdString(sequenceHash(sequenceText(plan_->commands, &robot)));
   const QString verdict = QString::fromStdString(result_->summary());
-  setStatus(tr("Rehearsal %1 (%2 simulated in %3 s): %4")
+  // Said when the preview told otherwise: the operator looked at it.
+  const QString differs = !preview_.isEmpty() && preview_ != verdict
+                              ? tr(" (the fast preview had: %1)").arg(preview_)
+                              : QString();
+  preview_.clear();
+  setStatus(tr("Rehearsal %1 (%2 simulated in %3 s): %4%5")
                 .arg(result_->passed ? tr("passed") : tr("failed"), seconds(result_->duration))
                 .arg(result_->wallSeconds, 0, 'f', 2)
-                .arg(verdict));
+                .arg(verdict, differs));
   emit logEvent("rehearsal", QStringLiteral("%1 %2 (%3 commands, %4 s simulated): %5")
                                  .arg(hash, result_->passed ? "passed" : "failed")
                                  .arg(plan_->commands.size())
                                  .arg(result_->duration)
                                  .arg(verdict));
-  showVerdicts();
-  std::vector<Vec3> path;
-  for (const RehearsalSample& s : result_->path) path.push_back(s.base.p);
-  emit pathChanged(path, {});
-  updateButtons();
+  showResult();
   emit rehearsed(result_->passed);
 }
 

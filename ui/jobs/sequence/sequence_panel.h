@@ -152,6 +152,9 @@ class SequencePanel : public QWidget {
 
  signals:
   void rehearsed(bool passed);
+  /// Rehearse's first verdicts are in: the fast profile's preview, while
+  /// the full-fidelity rehearsal (the one Send relays) still runs.
+  void previewed(bool passed);
   void robustnessDone();
   /// Send this SEQUENCE to the robot.
   void sendRequested(const sp::net::SequenceMsg& message);
@@ -179,6 +182,9 @@ class SequencePanel : public QWidget {
   /// Runs `work` on the runner: busy, progress, Cancel until its result runs.
   void runTask(const QString& what, BackgroundJobs::Work work);
   void rehearsalDone(RehearsalPlan plan, RehearsalResult result);
+  void previewDone(RehearsalPlan plan, RehearsalResult result);
+  /// The verdicts, the path in the view and the buttons for result_.
+  void showResult();
   void robustnessFinished(RobustnessResult result);
   void showVerdicts();
   void showScrub(int index);
@@ -190,6 +196,7 @@ class SequencePanel : public QWidget {
   FlightRules rules_;
   std::function<std::optional<RehearsalStart>()> startProvider_;
   bool linkReady_ = false;
+  QString preview_;  // the last preview's verdict, to say when the full one differs
 
   QPlainTextEdit* editor_ = nullptr;
   QListWidget* errorList_ = nullptr;
