@@ -237,6 +237,7 @@ int main(int argc, char** argv) {
     RehearsalPlan demo{*flat, defaults, {}, *parseCommandSequence(cases[0].text, "demo.seq", d, &flat->robots[0].model),
                        std::nullopt};
     demo.rules.robustSamples = 16;
+    demo.fast = demo.stopAtFirstFailure = true;
     std::vector<double> fastTimes, fullTimes;
     RobustnessResult r;
     for (int round = 0; round < rounds; ++round) {
@@ -245,7 +246,11 @@ int main(int argc, char** argv) {
       const auto t0 = Clock::now();
       std::atomic<int> next{0};
       auto work = [&] {
-        for (int i; (i = next++) < 16;) (void)rehearse(perturbed(demo, 1 + static_cast<uint64_t>(i)));
+        for (int i; (i = next++) < 16;) {
+          RehearsalPlan sample = perturbed(demo, 1 + static_cast<uint64_t>(i));
+          sample.fast = sample.stopAtFirstFailure = false;
+          (void)rehearse(sample);
+        }
       };
       std::thread other(work);
       work();

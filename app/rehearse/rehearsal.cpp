@@ -364,6 +364,7 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
   RobustnessResult out;
   out.samples = n;
   out.endPoses.resize(n);
+  out.endHashes.resize(n);
   out.samplePassed.assign(n, false);
   out.failures.resize(n);
   std::vector<char> ranToTheEnd(static_cast<size_t>(n), 0);
@@ -372,12 +373,11 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
   std::mutex progressMutex;
   auto work = [&] {
     for (int i; !cancelled && (i = next++) < n;) {
-      RehearsalPlan sample = perturbed(plan, seed + static_cast<uint64_t>(i));
-      sample.fast = sample.stopAtFirstFailure = true;
-      const RehearsalResult r = rehearse(sample);
+      const RehearsalResult r = rehearse(perturbed(plan, seed + static_cast<uint64_t>(i)));
       out.samplePassed[i] = r.passed;
       out.failures[i] = r.summary();
       if (!r.path.empty()) out.endPoses[i] = r.path.back().base;
+      out.endHashes[static_cast<size_t>(i)] = r.endHash;
       ranToTheEnd[static_cast<size_t>(i)] = !r.stoppedEarly;
       const int d = ++done;
       if (progress) {

@@ -162,12 +162,14 @@ std::string sequenceHash(const std::string& canonicalText);
 /// within the rules' ranges, heightfield samples moved, the start shifted.
 RehearsalPlan perturbed(const RehearsalPlan& plan, uint64_t seed);
 
-/// N perturbed rehearsals, each in the fast profile and stopped at its
-/// first failed rule.
+/// N perturbed rehearsals, each in the plan's profile (the console and
+/// `rehearse --robust` run them fast and stopped at their first failed
+/// rule; a sweep's samples, the same draws, at full fidelity to the end).
 struct RobustnessResult {
   int samples = 0, passed = 0;
   double probability() const { return samples ? static_cast<double>(passed) / samples : 0; }
   std::vector<Pose> endPoses;         ///< per sample
+  std::vector<uint64_t> endHashes;    ///< per sample: World::stateHash() at its end (a sweep's `hash`)
   std::vector<bool> samplePassed;     ///< per sample
   std::vector<std::string> failures;  ///< per sample: summary() ("passed" if it did)
   /// [m] largest distance of an end position from their mean, over the

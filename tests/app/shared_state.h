@@ -22,6 +22,12 @@ struct SharedState {
     }
     cv.notify_all();
   }
+  /// `get()` under the lock: reads what the callbacks' thread may be writing.
+  template <typename F>
+  auto read(F get) {
+    std::lock_guard lock(mutex);
+    return get();
+  }
   /// Waits until `pred` holds (checked under the lock) or `limit` passes.
   template <typename P>
   bool waitFor(P pred, std::chrono::milliseconds limit = std::chrono::seconds(5)) {

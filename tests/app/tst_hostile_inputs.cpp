@@ -6,6 +6,7 @@
 #include <sqlite3.h>
 #include <sys/stat.h>
 
+#include <QDir>
 #include <QElapsedTimer>
 #include <QFile>
 #include <QProcess>
@@ -146,16 +147,32 @@ class TestHostileInputs : public QObject {
     QVERIFY2(r.err.contains(bad + ": the snapshot at step 0: not a snapshot"), qPrintable(r.err));
 
     // A logged file name that climbs out of any folder: re-simulation holds
-    // the logged files in memory and writes nothing, there or anywhere.
+    // the logged files in memory, reads none from disk and writes nothing.
+    // The climbing name is refused, named in the error (the robot it
+    // refers to is not among the logged files at the place it points to),
+    // and no file appears anywhere in the test's folder or beyond it.
     const QString outside = dir_.filePath(QStringLiteral("outside"));
     const QString climbing = dir_.filePath(QStringLiteral("climb.splog"));
     const QByteArray name = ("../../../../.." + outside + "/evil.world.xml").toUtf8();
     QVERIFY(QFile::copy(log_, climbing) &&
             sql(climbing, ("UPDATE meta SET value = '" + name + "' WHERE key = 'world_file'").constData()));
+    const QStringList before = QDir(dir_.path()).entryList(QDir::AllEntries | QDir::NoDotAndDotDot);
     r = tool(QStringLiteral("simpartner-sim"), {"resim", climbing});
+    qInfo("climbing world_file: exit %d: %s", r.exit, qPrintable(r.err.left(300)));
+    QCOMPARE(r.exit, 1);
+    QVERIFY2(r.err.contains(climbing + ": cannot rebuild the logged world") && r.err.contains(QString::fromUtf8(name)),
+             qPrintable(r.err));
+    QCOMPARE(QDir(dir_.path()).entryList(QDir::AllEntries | QDir::NoDotAndDotDot), before);
     QVERIFY(!QFile::exists(outside));
-    QVERIFY(!QFile::exists(outside + QStringLiteral("/evil.world.xml")));
-    qInfo("climbing world_file: exit %d: %s", r.exit, qPrintable(r.err.left(200) + r.out.left(200)));
+    // The control: a name that is on no disk either, beside the logged
+    // robot's folder, re-simulates from the logged contents.
+    const QString plain = dir_.filePath(QStringLiteral("plain.splog"));
+    QVERIFY(QFile::copy(log_, plain) &&
+            sql(plain, "UPDATE meta SET value = '" SP_SOURCE_DIR "/terrains/not-on-disk.world.xml' WHERE key = 'world_file'"));
+    r = tool(QStringLiteral("simpartner-sim"), {"resim", plain});
+    QCOMPARE(r.exit, 0);
+    QVERIFY2(r.out.contains("no divergence"), qPrintable(r.out));
+    QVERIFY(!QFile::exists(SP_SOURCE_DIR "/terrains/not-on-disk.world.xml"));
   }
 
   // Errors cut a quoted value longer than 80 characters to 80 and its

@@ -100,19 +100,15 @@ class TestLinkDelay : public QObject {
         QVERIFY(seen.waitFor([&] { return seen.failsafes > 0; }, 5s));
         return;
       }
-      QCOMPARE(seen.failsafes, 0);
-      double x0 = 0;
+      QCOMPARE(seen.read([&] { return seen.failsafes; }), 0);
       QVERIFY(seen.waitFor([&] { return seen.telemetry.has_value(); }, 5s));
-      {
-        std::lock_guard lock(seen.mutex);
-        x0 = seen.telemetry->pose.p.x;
-      }
+      const double x0 = seen.read([&] { return seen.telemetry->pose.p.x; });
       const uint64_t seq = client.sendCommandText("drive 0.5 0");
       QVERIFY(seen.waitFor([&] { return seen.reply && seen.reply->seq == seq; }, 10s));
-      QCOMPARE(seen.reply->status, ReplyStatus::Ok);
+      QCOMPARE(seen.read([&] { return seen.reply->status; }), ReplyStatus::Ok);
       // The robot moves (as its delayed telemetry shows): 0.5 m/s for a while.
       QVERIFY(seen.waitFor([&] { return seen.telemetry->pose.p.x - x0 > 0.5; }, 10s));
-      QCOMPARE(seen.failsafes, 0);
+      QCOMPARE(seen.read([&] { return seen.failsafes; }), 0);
       const RobotClientStats stats = client.stats();
       QCOMPARE(stats.telemetryLost, uint64_t{0});
       QCOMPARE(stats.robotDropped, uint64_t{0});

@@ -10,6 +10,7 @@
 #include <QtTest>
 
 #include <fstream>
+#include <set>
 
 #include "tests/app/sweep_results.h"
 
@@ -89,6 +90,9 @@ class TestSweepSlurm : public QObject {
     const std::vector<std::string> a = sp::test::sweepHashes(onCluster.toStdString()), b = sp::test::sweepHashes(local.toStdString());
     QCOMPARE(a.size(), size_t{8});
     QCOMPARE(a, b);
+    // Eight draws, eight end states: equal hashes would mean the samples
+    // were not perturbed (or one ran eight times), and equality above nothing.
+    QCOMPARE(std::set<std::string>(a.begin(), a.end()).size(), size_t{8});
     for (int i = 0; i < 8; ++i) QVERIFY(QFile::exists(onCluster + QString("/logs/%1.out").arg(i)));
 
     // Two tasks lost (a node died): collect names them, a resume submits only those.

@@ -53,9 +53,11 @@ struct Seen : sp::test::SharedState {
     cb.reply = [this](const ReplyMsg& r) { add([&] { replies.push_back(r); }); };
     return cb;
   }
-  double z() {
+  double z() { return latest().pose.p.z; }
+  /// The newest frame, copied under the lock (the client's thread writes it).
+  TelemetryMsg latest() {
     std::lock_guard lock(mutex);
-    return last->pose.p.z;
+    return *last;
   }
 };
 
@@ -278,7 +280,7 @@ class TestTerrainEdit : public QObject {
       Rig rig;
       QVERIFY(rig.start(edits, dir));
       QCOMPARE(rig.client->stats().robotCapabilities, std::string(edits ? "terrain_edit" : ""));
-      const TelemetryMsg before = *rig.seen.last;
+      const TelemetryMsg before = rig.seen.latest();
       const Vec2 under = gridPoint(model.terrain, {before.pose.p.x, before.pose.p.y});
       const auto patch = brushDab(model.terrain.grid, under, Brush{BrushKind::Raise, 2.5, 0.1, 0, 1});
       QVERIFY(patch);
@@ -287,7 +289,7 @@ class TestTerrainEdit : public QObject {
       for (const TerrainPatchCmd& p : parts) rig.client->sendCommand(p);
       QVERIFY(rig.seen.waitFor([&] { return rig.seen.replies.size() == parts.size(); }, 20s));
       const double z0 = before.pose.p.z;
-      const double t0 = rig.seen.last->time;
+      const double t0 = rig.seen.latest().time;
       QVERIFY(rig.seen.waitFor([&] { return rig.seen.last->time > t0 + 2.0; }, 20s));  // settled again
       const double rise = rig.seen.z() - z0;
       {
