@@ -5,7 +5,10 @@
 
 #include <poll.h>
 #include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <chrono>
 #include <string>
@@ -31,6 +34,24 @@ inline pid_t spawnRobot(std::vector<std::string> args, int out, int err = -1) {
   posix_spawn_file_actions_destroy(&actions);
   return pid;
 }
+
+/// Kills and reaps the child when a test returns early (a failed QVERIFY),
+/// so no robot outlives its test; release() once the test reaped it itself.
+class ChildReaper {
+ public:
+  explicit ChildReaper(pid_t pid) : pid_(pid) {}
+  ChildReaper(const ChildReaper&) = delete;
+  ChildReaper& operator=(const ChildReaper&) = delete;
+  ~ChildReaper() {
+    if (pid_ <= 0) return;
+    kill(pid_, SIGKILL);
+    waitpid(pid_, nullptr, 0);
+  }
+  void release() { pid_ = 0; }
+
+ private:
+  pid_t pid_;
+};
 
 /// The port from the robot's stdout (`fd`): its "listening on 127.0.0.1:PORT"
 /// line, within `timeout`; 0 if none came. `text` gets what was read.

@@ -58,6 +58,7 @@ class TestRobotShutdown : public QObject {
     const std::string world = std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml";
     const pid_t pid = test::spawnRobot({"--world", world, "--port", "0", "--token", kToken, "--log", log}, out[1]);
     QVERIFY(pid != 0);
+    test::ChildReaper reaper(pid);  // a failure below must not leave it running
     close(out[1]);
     std::string text;
     const uint16_t port = test::listeningPort(out[0], text);
@@ -96,6 +97,7 @@ class TestRobotShutdown : public QObject {
     for (auto until = Clock::now() + 8s; (done = waitpid(pid, &status, WNOHANG)) == 0 && Clock::now() < until;)
       std::this_thread::sleep_for(20ms);
     if (done == 0) kill(pid, SIGKILL), waitpid(pid, &status, 0);
+    reaper.release();
     const double took = std::chrono::duration<double>(Clock::now() - sent).count();
     QVERIFY2(done == pid, "simpartner-robot did not end within 8 s of the signal");
     QVERIFY(WIFEXITED(status));

@@ -53,6 +53,7 @@ class TestRobotStderr : public QObject {
     const std::string world = std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml";
     const pid_t pid = sp::test::spawnRobot({"--world", world, "--port", "0", "--token", kToken, "--no-log"}, out[1], err[1]);
     QVERIFY(pid != 0);
+    sp::test::ChildReaper reaper(pid);  // a failure below must not leave it running
     close(out[1]);
     close(err[1]);  // err[0] stays open and unread: writes to it block once it is full
 
@@ -121,6 +122,7 @@ class TestRobotStderr : public QObject {
     for (auto until = Clock::now() + 5s; (done = waitpid(pid, &status, WNOHANG)) == 0 && Clock::now() < until;)
       std::this_thread::sleep_for(20ms);
     if (done == 0) kill(pid, SIGKILL), waitpid(pid, &status, 0);
+    reaper.release();
     QVERIFY2(done == pid, "simpartner-robot did not stop within 5 s of SIGTERM");
     QVERIFY(WIFEXITED(status));
     QCOMPARE(WEXITSTATUS(status), 0);

@@ -178,25 +178,39 @@ class TestRigid : public QObject {
     for (size_t j = 0; j < robot.joints.size(); ++j)
       if (robot.joints[j].name.rfind("hip_", 0) == 0 || robot.joints[j].name.rfind("knee_", 0) == 0)
         QCOMPARE(a->submit(JointTargetCmd{robot.joints[j].name, q[j]}), std::string());
-    // Settled for 1 s, then 5 s of driving: each base's path from its settled pose.
-    Pose settled[2];
-    for (int k = 0; k < 2; ++k) {
-      World& w = k == 0 ? *a : *b;
+    // Settled for 1 s, then 5 s of driving: each base's path from its settled
+    // pose. A third world, the held robot again, steers 14 degrees instead
+    // of 12: the control, which the 3 cm / 1 degree bound must see.
+    auto [unused, c] = fullAndRigid(world, *rigid);
+    QVERIFY(c);
+    QCOMPARE(c->setRobotMotion(0, linkMotions(rigid->model, start, {}, {}, rigidJoints(*rigid, q), rigidJoints(*rigid, rest))),
+             std::string());
+    Pose settled[3];
+    for (int k = 0; k < 3; ++k) {
+      World& w = k == 0 ? *a : k == 1 ? *b : *c;
       for (int i = 0; i < 1000; ++i) QVERIFY2(w.step(), w.health().message().c_str());
       settled[k] = w.linkPose(0, 0);
-      QCOMPARE(w.submit(DriveCmd{0.5, degToRad(12)}), std::string());
+      QCOMPARE(w.submit(DriveCmd{0.5, degToRad(k == 2 ? 14 : 12)}), std::string());
       for (int i = 0; i < 5000; ++i) QVERIFY2(w.step(), w.health().message().c_str());
     }
-    const Pose pa = a->linkPose(0, 0), pb = b->linkPose(0, 0);
-    const Vec3 da = pa.p - settled[0].p, db = pb.p - settled[1].p;
-    const double off = std::hypot(da.x - db.x, da.y - db.y);
-    const double yaw = radToDeg(std::abs(std::remainder(heading(pa.q) - heading(settled[0].q) - heading(pb.q) +
-                                                            heading(settled[1].q),
-                                                        2 * kPi)));
-    qInfo("crouched, 5 s: paths %.1f mm, %.3f deg apart; full robot moved %.2f m (settling: %.1f mm apart)",
-          off * 1000, yaw, std::hypot(da.x, da.y), distance(settled[0].p, settled[1].p) * 1000);
+    const auto apart = [&](World& other, int k) {
+      const Pose pa = a->linkPose(0, 0), pb = other.linkPose(0, 0);
+      const Vec3 da = pa.p - settled[0].p, db = pb.p - settled[k].p;
+      return std::make_pair(std::hypot(da.x - db.x, da.y - db.y),
+                            radToDeg(std::abs(std::remainder(heading(pa.q) - heading(settled[0].q) - heading(pb.q) +
+                                                                 heading(settled[k].q),
+                                                             2 * kPi))));
+    };
+    const auto [off, yaw] = apart(*b, 1);
+    const auto [controlOff, controlYaw] = apart(*c, 2);
+    const Vec3 driven = a->linkPose(0, 0).p - settled[0].p;
+    qInfo("crouched, 5 s: paths %.1f mm, %.3f deg apart; full robot moved %.2f m (settling: %.1f mm apart); "
+          "steering 14 deg instead: %.1f mm, %.2f deg",
+          off * 1000, yaw, std::hypot(driven.x, driven.y), distance(settled[0].p, settled[1].p) * 1000,
+          controlOff * 1000, controlYaw);
     QVERIFY(off < 0.03);
     QVERIFY(yaw < 1);
+    QVERIFY(controlOff >= 0.03 || controlYaw >= 1);  // the control
   }
 
   void refusals() {
