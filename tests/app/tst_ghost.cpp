@@ -190,14 +190,18 @@ class TestGhost : public QObject {
           static_cast<long long>(r.stats.trails), r.stats.trailMs, r.trail, r.maxTrail, r.stats.anchorMs,
           r.stats.anchorSpan);
     QCOMPARE(m <= 0.05, pass);
-    // The trail (the path ahead) keeps coming: 5 s ahead in 0.1 s steps.
-    // A trail whose world diverges ends there (Ghost: "up to where it
-    // diverged"); once in CI the last one on the test track, the robot
-    // stopped, ended after 26 points. So: whole trails during the drive,
-    // and the last one not empty.
+    // The trail (the path ahead) keeps coming: 5 s ahead in 0.1 s steps,
+    // 51 points, the last one too. A trail whose world diverges ends there
+    // (Ghost: "up to where it diverged"): once in CI the last one on the
+    // test track ended after 26 points, and the bound was loosened to 2.
+    // The cause was the twin's, not the test's: ODE's cylinder-heightfield
+    // contact threw a wheel into the ground at the track's creases (a 1 cm
+    // step diverged the twin); tyres now meet heightfields as spheres
+    // (sim/world_contacts.cpp), and the bound is whole again (6 of 6 runs
+    // of both track rows gave 51 when it was restored).
     QVERIFY(r.stats.trails > 10);
     QCOMPARE(r.maxTrail, size_t{51});
-    QVERIFY(r.trail >= 2);
+    QCOMPARE(r.trail, size_t{51});
     // Re-anchoring kept going (a stall would show as a handful).
     QVERIFY2(rate > 5, qPrintable(QString::number(rate)));
   }
