@@ -176,6 +176,7 @@ std::string ConsoleSession::startStandIn(const std::string& worldFile, const std
   o.logDir = options_.logDir;
   o.perturbSeed = options_.perturbSeed;
   o.emulation.delay = options_.delay;
+  o.emulation.jitter = options_.jitter;
   Diagnostics diag;
   std::unique_ptr<StandInRobot> standIn = StandInRobot::create(o, diag);
   if (!standIn) return text(diag);

@@ -46,6 +46,7 @@ struct ConsoleSessionOptions {
   std::string logDir = "sessions";     ///< where new logs go
   double rtf = -1;                     ///< stand-in real-time factor; < 0 = the parameters'
   double delay = 0;                    ///< [s] the stand-in's link emulates this one-way delay (each way)
+  double jitter = 0;                   ///< [s] +- on that delay, drawn per frame (each way)
   /// The stand-in is a robot that is not its twin: hidden deviations drawn
   /// from this seed (sim/perturbation.h); the console's twin, ghost and
   /// rehearsals keep the files. nullopt = the stand-in runs the files.
