@@ -16,6 +16,7 @@
 #include <cmath>
 #include <deque>
 
+#include "app/log/resimulation.h"
 #include "app/rehearse/sequence_relay.h"
 #include "app/log/session_log.h"
 #include "app/robot/stand_in.h"
@@ -190,6 +191,15 @@ class TestSequenceRelay : public QObject {
       done |= e.kind == "sequence" && e.text == "done " + msg->hash;
     }
     QVERIFY(started && done);
+    // Issue 35: a session with a relayed sequence re-simulates too, every
+    // hash (the sequence's commands are logged with their steps).
+    const std::optional<ResimReport> resim = resimulate(rig.logPath, {}, error);
+    QVERIFY2(resim, error.c_str());
+    qInfo("re-simulated: %d hashes, %d commands, divergence %s", resim->hashesCompared, resim->commandsApplied,
+          resim->divergence ? "yes" : "none");
+    QVERIFY(!resim->divergence);
+    QVERIFY(resim->hashesCompared >= 5);
+    QVERIFY(resim->commandsApplied >= 2);
   }
 
   // Criterion: with the stand-in's rubber-on-ground friction at 0.02
