@@ -365,16 +365,17 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
   out.samples = n;
   out.endPoses.resize(n);
   out.endHashes.resize(n);
-  out.samplePassed.assign(n, false);
   out.failures.resize(n);
-  std::vector<char> ranToTheEnd(static_cast<size_t>(n), 0);
+  // Per sample, written by the worker threads: chars, not vector<bool>'s
+  // shared bits, so two threads never write one word.
+  std::vector<char> passed(static_cast<size_t>(n), 0), ranToTheEnd(static_cast<size_t>(n), 0);
   std::atomic<int> next{0}, done{0};
   std::atomic<bool> cancelled{false};
   std::mutex progressMutex;
   auto work = [&] {
     for (int i; !cancelled && (i = next++) < n;) {
       const RehearsalResult r = rehearse(perturbed(plan, seed + static_cast<uint64_t>(i)));
-      out.samplePassed[i] = r.passed;
+      passed[static_cast<size_t>(i)] = r.passed;
       out.failures[i] = r.summary();
       if (!r.path.empty()) out.endPoses[i] = r.path.back().base;
       out.endHashes[static_cast<size_t>(i)] = r.endHash;
@@ -390,7 +391,8 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
   for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(work);
   work();
   for (std::thread& t : pool) t.join();
-  out.passed = static_cast<int>(std::count(out.samplePassed.begin(), out.samplePassed.end(), true));
+  out.samplePassed.assign(passed.begin(), passed.end());
+  out.passed = static_cast<int>(std::count(passed.begin(), passed.end(), 1));
   Vec3 mean;
   const auto ended = std::count(ranToTheEnd.begin(), ranToTheEnd.end(), 1);
   for (size_t k = 0; k < out.endPoses.size(); ++k)

@@ -30,6 +30,7 @@
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/params.h"
+#include "sim/text.h"
 
 namespace {
 
@@ -400,7 +401,7 @@ int rehearseCommand(const std::vector<std::string>& args) {
   std::cout << "rehearsal of " << commandsFile << " (hash " << sp::sequenceHash(sp::sequenceText(*commands, &world->robots[0].model))
             << ") on " << worldFile << ": " << r.duration << " s simulated in " << r.wallSeconds << " s, after "
             << r.settled << " s for the robot to settle from the world's start"
-            << (fast ? " (fast profile: step " + std::to_string(params.rehearsalFastStep * 1000).substr(0, 4) + " ms, " +
+            << (fast ? " (fast profile: step " + sp::shortestText(params.rehearsalFastStep * 1000) + " ms, " +
                            std::to_string(params.rehearsalFastIterations) + " iterations; a preview, not sendable)"
                      : std::string())
             << "\n";

@@ -167,7 +167,6 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   // Why a button is disabled, beside it (not a status line out of view).
   whyLabel_ = new WrappedLabel(this);
   whyLabel_->setObjectName(QStringLiteral("sequenceWhy"));
-  whyLabel_->setWordWrap(true);
   whyLabel_->setStyleSheet(QStringLiteral("color: #8a6d00"));
   layout->addWidget(whyLabel_);
   connect(rehearseButton_, &QPushButton::clicked, this, &SequencePanel::rehearse);

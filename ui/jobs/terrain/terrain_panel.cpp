@@ -201,7 +201,9 @@ void TerrainPanel::hoverAt(const Vec3& ground) {
   if (editor_->inStroke()) text += tr("; this stroke %1 m").arg(editor_->strokeChange(at), 0, 'f', 3, QLatin1Char(' '));
   text += next ? tr("; a dab %1%2 m").arg(dab >= 0 ? "+" : "").arg(dab, 0, 'f', 3) : tr("; off the grid");
   preview_->setText(text);
-  if (!limits_) return;
+  // While a stroke is open its dabs say what they made (dabAt): checking
+  // the would-be dab too would do the same work twice per mouse move.
+  if (!limits_ || editor_->inStroke()) return;
   showRisk(next ? strokeRisk(grid, *next, *limits_, wheelRadius_) : std::nullopt, false);
 }
 
