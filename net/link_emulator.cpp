@@ -27,10 +27,10 @@ std::optional<double> LinkEmulator::schedule(size_t bytes, double now) {
     ++dropped_;  // a lost frame takes no bandwidth and does not hold others up
     return std::nullopt;
   }
-  double leaves = now;
+  double leaves = std::max(now, fadeUntil_);
   if (config_.bandwidth > 0) {
     // Frames queue behind each other on the link at `bandwidth` bytes/s.
-    linkFreeAt_ = std::max(linkFreeAt_, now) + static_cast<double>(bytes) / config_.bandwidth;
+    linkFreeAt_ = std::max(linkFreeAt_, leaves) + static_cast<double>(bytes) / config_.bandwidth;
     leaves = linkFreeAt_;
   }
   const double delay = std::max(0.0, config_.delay + config_.jitter * (2 * jitterDraw - 1));

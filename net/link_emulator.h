@@ -8,6 +8,7 @@
 //
 // Thread: one thread at a time; no method is thread-safe.
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -54,6 +55,13 @@ class LinkEmulator {
   /// with `now` not decreasing.
   std::optional<double> schedule(size_t bytes, double now);
 
+  /// A fade (a radio outage, a tunnel): frames sent from `now` until
+  /// `until` [s, same clock] leave at `until` (TCP delivers them once the
+  /// link is back), then take their delay. Frames scheduled before stay as
+  /// they were. Nothing random is drawn, so the times of other frames do
+  /// not change.
+  void fade(double until) { fadeUntil_ = std::max(fadeUntil_, until); }
+
   const LinkEmulatorConfig& config() const { return config_; }
   /// Replaces the config; the engine is re-seeded and the order kept with
   /// frames already scheduled.
@@ -70,6 +78,7 @@ class LinkEmulator {
   std::mt19937_64 engine_;
   double lastDue_ = 0;     ///< due time of the last frame not lost (keepOrder)
   double linkFreeAt_ = 0;  ///< when the last frame has left (bandwidth)
+  double fadeUntil_ = 0;   ///< frames sent before it leave at it (fade())
   uint64_t sent_ = 0, dropped_ = 0, bytes_ = 0;
 };
 

@@ -66,7 +66,20 @@ RobotServer::RobotServer(asio::io_context& io, RobotServerConfig config, RobotPo
       link_(config_.link, robot.model(), [&robot](const Command& c) { return robot.check(c); }),
       acceptor_(io),
       timer_(io),
-      acceptRetry_(io) {}
+      acceptRetry_(io),
+      emulating_(config_.emulation.active()) {}
+
+void RobotServer::fade(double seconds) {
+  // From now on frames go through the emulators (a perfect link's are due
+  // at once); a session opened during the fade is not faded (it is a new
+  // connection over the link that came back).
+  emulating_ = true;
+  const double until = now() + std::max(0.0, seconds);
+  for (auto& [id, s] : sessions_) {
+    s->toClient.fade(until);
+    s->fromClient.fade(until);
+  }
+}
 
 RobotServer::~RobotServer() { stop(); }
 
@@ -184,7 +197,7 @@ void RobotServer::startRead(ClientId id) {
 }
 
 bool RobotServer::telemetryRoom(Session& s) {
-  if (s.telemetryWaiting(now(), !config_.emulation.active() || config_.emulation.keepOrder) < config_.maxQueuedFrames)
+  if (s.telemetryWaiting(now(), !emulating_ || config_.emulation.keepOrder) < config_.maxQueuedFrames)
     return true;
   // A slow reader loses telemetry; the control loop never waits for it.
   ++s.lost;
@@ -205,7 +218,7 @@ void RobotServer::enqueueFrame(Session& s, std::string frame, bool telemetry) {
     return;
   }
   double due = 0;
-  if (config_.emulation.active()) {
+  if (emulating_) {
     const std::optional<double> at = s.toClient.schedule(frame.size(), now());
     if (!at) {
       ++stats_.emulatedLost;
@@ -224,7 +237,7 @@ void RobotServer::received(ClientId id, const std::string& bytes) {
     std::string error;
     std::optional<Message> message = decodeMessage(*frame, error);
     // A well-framed message with bad content: refused, with the reason.
-    if (config_.emulation.active()) {
+    if (emulating_) {
       const std::optional<double> at =
           s.fromClient.schedule(frame->payload.size() + kFrameHeaderSize + kFrameCrcSize, now());
       if (!at) ++stats_.emulatedLost;
@@ -395,7 +408,7 @@ void RobotServer::schedule() {
 
 void RobotServer::onTimer() {
   const double t = now();
-  if (config_.emulation.active()) deliverDue();
+  if (emulating_) deliverDue();
   link_.tick(t);
   // Connections that never said HELLO are closed: they would hold a slot
   // (and a descriptor) for nothing.

@@ -154,6 +154,10 @@ class RobotServer {
   /// then ERROR with `reason`, and is closed once it has them (or after a
   /// second). The server runs on until stop().
   void shutdown(const std::string& reason);
+  /// The emulated link fades for `seconds` from now, both ways, for every
+  /// connection (LinkEmulator::fade): what a radio outage does to the
+  /// deadman, on purpose (tests). On the server's thread.
+  void fade(double seconds);
   uint16_t port() const { return port_; }
   const RobotServerStats& stats() const { return stats_; }
   const RobotLink& link() const { return link_; }
@@ -191,6 +195,7 @@ class RobotServer {
   asio::steady_timer timer_;
   asio::steady_timer acceptRetry_;  // after an accept error (out of descriptors): try again soon
   double lastAcceptErrorLog_ = -1e9;
+  bool emulating_;  // frames pass the emulators: an active emulation, or a fade()
   // Sessions are owned here; asynchronous handlers hold only their id and
   // look the session up, so a closed session is never touched.
   std::map<ClientId, std::unique_ptr<Session>> sessions_;

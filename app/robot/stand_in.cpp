@@ -187,6 +187,10 @@ bool StandInRobot::shutdown(const std::string& reason, double maxWait) {
   return rest;
 }
 
+void StandInRobot::fadeLink(double seconds) {
+  if (server_) asio::post(server_->io, [s = server_.get(), seconds] { s->server->fade(seconds); });
+}
+
 void StandInRobot::stop() {
   if (server_) {
     Server& s = *server_;

@@ -119,6 +119,10 @@ class StandInRobot {
   /// `maxWait` [s]) and its log has samples of it at rest; then stop().
   /// Returns whether it came to rest in time.
   bool shutdown(const std::string& reason, double maxWait = 3.0);
+  /// The link fades for `seconds` from now, both ways (net::RobotServer::
+  /// fade): nothing sent meanwhile arrives before the fade ends. Any thread;
+  /// does nothing before start().
+  void fadeLink(double seconds);
 
   /// The port listened on (the real one when 0 was asked); 0 before start().
   uint16_t port() const { return port_; }

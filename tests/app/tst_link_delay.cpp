@@ -2,8 +2,8 @@
 // stand-in robot on loopback with delay and jitter in both directions, a
 // RobotClient taking control and driving. With the table's settings the
 // robot is driven over each link: no failsafe, the drive command accepted,
-// the robot moves, no telemetry lost or dropped. Control: the planetary link
-// with a deadman below the table's trips the failsafe.
+// the robot moves, no telemetry lost or dropped. Then the link fades on
+// purpose: a fade the deadman must ride out, and the control, one it cannot.
 
 #include <QtTest>
 
@@ -54,20 +54,27 @@ class TestLinkDelay : public QObject {
     QTest::addColumn<double>("delay");    // one way [s], both directions
     QTest::addColumn<double>("jitter");   // +- [s], each direction
     QTest::addColumn<double>("deadman");  // the robot's [s]
+    QTest::addColumn<double>("fade");     // [s] the link fades while driving; 0 = never
     QTest::addColumn<bool>("failsafe");   // expected
-    QTest::newRow("LAN") << 0.0 << 0.0 << 0.2 << false;
-    QTest::newRow("radio 300 ms +- 50 round trip") << 0.15 << 0.05 << 0.3 << false;
-    QTest::newRow("planetary 2 s +- 0.1 round trip") << 1.0 << 0.1 << 0.5 << false;
-    // Control: a deadman below the table's for this link trips on jitter
-    // (keep-alives every 37.5 ms; gaps above 150 ms come several times a
-    // second with +- 0.1 s jitter each way).
-    QTest::newRow("planetary with a 150 ms deadman (control)") << 1.0 << 0.1 << 0.15 << true;
+    QTest::newRow("LAN") << 0.0 << 0.0 << 0.2 << 0.0 << false;
+    QTest::newRow("radio 300 ms +- 50 round trip") << 0.15 << 0.05 << 0.3 << 0.0 << false;
+    QTest::newRow("planetary 2 s +- 0.1 round trip") << 1.0 << 0.1 << 0.5 << 0.0 << false;
+    // The bounds, from the protocol: keep-alives leave every
+    // min(link.keepalive 50 ms, deadman / 4); a fade of F holds every frame
+    // sent in it until its end, so the robot's longest silence is at most
+    // F + 50 ms + 2 x jitter (the frame before the fade late by the
+    // jitter, the one after early by it), and at least F - 2 x jitter.
+    // Ridden out: 0.1 + 0.05 + 0.2 = 0.35 s < 0.5 s (150 ms to spare).
+    QTest::newRow("planetary, a 100 ms fade ridden out") << 1.0 << 0.1 << 0.5 << 0.1 << false;
+    // Control, tripping by construction: 0.9 - 0.2 = 0.7 s > 0.5 s.
+    QTest::newRow("planetary, a 900 ms fade trips the deadman (control)") << 1.0 << 0.1 << 0.5 << 0.9 << true;
   }
 
   void drivesOverEmulatedLinks() {
     QFETCH(double, delay);
     QFETCH(double, jitter);
     QFETCH(double, deadman);
+    QFETCH(double, fade);
     QFETCH(bool, failsafe);
     StandInOptions o;
     o.worldFile = std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml";
@@ -96,10 +103,6 @@ class TestLinkDelay : public QObject {
       client.acquireLease();
       QVERIFY(seen.waitFor([&] { return seen.lease; }, 10s));
       std::this_thread::sleep_for(2 * roundTrip + 500ms);
-      if (failsafe) {
-        QVERIFY(seen.waitFor([&] { return seen.failsafes > 0; }, 5s));
-        return;
-      }
       QCOMPARE(seen.read([&] { return seen.failsafes; }), 0);
       QVERIFY(seen.waitFor([&] { return seen.telemetry.has_value(); }, 5s));
       const double x0 = seen.read([&] { return seen.telemetry->pose.p.x; });
@@ -109,6 +112,17 @@ class TestLinkDelay : public QObject {
       // The robot moves (as its delayed telemetry shows): 0.5 m/s for a while.
       QVERIFY(seen.waitFor([&] { return seen.telemetry->pose.p.x - x0 > 0.5; }, 10s));
       QCOMPARE(seen.read([&] { return seen.failsafes; }), 0);
+      if (fade > 0) {
+        robot->fadeLink(fade);
+        // The fade, then a round trip for the failsafe's EVENT to come back.
+        const auto after = std::chrono::milliseconds(static_cast<int>(1000 * fade)) + roundTrip + 500ms;
+        if (failsafe) {
+          QVERIFY(seen.waitFor([&] { return seen.failsafes > 0; }, after));
+        } else {
+          std::this_thread::sleep_for(after);
+          QCOMPARE(seen.read([&] { return seen.failsafes; }), 0);
+        }
+      }
       const RobotClientStats stats = client.stats();
       QCOMPARE(stats.telemetryLost, uint64_t{0});
       QCOMPARE(stats.robotDropped, uint64_t{0});

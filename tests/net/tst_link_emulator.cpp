@@ -153,6 +153,26 @@ class TestLinkEmulator : public QObject {
     QCOMPARE(*link.schedule(100, 10.0), 10.0 + 0.5 + 0.01);
   }
 
+  // A fade holds what is sent in it until its end, then adds the delay; the
+  // frames around it keep the times they would have had (no draw is spent).
+  void fade() {
+    const LinkEmulatorConfig config{.delay = 0.3, .jitter = 0.05, .seed = 8};
+    LinkEmulator faded(config), plain(config);
+    for (int i = 0; i < 300; ++i) {
+      const double now = i * 0.01;  // the fade covers [1, 1.5)
+      if (i == 100) faded.fade(1.5);
+      const double f = *faded.schedule(20, now), p = *plain.schedule(20, now);
+      if (now < 1.0) QCOMPARE(f, p);
+      else if (now < 1.5) QVERIFY2(f >= 1.5 + 0.25 - 1e-9, qPrintable(QString("sent at %1, due %2").arg(now).arg(f)));
+      else if (now > 1.6) QCOMPARE(f, p);  // past the fade and its backlog
+    }
+    // A shorter fade inside a longer one does not shorten it.
+    LinkEmulator link({.delay = 0.1});
+    link.fade(2.0);
+    link.fade(1.0);
+    QCOMPARE(*link.schedule(1, 0.5), 2.1);
+  }
+
   // The same seed gives the same times; another seed other times.
   void deterministic() {
     const LinkEmulatorConfig config{.delay = 0.2, .jitter = 0.1, .loss = 0.2, .seed = 99};
