@@ -6,7 +6,7 @@
 #include <QCommandLineParser>
 #include <QDir>
 #include <QElapsedTimer>
-#include <QFileInfo>
+#include <QMessageBox>
 #include <QRegularExpression>
 #include <QTimer>
 
@@ -16,6 +16,8 @@
 #include <optional>
 
 #include "app/console/console_session.h"
+#include "app/data/data_files.h"
+#include "ui/icons.h"
 #include "ui/jobs/drive/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/live_plots.h"
@@ -23,15 +25,6 @@
 #include "ui/scene_view.h"
 
 namespace {
-
-/// A data file given relative to the project (terrains/..., robots/...) is
-/// found from the current folder, else from the source tree the program was
-/// built from, so the console starts from anywhere.
-QString findDataFile(const QString& path) {
-  if (path.isEmpty() || QFileInfo(path).isAbsolute() || QFileInfo::exists(path)) return path;
-  const QString inSource = QDir(QStringLiteral(SP_SOURCE_DIR)).filePath(path);
-  return QFileInfo::exists(inSource) ? inSource : path;
-}
 
 /// The value of a numeric option, or nullopt after saying on stderr what is
 /// wrong with it (`<command line>: error: --OPTION: ...`).
@@ -85,7 +78,8 @@ int main(int argc, char** argv) {
   const QCommandLineOption sequenceFile(QStringLiteral("sequence"), QStringLiteral("Open this command sequence in the Sequence dock."), QStringLiteral("FILE"));
   const QCommandLineOption replay(QStringLiteral("replay"), QStringLiteral("Open this session log in the Replay dock."), QStringLiteral("LOG"));
   const QCommandLineOption drive(QStringLiteral("drive"), QStringLiteral("Drive at SPEED m/s once in control (for demonstrations)."), QStringLiteral("SPEED"));
-  parser.addOptions({world, params, set, connectTo, token, logDir, noLog, rtf, delay, perturb, noGhost, noCalibration, monitor, screenshot, quitAfter, drive, rules,
+  const QCommandLineOption errorDialog(QStringLiteral("error-dialog"), QStringLiteral("Show an error that stops the start in a dialog too (the desktop entry sets it: no terminal shows stderr there)."));
+  parser.addOptions({errorDialog, world, params, set, connectTo, token, logDir, noLog, rtf, delay, perturb, noGhost, noCalibration, monitor, screenshot, quitAfter, drive, rules,
                      sequenceFile, replay});
   if (!parser.parse(QCoreApplication::arguments())) {
     std::cerr << "<command line>: error: " << parser.errorText().toStdString() << "\n";
@@ -112,6 +106,16 @@ int main(int argc, char** argv) {
     }
   }
 
+  // Files named relative to the data folder (terrains/..., robots/...) are
+  // found there from any working directory (app/data/data_files.h). One not
+  // found stops the start, said once the application exists (a dialog needs it).
+  QString startError;
+  const auto findDataFile = [&startError](const QString& path) {
+    std::string error;
+    const std::string found = sp::findDataFile(path.toStdString(), error);
+    if (!error.empty() && startError.isEmpty()) startError = QString::fromStdString(error);
+    return QString::fromStdString(found);
+  };
   sp::ConsoleOptions options;
   options.world = findDataFile(parser.value(world));
   options.params = findDataFile(parser.value(params));
@@ -159,14 +163,21 @@ int main(int argc, char** argv) {
   QApplication::setApplicationName(QStringLiteral("SimPartner"));
   QApplication::setOrganizationName(QStringLiteral("SimPartner"));
   QApplication::setApplicationVersion(QStringLiteral(SP_VERSION));
+  QApplication::setWindowIcon(sp::appIcon());
+  QGuiApplication::setDesktopFileName(QStringLiteral("simpartner"));  // matches the installed .desktop entry
 
-  sp::MainWindow window(options);
-  if (const QString error = window.start(); !error.isEmpty()) {
-    // Said where it was asked for: on the command line's stderr, as every
-    // SimPartner tool does (a dialog would hang a scripted start).
+  // Said where it was asked for: on the command line's stderr, as every
+  // SimPartner tool does (a dialog would hang a scripted start), and in a
+  // dialog when the desktop entry started us.
+  const auto failed = [&](const QString& error) {
     std::cerr << error.toStdString() << "\n";
+    if (parser.isSet(errorDialog))
+      QMessageBox::critical(nullptr, QObject::tr("SimPartner cannot start"), error);
     return 1;
-  }
+  };
+  if (!startError.isEmpty()) return failed(startError);
+  sp::MainWindow window(options);
+  if (const QString error = window.start(); !error.isEmpty()) return failed(error);
   window.show();
   if (!window.logPath().isEmpty()) std::cout << "logging to " << window.logPath().toStdString() << std::endl;
 

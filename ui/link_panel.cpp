@@ -10,6 +10,8 @@
 
 #include <algorithm>
 
+#include "ui/icons.h"
+
 namespace sp {
 
 namespace {
@@ -68,19 +70,20 @@ LinkPanel::LinkPanel(QWidget* parent) : QWidget(parent) {
   layout->addLayout(form);
 
   auto* row = new QHBoxLayout;
-  connect_ = new QPushButton(tr("Disconnect"));
-  control_ = new QPushButton(tr("Take control"));
+  connect_ = new QPushButton(actionIcon(QStringLiteral("disconnect")), tr("Disconnect"));
+  control_ = new QPushButton(actionIcon(QStringLiteral("take-control")), tr("Take control"));
   control_->setToolTip(tr("Ask the robot for the control lease: only its holder may command it"));
   row->addWidget(connect_);
   row->addWidget(control_);
   layout->addLayout(row);
   auto* row2 = new QHBoxLayout;
-  estop_ = new QPushButton(tr("E-STOP (Esc)"));
+  estop_ = new QPushButton(actionIcon(QStringLiteral("estop")), tr("E-STOP (Esc)"));
+  estop_->setIconSize(QSize(24, 24));
   estop_->setObjectName(QStringLiteral("estopButton"));
   estop_->setMinimumHeight(40);
   estop_->setStyleSheet(QStringLiteral("QPushButton { background: #c62828; color: white; font-weight: bold; }"));
   estop_->setToolTip(tr("Emergency stop: the robot stops and stays stopped until re-armed. Key Esc works anywhere in the console."));
-  rearm_ = new QPushButton(tr("Re-arm"));
+  rearm_ = new QPushButton(actionIcon(QStringLiteral("rearm")), tr("Re-arm"));
   rearm_->setObjectName(QStringLiteral("rearmButton"));
   rearm_->setToolTip(tr("Clear a latched failsafe or e-stop (the lease holder only)"));
   row2->addWidget(estop_, 2);
@@ -149,6 +152,7 @@ void LinkPanel::showConnection(net::ConnectionState state, const QString& detail
                                                                  : "#ef6c00";
   state_->setFullText(text, colour);
   connect_->setText(open_ ? tr("Disconnect") : tr("Connect"));
+  connect_->setIcon(actionIcon(open_ ? QStringLiteral("disconnect") : QStringLiteral("connect")));
   control_->setEnabled(state == net::ConnectionState::Ready);
   rearm_->setEnabled(state == net::ConnectionState::Ready);
   if (state != net::ConnectionState::Ready) showLease({});

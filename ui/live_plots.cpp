@@ -29,6 +29,7 @@
 
 #include "app/validation/plot.h"  // plotSeriesColor: the report plots' palette
 #include "sim/math.h"
+#include "ui/icons.h"
 
 namespace sp {
 
@@ -184,7 +185,7 @@ WheelForcePlot::WheelForcePlot(QWidget* parent, std::size_t capacity)
   windowBox_->setKeyboardTracking(false);  // typing "60" should not replot at 6 s first
   windowBox_->setToolTip(tr("Length of the time window shown"));
   label->setBuddy(windowBox_);
-  pauseButton_ = new QPushButton(tr("Pause"), this);
+  pauseButton_ = new QPushButton(actionIcon(QStringLiteral("pause")), tr("Pause"), this);
   pauseButton_->setObjectName("pause");
   pauseButton_->setCheckable(true);
   pauseButton_->setToolTip(tr("Pause: hold the view to read it or scroll back. Follow: show the newest samples"));

@@ -25,10 +25,12 @@
 #include <QVBoxLayout>
 
 #include "app/console/console_session.h"
+#include "app/data/data_files.h"
 #include "app/log/log_player.h"
 #include "ui/background_jobs.h"
 #include "ui/connect_dialog.h"
 #include "ui/console_monitor.h"
+#include "ui/icons.h"
 #include "ui/jobs/drive/drive_job.h"
 #include "ui/jobs/jobs.h"
 #include "ui/jobs/link/link_job.h"
@@ -76,6 +78,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
                                               QStringLiteral("/SimPartner/sessions")
                                         : options_.logDir),
       session_(std::make_unique<ConsoleSession>(toSessionOptions(options_, logDir_))) {
+  setWindowIcon(appIcon());
   setWindowTitle(tr("SimPartner"));
   // Object names let QSettings restore the docks and toolbars by name.
   setObjectName(QStringLiteral("SimPartnerMainWindow"));
@@ -354,7 +357,7 @@ void MainWindow::buildMenus() {
   });
   // The jobs' File items (session logs, ...) go here, before Open robot.
   menuAnchors_[tr("&File")] = file->addAction(tr("Open &robot…"), this, [this] {
-    const QString path = QFileDialog::getOpenFileName(this, tr("Open robot"), QStringLiteral("robots"),
+    const QString path = QFileDialog::getOpenFileName(this, tr("Open robot"), QString::fromStdString(dataSubfolder("robots")),
                                                       tr("Robot files (*.xml)"));
     if (!path.isEmpty()) openRobot(path);
   });

@@ -107,6 +107,13 @@ constexpr int kMass = static_cast<int>(CalParam::Mass);
 constexpr int kFitted = kMass;  // the parameters fitted through the twin: all but the mass
 constexpr double kUnobserved = 0.25;  // sigma above this share of a parameter's scale: unobserved
 
+/// A duration for the operator: one decimal ("4.0", not "4.000000000000001").
+std::string tenths(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", seconds);
+  return text;
+}
+
 // What one scaled residual is: a deviation of this size counts 1.
 struct ResidualScale {
   double position = 0.01;   // [m]
@@ -519,7 +526,7 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   fit.segments = static_cast<int>(pb.segments.size());
   if (fit.segments < o.minSegments)
     return done("not enough driving: " + std::to_string(fit.segments) + " segments of " + shortestText(o.horizon) +
-                " s with the wheels turning and the legs still in " + shortestText(fit.to - fit.from) +
+                " s with the wheels turning and the legs still in " + tenths(fit.to - fit.from) +
                 " s of telemetry (need " + std::to_string(o.minSegments) + ")");
 
   // The motor gain in closed form, the rest by Levenberg-Marquardt: the

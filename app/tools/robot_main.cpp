@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "app/data/data_files.h"
 #include "app/robot/line_writer.h"
 #include "app/robot/stand_in.h"
 #include "sim/model_loader.h"
@@ -19,8 +20,12 @@
 namespace {
 
 constexpr const char* kUsage = R"(usage:
-  simpartner-robot --world FILE [options]
+  simpartner-robot [--world FILE] [options]
       Runs the twin as a robot on the link protocol (docs/protocol.md).
+      --world FILE      world to run (default terrains/flat.world.xml); a
+                        relative name not found from the working directory
+                        is taken from the data folder (installed with the
+                        program; $SIMPARTNER_DATA overrides)
       --port N          TCP port (default: port.robot of the parameters; 0 = any free port)
       --bind ADDRESS    address to listen on (default 127.0.0.1); any other
                         address needs --token
@@ -66,6 +71,10 @@ int main(int argc, char** argv) {
     const std::string& a = args[i];
     if (a == "--help" || a == "-h") {
       std::cout << kUsage;
+      return 0;
+    }
+    if (a == "--version") {
+      std::cout << "simpartner-robot " << SP_VERSION << "\n";
       return 0;
     }
     if (a == "--no-log") {
@@ -119,9 +128,14 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (options.worldFile.empty()) {
-    std::cerr << "<command line>: error: --world FILE is required\n" << kUsage;
-    return 2;
+  if (options.worldFile.empty()) options.worldFile = "terrains/flat.world.xml";
+  for (std::string* file : {&options.worldFile, &options.paramsFile}) {
+    std::string error;
+    *file = sp::findDataFile(*file, error);
+    if (!error.empty()) {
+      std::cerr << error << "\n";
+      return 1;
+    }
   }
   if (perturbReport) {
     if (!options.perturbSeed) {

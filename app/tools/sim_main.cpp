@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "app/calibration/calibration.h"
+#include "app/data/data_files.h"
 #include "app/ghost/ghost.h"
 #include "app/tools/headless_runner.h"
 #include "app/log/log_export.h"
@@ -35,6 +36,8 @@
 namespace {
 
 constexpr const char* kUsage = R"(usage:
+  simpartner-sim --version
+      Prints the version.
   simpartner-sim check FILE...
       Validates robot (.xml), world (.world.xml), parameter (.params) and
       command sequence (.seq) files; sequences are also checked against the
@@ -188,7 +191,7 @@ int check(const std::vector<std::string>& files) {
   return errors == 0 ? 0 : 1;
 }
 
-int validate(const std::vector<std::string>& args, const char* argv0) {
+int validate(const std::vector<std::string>& args) {
   sp::ValidationOptions o;
   std::string out = "validation", paramsFile, convergence;
   std::vector<std::string> overrides;
@@ -210,12 +213,17 @@ int validate(const std::vector<std::string>& args, const char* argv0) {
   std::cerr << diag.format();
   if (!params) return 2;
   o.params = *params;
-  // The shipped robots/ and terrains/: next to the working directory, or
-  // two levels above the executable (build/app/).
+  // The shipped robots/ and terrains/: from the working directory or the
+  // data folder (app/data/data_files.h).
   namespace fs = std::filesystem;
-  o.sourceDir = fs::exists("terrains/flat.world.xml")
-                    ? "."
-                    : fs::absolute(fs::path(argv0)).parent_path().parent_path().parent_path().string();
+  std::string dataError;
+  const std::string flat = sp::findDataFile("terrains/flat.world.xml", dataError);
+  if (flat.empty()) {
+    std::cerr << dataError << "\n";
+    return 1;
+  }
+  o.sourceDir = fs::path(flat).parent_path().parent_path().string();
+  if (o.sourceDir.empty()) o.sourceDir = ".";
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) {
@@ -710,8 +718,24 @@ int main(int argc, char** argv) {
     std::cout << kUsage;
     return args.empty() ? 2 : 0;
   }
+  if (args[0] == "--version") {
+    std::cout << "simpartner-sim " << SP_VERSION << "\n";
+    return 0;
+  }
   const std::string cmd = args[0];
   args.erase(args.begin());
+  // Files named relative to the data folder (terrains/..., robots/...) are
+  // found there from any working directory; one found nowhere stays as
+  // given, and its command says it cannot open it.
+  const auto dataFile = [](std::string& path) {
+    std::string error;
+    if (std::string found = sp::findDataFile(path, error); !found.empty()) path = found;
+  };
+  for (size_t i = 0; i + 1 < args.size(); ++i)
+    if (args[i] == "--world" || args[i] == "--commands" || args[i] == "--rules" || args[i] == "--params")
+      dataFile(args[++i]);
+  if (cmd == "check")
+    for (std::string& file : args) dataFile(file);
   if (cmd == "check") {
     if (args.empty()) {
       std::cerr << "<command line>: error: check needs at least one file\n";
@@ -721,7 +745,7 @@ int main(int argc, char** argv) {
   }
   if (cmd == "run") return run(args);
   if (cmd == "params") return printParams();
-  if (cmd == "validate") return validate(args, argv[0]);
+  if (cmd == "validate") return validate(args);
   if (cmd == "resim") return resim(args);
   if (cmd == "rehearse") return rehearseCommand(args);
   if (cmd == "export") return exportLog(args);

@@ -600,7 +600,8 @@ class TestConsole : public QObject {
     QTest::newRow("rtf") << QStringList{"--rtf", "fast"} << 2 << "<command line>: error: --rtf: expected a number";
     QTest::newRow("drive") << QStringList{"--drive", "99"} << 2 << "<command line>: error: --drive: expected a number in [-10, 10]";
     QTest::newRow("connect") << QStringList{"--connect", "nowhere"} << 1 << "--connect: expected HOST:PORT, got 'nowhere'";
-    QTest::newRow("world") << QStringList{"--world", "missing.world.xml"} << 1 << "missing.world.xml: error: cannot open world file: not found";
+    QTest::newRow("world") << QStringList{"--world", "missing.world.xml"} << 1
+                           << "missing.world.xml: error: not found; looked in the working directory (";
     QTest::newRow("token") << QStringList{"--token", "abc"} << 2
                            << "<command line>: error: --token: expected at least 32 hex digits (128 bits), got 3 digits";
     QTest::newRow("unknown option") << QStringList{"--bogus"} << 2 << "<command line>: error: Unknown option 'bogus'";

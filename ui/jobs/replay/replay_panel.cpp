@@ -1,6 +1,7 @@
 #include "ui/jobs/replay/replay_panel.h"
 
 #include "ui/background_jobs.h"
+#include "ui/icons.h"
 
 #include <QBoxLayout>
 #include <QComboBox>
@@ -92,10 +93,11 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   title_ = new QLabel(tr("No log open: File ▸ Open session log…"), this);
   layout->addWidget(title_);
   auto* row = new QHBoxLayout;
-  auto* back = new QPushButton(QStringLiteral("◀"), this);
+  auto* back = new QPushButton(actionIcon(QStringLiteral("step-back")), QString(), this);
   back->setToolTip(tr("Step back %1 s").arg(kStep));
-  playButton_ = new QPushButton(tr("Play"), this);
-  auto* forward = new QPushButton(QStringLiteral("▶|"), this);
+  playButton_ = new QPushButton(actionIcon(QStringLiteral("play")), QString(), this);
+  playButton_->setToolTip(tr("Play"));
+  auto* forward = new QPushButton(actionIcon(QStringLiteral("step-forward")), QString(), this);
   forward->setToolTip(tr("Step forward %1 s").arg(kStep));
   for (QPushButton* b : {back, playButton_, forward}) b->setFocusPolicy(Qt::NoFocus);
   speedBox_ = new QComboBox(this);
@@ -424,7 +426,8 @@ void ReplayPanel::play() {
   if (!player_) return;
   if (cursor_ >= player_->endTime()) show(player_->startTime());  // from the start again
   playing_ = true;
-  playButton_->setText(tr("Pause"));
+  playButton_->setIcon(actionIcon(QStringLiteral("pause")));
+  playButton_->setToolTip(tr("Pause"));
   wall_.start();
   timer_->start();
 }
@@ -432,7 +435,8 @@ void ReplayPanel::play() {
 void ReplayPanel::pause() {
   playing_ = false;
   timer_->stop();
-  playButton_->setText(tr("Play"));
+  playButton_->setIcon(actionIcon(QStringLiteral("play")));
+  playButton_->setToolTip(tr("Play"));
 }
 
 void ReplayPanel::setSpeed(double factor) {

@@ -15,6 +15,7 @@
 #include <cmath>
 
 #include "sim/terrain_file.h"
+#include "ui/icons.h"
 
 namespace sp {
 namespace {
@@ -59,7 +60,8 @@ TerrainPanel::TerrainPanel(QWidget* parent) : QWidget(parent) {
   auto* form = new QFormLayout;
   kind_ = new QComboBox(this);
   for (BrushKind k : {BrushKind::Raise, BrushKind::Lower, BrushKind::Smooth, BrushKind::Flatten, BrushKind::Noise})
-    kind_->addItem(QString::fromLatin1(brushName(k)), static_cast<int>(k));
+    kind_->addItem(actionIcon(QStringLiteral("brush-") + QLatin1String(brushName(k))), QString::fromLatin1(brushName(k)),
+                   static_cast<int>(k));
   radius_ = new QDoubleSpinBox(this);
   radius_->setRange(0.1, 20);
   radius_->setSingleStep(0.1);
