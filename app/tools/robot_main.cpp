@@ -49,7 +49,8 @@ constexpr const char* kUsage = R"(usage:
                         actuator delay 0-60 ms, IMU roll/pitch bias +-1 deg);
                         WELCOME and telemetry do not tell them, the log does
       --perturb-report  print the deviations (with --perturb) and exit
-  Prints `logging to PATH`, then `listening on ADDRESS:PORT` when ready;
+  Prints `world PATH`, `logging to PATH`, then `listening on ADDRESS:PORT`
+  when ready;
   connections, lease changes and e-stops go to stderr. On SIGINT or SIGTERM
   it stops every motor (as an e-stop), tells every client why and closes
   them, waits for the robot to come to rest (at most 3 s), then exits; the
@@ -178,6 +179,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (options.token.empty()) std::cout << "token " << robot->token() << "\n";
+  std::cout << "world " << options.worldFile << "\n";
   const sp::net::LinkEmulatorConfig& emulation = options.emulation;
   if (emulation.active())
     std::cout << "emulating a link with " << emulation.delay << " s delay, +-" << emulation.jitter << " s jitter, "

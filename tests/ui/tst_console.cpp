@@ -35,6 +35,7 @@
 #include "app/console/console_session.h"
 #include "app/log/session_log.h"
 #include "ui/connect_dialog.h"
+#include "ui/icons.h"
 #include "ui/jobs/drive/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/live_plots.h"
@@ -138,6 +139,13 @@ class TestConsole : public QObject {
     QVERIFY(w.logPath().startsWith(options_.logDir));
     QVERIFY(w.bannerText().isEmpty());
     QTRY_VERIFY_WITH_TIMEOUT(w.realTimeFactor() > 0.5, 5000);
+    // Its icons come from the bundled assets (assets/assets.qrc), none from disk.
+    QVERIFY(!w.windowIcon().isNull());
+    QVERIFY(w.windowIcon().availableSizes().contains(QSize(256, 256)));
+    auto* estop = w.findChild<QPushButton*>(QStringLiteral("estopButton"));
+    QVERIFY(estop);
+    QVERIFY(!estop->icon().isNull());
+    QVERIFY(actionIcon(QStringLiteral("no-such-icon")).isNull());  // the control: a missing file is no icon
   }
 
   // The 3D view renders terrain and robot: a grab holds far more than sky.
