@@ -9,7 +9,7 @@ packages=(
   qt6-base-dev libqt6opengl6-dev qt6-charts-dev libopenscenegraph-dev
   libxml2-utils xvfb xauth mesa-utils libgl1-mesa-dri imagemagick x11-apps
   python3 clang libclang-rt-14-dev
-  desktop-file-utils lintian help2man
+  desktop-file-utils lintian help2man liburdfdom-tools
   slurmctld slurmd slurm-client munge
 )
 

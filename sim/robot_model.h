@@ -55,6 +55,16 @@ struct LinkSpec {
   int line = 0;
 };
 
+/// A link's mass properties as the twin builds its body (sim/world_build.cpp,
+/// with ODE's own mass functions): the mass, its centre in the link frame,
+/// and the inertia tensor about that centre in the link's axes [kg m^2].
+struct MassProperties {
+  double mass = 0;
+  Vec3 centre;
+  double ixx = 0, iyy = 0, izz = 0, ixy = 0, ixz = 0, iyz = 0;
+};
+MassProperties massProperties(const LinkSpec& link);
+
 enum class JointType { Hinge, Slider, Universal, Ball, Fixed };
 const char* toString(JointType type);
 

@@ -44,6 +44,28 @@ dMass massOf(const std::vector<GeomSpec>& geoms, double total) {
   return sum;
 }
 
+}  // namespace
+
+MassProperties massProperties(const LinkSpec& link) {
+  dMass mass = massOf(link.geoms, link.mass);
+  const Vec3& shift = link.centreOfMassShift;
+  dMassTranslate(&mass, shift.x, shift.y, shift.z);
+  MassProperties out;
+  out.mass = mass.mass;
+  out.centre = {mass.c[0], mass.c[1], mass.c[2]};
+  dMassTranslate(&mass, -out.centre.x, -out.centre.y, -out.centre.z);  // about the centre
+  // dMass::I is a row-major 3x4 matrix.
+  out.ixx = mass.I[0];
+  out.iyy = mass.I[5];
+  out.izz = mass.I[10];
+  out.ixy = mass.I[1];
+  out.ixz = mass.I[2];
+  out.iyz = mass.I[6];
+  return out;
+}
+
+namespace {
+
 dSurfaceParameters toSurface(const ContactSpec& c, double step) {
   dSurfaceParameters s{};
   s.mode = dContactApprox1;

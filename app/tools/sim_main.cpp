@@ -31,7 +31,9 @@
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/params.h"
+#include "sim/terrain_file.h"
 #include "sim/text.h"
+#include "sim/urdf.h"
 
 namespace {
 
@@ -127,6 +129,12 @@ constexpr const char* kUsage = R"(usage:
   simpartner-sim export LOG --csv DIR
       Writes one CSV per stream of a session log into DIR (samples.csv,
       laser.csv, commands.csv, events.csv), headers naming columns and units.
+  simpartner-sim urdf FILE [--out URDF]
+      Writes the robot of FILE (a robot file, or a world's first robot) as
+      URDF for ROS tools (RViz, check_urdf): links with the twin's inertia,
+      visual and collision geometry, joints with limits, efforts and
+      damping (docs/formats.md, "URDF"). To stdout, or to URDF whole or not
+      at all. Exits 1 on a bad file or a robot URDF cannot describe.
 )";
 
 std::atomic<bool> gStop{false};
@@ -499,6 +507,50 @@ int exportLog(const std::vector<std::string>& args) {
   return 0;
 }
 
+int urdfCommand(const std::vector<std::string>& args) {
+  std::string file, out;
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--out" && i + 1 < args.size()) out = args[++i];
+    else if (file.empty() && !args[i].empty() && args[i][0] != '-') file = args[i];
+    else {
+      std::cerr << "<command line>: error: unknown or incomplete option '" << args[i] << "'\n" << kUsage;
+      return 2;
+    }
+  }
+  if (file.empty()) {
+    std::cerr << "<command line>: error: urdf needs a robot or world file\n";
+    return 2;
+  }
+  // A robot file, or a world's first robot.
+  sp::Diagnostics diag;
+  std::optional<sp::RobotModel> robot;
+  if (endsWith(file, ".world.xml")) {
+    if (std::optional<sp::WorldModel> world = sp::loadWorld(file, diag); world && !world->robots.empty())
+      robot = world->robots.front().model;
+    else if (world) diag.error(file, 0, "the world has no robot");
+  } else {
+    robot = sp::loadRobot(file, diag);
+  }
+  std::cerr << diag.format();
+  if (!robot) return 1;
+  std::string error;
+  const std::optional<std::string> urdf = sp::robotUrdf(*robot, error);
+  if (!urdf) {
+    std::cerr << file << ": error: " << error << "\n";
+    return 1;
+  }
+  if (out.empty()) {
+    std::cout << *urdf;
+    return 0;
+  }
+  if (!sp::writeFileAtomically(out, *urdf, error)) {  // nothing half-written
+    std::cerr << error << "\n";
+    return 1;
+  }
+  std::cout << "wrote " << out << " (" << robot->links.size() << " links, " << robot->joints.size() << " joints)\n";
+  return 0;
+}
+
 int calibrate(const std::vector<std::string>& args) {
   std::string log, out, robotOut, profileName = "ghost";
   double window = 0;
@@ -750,6 +802,7 @@ int main(int argc, char** argv) {
   if (cmd == "rehearse") return rehearseCommand(args);
   if (cmd == "export") return exportLog(args);
   if (cmd == "calibrate") return calibrate(args);
+  if (cmd == "urdf") return urdfCommand(args);
   if (cmd == "sweep") return sweepCommand(args, argv[0]);
   if (cmd == "sweep-task") return sweepTaskCommand(args);
   if (cmd == "collect") return collectCommand(args);
