@@ -67,6 +67,10 @@ void RobotLink::stalled(ClientId client, const std::string& why, double now) {
     notice("link", name + " closed: " + why);
 }
 
+void RobotLink::robotFault(const std::string& reason, double now) {
+  if (!failsafe_) stopEverything(EventKind::Failsafe, reason, now);
+}
+
 void RobotLink::shutdown(const std::string& reason, double now) {
   stopEverything(EventKind::Estop, reason + ": every motor stopped", now);
   std::vector<ClientId> everyone;

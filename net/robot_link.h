@@ -72,6 +72,10 @@ class RobotLink {
   /// lease holder's robot is stopped with a failsafe saying so, at once
   /// (its keep-alives alone must not keep a blind controller in control).
   void stalled(ClientId client, const std::string& why, double now);
+  /// The robot itself must stop (`reason`: its inputs went stale, say): a
+  /// failsafe as the deadman's, latched until the lease holder re-arms.
+  /// Nothing while the failsafe is latched already.
+  void robotFault(const std::string& reason, double now);
   /// `client`, not authenticated, took too long to say HELLO: it gets
   /// ERROR `reason` and is closed (takeClosing).
   void closeUnauthenticated(ClientId client, const std::string& reason);

@@ -409,6 +409,7 @@ void RobotServer::schedule() {
 void RobotServer::onTimer() {
   const double t = now();
   if (emulating_) deliverDue();
+  if (const std::string fault = robot_.fault(); !fault.empty()) link_.robotFault(fault, t);
   link_.tick(t);
   // Connections that never said HELLO are closed: they would hold a slot
   // (and a descriptor) for nothing.

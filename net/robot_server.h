@@ -91,6 +91,10 @@ class RobotPort {
   /// Stops the running sequence (its remaining commands are dropped; the
   /// link queues the stop itself). Nothing when none runs.
   virtual void abortSequence(const std::string& /*reason*/) {}
+  /// Why the robot must stop now, "" when nothing is wrong: polled every
+  /// tick; while it is not "", the failsafe fires with it (again after a
+  /// re-arm). A bridge's stale sensor input, say; the twin has none.
+  virtual std::string fault() const { return {}; }
 };
 
 struct RobotServerConfig {
