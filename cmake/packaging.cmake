@@ -49,6 +49,8 @@ add_custom_target(packaging_files ALL DEPENDS ${sp_packaged})
 # (dpkg-shlibdeps), plus Qt's platform plugins, which nothing links but the
 # console needs to open a window.
 set(CPACK_GENERATOR DEB)
+# Everything but the ROS component (ros/CMakeLists.txt): the package depends on no ROS library.
+set(CPACK_INSTALL_CMAKE_PROJECTS "${PROJECT_BINARY_DIR};${PROJECT_NAME};Unspecified;/")
 set(CPACK_PACKAGE_NAME simpartner)
 set(CPACK_PACKAGE_VENDOR "SimPartner")
 set(CPACK_PACKAGE_CONTACT "SimPartner team <simpartner@example.org>")

@@ -8,7 +8,9 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <filesystem>
 #include <cstdio>
@@ -129,6 +131,10 @@ constexpr const char* kUsage = R"(usage:
   simpartner-sim export LOG --csv DIR
       Writes one CSV per stream of a session log into DIR (samples.csv,
       laser.csv, commands.csv, events.csv), headers naming columns and units.
+  simpartner-sim export LOG --bag FILE
+      Writes the session log as a ROS bag (/odom, /joint_states, /scan, /tf,
+      /simpartner/commands, /simpartner/events; robot time), whole or not at
+      all, with simpartner-ros-export (the ROS component, docs/ros.md).
   simpartner-sim urdf FILE [--out URDF]
       Writes the robot of FILE (a robot file, or a world's first robot) as
       URDF for ROS tools (RViz, check_urdf): links with the twin's inertia,
@@ -483,19 +489,37 @@ int resim(const std::vector<std::string>& args) {
   return 0;
 }
 
-int exportLog(const std::vector<std::string>& args) {
-  std::string log, dir;
+int exportLog(const std::vector<std::string>& args, const char* argv0) {
+  std::string log, dir, bag;
   for (size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--csv" && i + 1 < args.size()) dir = args[++i];
+    else if (args[i] == "--bag" && i + 1 < args.size()) bag = args[++i];
     else if (log.empty() && !args[i].empty() && args[i][0] != '-') log = args[i];
     else {
       std::cerr << "<command line>: error: unknown or incomplete option '" << args[i] << "'\n" << kUsage;
       return 2;
     }
   }
-  if (log.empty() || dir.empty()) {
-    std::cerr << "<command line>: error: export needs LOG and --csv DIR\n";
+  if (log.empty() || dir.empty() == bag.empty()) {
+    std::cerr << "<command line>: error: export needs LOG and one of --csv DIR, --bag FILE\n";
     return 2;
+  }
+  if (!bag.empty()) {
+    // ROS bags come from the ROS component (ros/), built only with ROS's
+    // packages: its exporter sits beside this program, which links no ROS.
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+    const fs::path exporter = (ec ? fs::path(argv0) : self).parent_path() / "simpartner-ros-export";
+    if (!fs::exists(exporter)) {
+      std::cerr << "error: --bag needs the ROS component (" << exporter.string()
+                << " is missing): install Debian's ROS 1 packages (scripts/install-deps.sh) and build again\n";
+      return 1;
+    }
+    const std::string path = exporter.string();
+    execl(path.c_str(), path.c_str(), log.c_str(), "--bag", bag.c_str(), static_cast<char*>(nullptr));
+    std::cerr << "error: cannot run " << path << ": " << std::strerror(errno) << "\n";
+    return 1;
   }
   std::string error;
   std::vector<std::string> written;
@@ -800,7 +824,7 @@ int main(int argc, char** argv) {
   if (cmd == "validate") return validate(args);
   if (cmd == "resim") return resim(args);
   if (cmd == "rehearse") return rehearseCommand(args);
-  if (cmd == "export") return exportLog(args);
+  if (cmd == "export") return exportLog(args, argv[0]);
   if (cmd == "calibrate") return calibrate(args);
   if (cmd == "urdf") return urdfCommand(args);
   if (cmd == "sweep") return sweepCommand(args, argv[0]);

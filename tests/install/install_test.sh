@@ -108,5 +108,9 @@ for f in ./usr/share/applications/simpartner.desktop ./usr/share/icons/hicolor/2
   grep -q " $f\$" "$tmp/contents" || fail "the .deb lacks $f"
 done
 dpkg-deb --field "$deb" Depends | grep -q "libode8" || fail "the .deb does not depend on ODE's package"
+# The ROS component stays out of it: the console's package needs no ROS.
+if grep -q "simpartner-ros-" "$tmp/contents" || dpkg-deb --field "$deb" Depends | grep -q "libros"; then
+  fail "the .deb holds the ROS component or depends on ROS"
+fi
 lintian --fail-on error "$deb" > "$tmp/lintian.log" 2>&1 || { cat "$tmp/lintian.log"; fail "lintian reports errors"; }
 pass "the .deb: desktop entry, icon, programs, data; depends on $(dpkg-deb --field "$deb" Depends | tr ',' '\n' | wc -l) packages; lintian: no error"
