@@ -6,6 +6,7 @@
 
 #include <pthread.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <asio.hpp>
 
@@ -18,6 +19,7 @@
 #include <thread>
 
 #include "app/bridge/topic_robot.h"
+#include "app/robot/line_writer.h"
 #include "app/log/session_recorder.h"
 #include "net/auth.h"
 #include "net/robot_server.h"
@@ -172,9 +174,12 @@ int main(int argc, char** argv) {
   server.link.leaseConfirm = params->linkLeaseConfirm;
   server.maxConnections = static_cast<size_t>(params->linkMaxConnections);
   server.helloTimeout = params->linkHelloTimeout;
-  server.log = [](const std::string& line) { std::cerr << "simpartner-ros-bridge: " << line << std::endl; };
-  server.events = [](const std::string& kind, const std::string& text) {
-    std::cerr << "simpartner-ros-bridge: " << (kind == "link" ? text : kind + ": " + text) << std::endl;
+  // The link's lines go through their own thread: the link thread (which
+  // runs the deadman) never waits for a stderr nobody reads.
+  sp::LineWriter lines(STDERR_FILENO, "simpartner-ros-bridge: ");
+  server.log = [&lines](const std::string& line) { lines.write(line); };
+  server.events = [&lines](const std::string& kind, const std::string& text) {
+    lines.write(kind == "link" ? text : kind + ": " + text);
   };
   asio::io_context io;
   sp::net::RobotServer linkServer(io, server, robot);
