@@ -34,6 +34,7 @@ struct RawClient {
 
   explicit RawClient(uint16_t port) {
     socket.connect({asio::ip::make_address("127.0.0.1"), port});
+    socket.set_option(asio::ip::tcp::no_delay(true));  // as RobotClient: small frames leave at once
     socket.non_blocking(true);
   }
   void send(const Message& m) {
