@@ -206,14 +206,7 @@ class TestTopicRobot : public QObject {
 
     // Stale odometry: the failsafe with its reason. The controller keeps
     // its lease alive meanwhile, so the deadman stays quiet.
-    const auto nextFailsafe = [&holder](double timeout) -> std::optional<EventMsg> {
-      const auto t0 = Clock::now();
-      while (seconds(t0) < timeout) {
-        holder.send(LeaseKeepaliveMsg{});
-        if (auto e = holder.waitFor<EventMsg>(0.05); e && e->kind == EventKind::Failsafe) return e;
-      }
-      return std::nullopt;
-    };
+    const auto nextFailsafe = [&holder](double timeout) { return holder.failsafeWhileKeepingAlive(timeout, 0.05); };
     holder.send(RearmMsg{});
     QVERIFY(!nextFailsafe(0.3));  // odometry flows: nothing
     odometryFlows = false;

@@ -82,6 +82,17 @@ struct RawClient {
     }
     return std::nullopt;
   }
+  /// The next failsafe EVENT within `timeout` seconds while keeping the
+  /// lease alive every `period` seconds (so the deadman stays quiet), or
+  /// nullopt; other messages are skipped.
+  std::optional<EventMsg> failsafeWhileKeepingAlive(double timeout, double period) {
+    const auto t0 = Clock::now();
+    while (seconds(t0) < timeout) {
+      send(LeaseKeepaliveMsg{});
+      if (auto e = waitFor<EventMsg>(period); e && e->kind == EventKind::Failsafe) return e;
+    }
+    return std::nullopt;
+  }
   /// The HELLO that answers this connection's CHALLENGE with a proof of `token`.
   HelloMsg provingHello(Role role, const std::string& name, const std::string& token = kToken) {
     const auto challenge = waitFor<ChallengeMsg>(3.0);

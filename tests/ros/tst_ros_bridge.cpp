@@ -229,14 +229,7 @@ class TestRosBridge : public QObject {
     client.hello(Role::Control, "operator2");
     client.send(LeaseAcquireMsg{});
     client.send(RearmMsg{});
-    const auto nextFailsafe = [&client](double timeout) -> std::optional<EventMsg> {
-      const auto t0 = Clock::now();
-      while (seconds(t0) < timeout) {
-        client.send(LeaseKeepaliveMsg{});
-        if (auto e = client.waitFor<EventMsg>(0.04); e && e->kind == EventKind::Failsafe) return e;
-      }
-      return std::nullopt;
-    };
+    const auto nextFailsafe = [&client](double timeout) { return client.failsafeWhileKeepingAlive(timeout, 0.04); };
     // Taking the lease tells the latch left by the last test; then, the
     // control: odometry flows, nothing fires.
     nextFailsafe(0.3);
