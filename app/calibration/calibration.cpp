@@ -105,7 +105,14 @@ namespace {
 
 constexpr int kMass = static_cast<int>(CalParam::Mass);
 constexpr int kFitted = kMass;  // the parameters fitted through the twin: all but the mass
-constexpr double kUnobserved = 0.25;  // sigma above this share of a parameter's scale: unobserved
+// A parameter is unobserved when its deviation is above this share of its
+// scale. The first step of a fit takes only those pinned to kFirstStep:
+// from the start values the residuals are far from linear, and a step in a
+// weakly pinned direction (the tyres' front-rear split) can stall the rest;
+// later steps, near the fit, take all within kUnobserved, so that windows
+// each too short to pin the split alone pin it fused (docs/performance.md).
+constexpr double kUnobserved = 0.5;
+constexpr double kFirstStep = 0.25;
 
 /// A duration for the operator: one decimal ("4.0", not "4.000000000000001").
 std::string tenths(double seconds) {
@@ -404,13 +411,13 @@ Normal normalEquations(const std::vector<std::vector<double>>& jac, const std::v
 // data cannot pin are dropped from `on` one at a time, worst first.
 // Observability is judged on the residuals' scales as given (far from the
 // fit they are large for want of fitting, not noise): a parameter is
-// observed when its deviation is at most kUnobserved of its scale. The
+// observed when its deviation is at most `threshold` of its scale. The
 // deviations reported grow by the residuals' own scatter and by
 // `correlated`, the residuals that move together (a segment's checkpoints
 // share its anchor's error: they count as one), so that fusing fits
 // (fuse()) weighs each window for what it is worth.
 std::vector<int> observable(const std::vector<std::vector<double>>& jac, const std::vector<double>& r,
-                            std::vector<int> on, CalValues& sigma, double correlated) {
+                            std::vector<int> on, CalValues& sigma, double correlated, double threshold) {
   const double dof = std::max<double>(1, static_cast<double>(r.size()) - static_cast<double>(on.size()));
   const double inflate = correlated * std::max(1.0, meanSquare(r) * static_cast<double>(r.size()) / dof);
   while (!on.empty()) {
@@ -427,7 +434,7 @@ std::vector<int> observable(const std::vector<std::vector<double>>& jac, const s
     size_t worst = 0;
     for (size_t k = 0; k < on.size(); ++k)
       if (singular ? n.h[k][k] < n.h[worst][worst] : var[k] > var[worst]) worst = k;
-    if (!singular && std::sqrt(var[worst]) <= kUnobserved) {
+    if (!singular && std::sqrt(var[worst]) <= threshold) {
       for (size_t k = 0; k < on.size(); ++k)
         sigma[static_cast<size_t>(on[k])] = std::sqrt(var[k] * inflate) * calParams()[static_cast<size_t>(on[k])].scale;
       return on;
@@ -588,6 +595,7 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   double lambda = 1e-3;
   std::vector<std::vector<double>> jac(kFitted);
   std::vector<int> on, everSmooth;  // everSmooth: moved the twin more than its noise at some iteration
+  std::vector<int> fitted;          // in some step's parameters: the fit sought their best values
   const auto elapsedMs = [&] {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - began).count();
   };
@@ -632,9 +640,11 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       }
     }
     CalValues sigma{};
-    on = observable(jac, *r, smooth, sigma, 1);
+    on = observable(jac, *r, smooth, sigma, 1, it == 0 ? kFirstStep : kUnobserved);
     for (int p : free) fit.sigma[static_cast<size_t>(p)] = sigma[static_cast<size_t>(p)];
     if (on.empty()) break;
+    for (int p : on)
+      if (std::find(fitted.begin(), fitted.end(), p) == fitted.end()) fitted.push_back(p);
     const Normal n = normalEquations(jac, *r, on);
     bool stepped = false;
     for (int attempt = 0; attempt < 4 && !stepped; ++attempt) {
@@ -677,13 +687,17 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   std::sort(everSmooth.begin(), everSmooth.end());
   if (!everSmooth.empty()) {
     CalValues sigma{};
-    on = observable(jac, *r, everSmooth, sigma, std::max(1.0, o.horizon / o.checkpoint));
+    on = observable(jac, *r, everSmooth, sigma, std::max(1.0, o.horizon / o.checkpoint), kUnobserved);
     for (int p : free) fit.sigma[static_cast<size_t>(p)] = sigma[static_cast<size_t>(p)];
   }
   for (int p : on) fit.observed[static_cast<size_t>(p)] = true;
   for (int p = 0; p < kFitted; ++p) {
     const size_t i = static_cast<size_t>(p);
-    if (i != kGain && std::find(on.begin(), on.end(), p) == on.end()) fit.observed[i] = false;
+    // Observed is pinned by the data and fitted to it: one pinned only at
+    // the last check, never in a step, still has its start value.
+    if (i != kGain && (std::find(on.begin(), on.end(), p) == on.end() ||
+                       std::find(fitted.begin(), fitted.end(), p) == fitted.end()))
+      fit.observed[i] = false;
     if (!fit.observed[i]) {
       fit.sigma[i] = 0;
       v[i] = start[i];  // unobserved: left alone

@@ -28,9 +28,11 @@
 //
 // Observability. From J'J, each parameter's standard deviation (inflated by
 // the residuals' own scatter when they exceed their scales); a parameter
-// whose deviation exceeds a quarter of its prior range (CalParamInfo::
-// scale) is unobserved: it is taken out of the fit, keeps its previous
-// value and is reported as such (friction while driving straight on grip).
+// whose deviation exceeds half its prior range (CalParamInfo::scale) is
+// unobserved: it is taken out of the fit, keeps its previous value and is
+// reported as such (friction while driving straight on grip). A fit's first
+// step takes only those within a quarter: far from the fit, a step along a
+// weakly pinned direction (the tyres' front-rear split) stalls the rest.
 //
 // Refusals: a window without enough driving, a twin that diverges, a fit
 // that lands outside a parameter's physical bounds: the previous values are

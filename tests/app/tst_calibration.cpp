@@ -11,6 +11,10 @@
 //     0.3 % from a 10 s drive when the fit is asked for it alone, within
 //     0.5 % with every parameter free, the others then within three
 //     deviations of the files' (they are not there to be found);
+//   - a front-rear split of the tyres (+2.5 %) that no single 8 s window
+//     pins is applied by the fused windows of 20 s of driving, within 1
+//     point; on a robot that is its twin it is within two deviations of
+//     the files' (control);
 //   - a straight-line drive on grip leaves friction unobserved (and its
 //     value the files'); the same robot turning observes it is not claimed;
 //   - a fit the physics cannot follow (telemetry of a robot whose wheels
@@ -69,6 +73,14 @@ const char* const kDriveAndTurn =
     "3.5 drive 0.6 15\n"
     "6.5 drive 0.6 -15\n";
 const char* const kStraight = "0.5 drive 0.6 0\n";
+const char* const kDriveAndTurnLong =
+    "0.5 drive 0.6 0\n"
+    "3.5 drive 0.6 15\n"
+    "6.5 drive 0.7 -15\n"
+    "9.5 drive 0.5 0\n"
+    "12.5 drive 0.6 12\n"
+    "15.5 drive 0.7 -12\n"
+    "18.5 drive 0.6 0\n";
 
 Perturbation none(const WorldModel& world) {
   Perturbation p;
@@ -116,6 +128,53 @@ class TestCalibration : public QObject {
     for (size_t i = 1; i < kCalParams; ++i)
       if (all.observed[i])
         QVERIFY2(std::abs(all.value[i] - calParams()[i].files) <= 3 * all.sigma[i] + 0.005, calParams()[i].key);
+  }
+
+  // The tyres' front-rear split, which no 8 s window pins to a quarter of
+  // its range, is pinned by the windows fused as the live fitter fuses them
+  // (8 s every 3 s over 20 s of driving and turning): hidden +2.5 % (front
+  // tyres 1.25 % larger, rear 1.25 % smaller), the fused split applied and
+  // within 1 point of it (with a quarter of the range as the limit, as
+  // before, it was never fitted). Control: on a robot that is its twin the
+  // fused split is within two of its deviations of the files' (20 s pin it
+  // to about +-1.2 %: a deviation's worth of noise may still be applied,
+  // which the benchmark's control measures on the ghost).
+  void frontRearSplitPinnedByFusedWindows_data() {
+    QTest::addColumn<double>("split");
+    QTest::newRow("hidden split +2.5 %") << 0.025;
+    QTest::newRow("control: none") << 0.0;
+  }
+  void frontRearSplitPinnedByFusedWindows() {
+    QFETCH(double, split);
+    const WorldModel world = loadWorldFile("flat.world.xml");
+    Perturbation p = none(world);
+    p.wheelRadius = {1 + split / 2, 1 + split / 2, 1 - split / 2, 1 - split / 2};  // FL FR RL RR
+    const RecordedDrive d = recordDrive(world, SimParams{}, p, commands(world, kDriveAndTurnLong), 20.0);
+    QVERIFY2(d.problem.empty(), d.problem.c_str());
+    CalEstimate estimate = filesEstimate();
+    CalibrationOptions o;
+    o.window = 8;
+    o.iterations = 2;
+    o.threads = 2;
+    for (double end = 8; end <= 20 + 1e-9; end += 3) {
+      std::vector<RobotFrame> upTo;
+      for (const RobotFrame& f : d.frames)
+        if (f.time <= end) upTo.push_back(f);
+      const CalibrationFit fit = fitCalibration(world, ghostProfile(), upTo, d.commands, estimate.value, o);
+      print(fit);
+      QVERIFY2(fit.refused.empty(), fit.refused.c_str());
+      estimate = fuse(estimate, fit, o.window / 3);
+    }
+    constexpr size_t kSplit = static_cast<size_t>(CalParam::WheelRadiusSplit);
+    const double applied = significantValues(estimate)[kSplit];
+    qInfo("fused split %.4f +- %.4f, applied %.4f (hidden %.4f)", estimate.value[kSplit], estimate.sigma[kSplit], applied,
+          split);
+    if (split != 0) {
+      QVERIFY(estimate.observed[kSplit]);
+      QVERIFY(std::abs(applied - split) <= 0.01);
+    } else {
+      QVERIFY(std::abs(estimate.value[kSplit]) <= 2 * estimate.sigma[kSplit]);
+    }
   }
 
   void straightDriveLeavesFrictionUnobserved() {
