@@ -26,7 +26,7 @@ namespace sp {
 // sizes (x86-64, GCC) change with it, and the build stops here.
 static_assert(sizeof(BodyState) == 13 * 8, "list the new BodyState field in visitState() below");
 static_assert(sizeof(ActuatorState) == 5 * 8, "list the new ActuatorState field in visitState() below");
-static_assert(sizeof(RobotControlState) == 136 && sizeof(GaitState) == 16,
+static_assert(sizeof(RobotControlState) == 160 && sizeof(GaitState) == 16,
               "list the new RobotControlState field in visitState() below");
 static_assert(sizeof(SensorState) == 8 + 3 * 24 + 8 + sizeof(SensorSample),
               "list the new SensorState field in visitState() below");
@@ -74,7 +74,7 @@ void visitState(R& rc, V&& v) {
   v(rc.driveYawRate, kHashed);
   v(rc.gaitActive, kHashed);
   v(rc.gait, kHashed);
-  v.resistance(rc.resistance, rc.resistanceShare);
+  v.resistance(rc.resistance, rc.resistanceShare, rc.resistanceHold);
 }
 
 /// One sensor's sampling state and its latest reading.

@@ -130,7 +130,6 @@ bool World::step() {
     sampleSensors();
   }
   dJointGroupEmpty(m.contacts);
-  dJointGroupEmpty(m.resistanceJoints);
   tOdeMessages = nullptr;
   return true;
 }

@@ -52,6 +52,10 @@ struct RobotControlState {
   /// and the share of it a rolling-only surface leaves (1 when sliding
   /// wheels meet it too). State: it carries a step's forces into the next.
   std::vector<double> resistance, resistanceShare;
+  /// [m] per link: how far the snow holding a wheel has given way along
+  /// its travel since the wheel last slipped through it (the resistance's
+  /// hold, World::applyMotionResistance).
+  std::vector<double> resistanceHold;
   friend bool operator==(const RobotControlState&, const RobotControlState&) = default;
 };
 

@@ -152,7 +152,6 @@ World::~World() {
   if (!m.world) return;
   ensureOdeThread();
   dJointGroupDestroy(m.contacts);
-  if (m.resistanceJoints) dJointGroupDestroy(m.resistanceJoints);
   dSpaceDestroy(m.space);  // destroys the geoms too (cleanup mode on)
   dGeomDestroy(m.ray);
   dGeomDestroy(m.tyreProxy);
@@ -176,7 +175,6 @@ bool World::build(Diagnostics& diag) {
   m.space = dHashSpaceCreate(nullptr);
   dSpaceSetCleanup(m.space, 1);
   m.contacts = dJointGroupCreate(0);
-  m.resistanceJoints = dJointGroupCreate(0);
   m.randState = static_cast<unsigned long>(params_.seed & 0xffffffffu);
   m.random.reseed(params_.seed);
   m.ray = dCreateRay(nullptr, 1.0);
@@ -370,6 +368,7 @@ bool World::build(Diagnostics& diag) {
     for (const ActuatorSpec& a : robot.actuators) rt.control.actuators.push_back(initialActuatorState(a));
     rt.control.resistance.assign(robot.links.size(), 0.0);
     rt.control.resistanceShare.assign(robot.links.size(), 1.0);
+    rt.control.resistanceHold.assign(robot.links.size(), 0.0);
     rt.jointAbove.assign(robot.links.size(), -1);
     for (size_t ji = 0; ji < robot.joints.size(); ++ji)
       rt.jointAbove[static_cast<size_t>(robot.joints[ji].child)] = static_cast<int>(ji);

@@ -111,7 +111,6 @@ struct World::Impl {
   dWorldID world = nullptr;
   dSpaceID space = nullptr;
   dJointGroupID contacts = nullptr;
-  dJointGroupID resistanceJoints = nullptr;  // this step's motion resistance motors, emptied with the contacts
   dThreadingImplementationID threading = nullptr;
   unsigned long randState = 0;
   bool perThreadRandom = true;

@@ -84,10 +84,12 @@ std::string World::restore(const Snapshot& s) {
     // Snapshots from before motion resistance (or of a welded twin) carry
     // none: the next step's contacts set it.
     const size_t links = m.robots[r].bodies.size();
-    if (m.robots[r].control.resistance.size() != links || m.robots[r].control.resistanceShare.size() != links) {
-      m.robots[r].control.resistance.assign(links, 0.0);
-      m.robots[r].control.resistanceShare.assign(links, 1.0);
+    RobotControlState& rc = m.robots[r].control;
+    if (rc.resistance.size() != links || rc.resistanceShare.size() != links) {
+      rc.resistance.assign(links, 0.0);
+      rc.resistanceShare.assign(links, 1.0);
     }
+    if (rc.resistanceHold.size() != links) rc.resistanceHold.assign(links, 0.0);
     m.robots[r].sensors = s.sensors[r];
     if (scale != 1.0)
       for (SensorState& st : m.robots[r].sensors)
@@ -169,11 +171,13 @@ struct StateHasher {
   }
   // Motion resistance only where a surface has it: other runs keep the
   // hashes they always had.
-  void resistance(const std::vector<double>& forces, const std::vector<double>& shares) {
+  void resistance(const std::vector<double>& forces, const std::vector<double>& shares,
+                  const std::vector<double>& holds) {
     if (std::none_of(forces.begin(), forces.end(), [](double f) { return f != 0; })) return;
     for (size_t l = 0; l < forces.size(); ++l) {
       h.value(forces[l]);
       h.value(shares[l]);
+      h.value(l < holds.size() ? holds[l] : 0.0);
     }
   }
 };

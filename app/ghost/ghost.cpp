@@ -102,6 +102,7 @@ void Ghost::carryControl(const World& from, const Twin& fromTwin, World& to, con
   now.actuators = fresh.actuators;
   now.resistance = fresh.resistance;  // per link: the two twins' links differ
   now.resistanceShare = fresh.resistanceShare;
+  now.resistanceHold = fresh.resistanceHold;
   for (size_t i = 0; i < b.actuators.size(); ++i) {
     const ActuatorSpec& spec = b.actuators[i];
     const auto same = std::find_if(a.actuators.begin(), a.actuators.end(),

@@ -271,11 +271,13 @@ struct Encode {
     w.u64(items.size());
     for (const T& item : items) visitState(item, *this);
   }
-  void resistance(const std::vector<double>& forces, const std::vector<double>& shares) {
+  void resistance(const std::vector<double>& forces, const std::vector<double>& shares,
+                  const std::vector<double>& holds) {
     w.u64(forces.size());
     for (size_t l = 0; l < forces.size(); ++l) {
       w.f64(forces[l]);
       w.f64(l < shares.size() ? shares[l] : 1.0);
+      w.f64(l < holds.size() ? holds[l] : 0.0);
     }
   }
 };
@@ -294,7 +296,7 @@ size_t minEncodedSize() {
   return size;
 }
 
-// Reads what Encode wrote; `version` is the snapshot's (1 has no motion resistance).
+// Reads what Encode wrote; `version` is the snapshot's (1 has no motion resistance, 2 no hold).
 struct Decode {
   Reader& r;
   uint32_t version;
@@ -331,13 +333,15 @@ struct Decode {
     items.resize(r.count(minEncodedSize<T>()));
     for (T& item : items) visitState(item, *this);
   }
-  void resistance(std::vector<double>& forces, std::vector<double>& shares) {
+  void resistance(std::vector<double>& forces, std::vector<double>& shares, std::vector<double>& holds) {
     if (version < 2) return;
-    forces.resize(r.count(16));
+    forces.resize(r.count(version < 3 ? 16 : 24));
     shares.resize(forces.size());
+    holds.assign(forces.size(), 0.0);  // version 2: a hold not yet given way
     for (size_t l = 0; l < forces.size(); ++l) {
       forces[l] = r.f64();
       shares[l] = r.f64();
+      if (version >= 3) holds[l] = r.f64();
     }
   }
 };
@@ -387,7 +391,7 @@ std::optional<Snapshot> decodeSnapshot(const std::vector<uint8_t>& data, std::st
   try {
     for (int i = 0; i < 4; ++i) r.u8();
     uint32_t version = r.u32();
-    if (version != kSnapshotCodecVersion && version != 1)
+    if (version < 1 || version > kSnapshotCodecVersion)
       return fail("snapshot format version " + std::to_string(version) + " is not supported (expected " +
                   std::to_string(kSnapshotCodecVersion) + ")");
     Snapshot s;

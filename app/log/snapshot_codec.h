@@ -16,7 +16,7 @@
 
 namespace sp {
 
-inline constexpr uint32_t kSnapshotCodecVersion = 2;  // 2: motion resistance per link (1 is still read)
+inline constexpr uint32_t kSnapshotCodecVersion = 3;  // 2: motion resistance per link; 3: its hold (1 and 2 are still read)
 
 /// Serializes a snapshot. Thread: any; pure function.
 std::vector<uint8_t> encodeSnapshot(const Snapshot& snapshot);

@@ -629,22 +629,32 @@ ExperimentResult slipperySurface(const ValidationOptions& o) {
   // each within a factor of 1.5, and in its order (caterpillar > rolking >
   // rolling). The slip and the ratios follow from the speeds: for the record.
   const double slip = 1 - v[0] / (1.0 * wheelRadius);
+  // Near zero a relative tolerance means nothing: the rolling speed is
+  // converged when within a tenth of the paper's figure of the reference.
+  const double rollingFloor = 0.1 * paper[0];
   for (int m = 0; m < 3; ++m) {
     r.metrics.push_back({std::string("mean speed, ") + kModeNames[m] + " (ours / paper's: " + num(v[m] / paper[m], 2) +
                              " x)",
-                         num(paper[m], 4), v[m], "m/s", "within a factor of 1.5", paperFactor(v[m], paper[m]) <= 1.5});
+                         num(paper[m], 4), v[m], "m/s", "within a factor of 1.5", paperFactor(v[m], paper[m]) <= 1.5,
+                         true, Basis::Paper, m == 0 ? rollingFloor : 0});
   }
   r.metrics.push_back({"order: caterpillar > rolking > rolling", "0.057 > 0.048 > 0.0038", v[1] > v[2] && v[2] > v[0] ? 1.0 : 0.0,
                        "", "1 (in order)", v[1] > v[2] && v[2] > v[0]});
   // Converged: the rolling speed must be the surface's, not the iterative
-  // solver's creep (with C above mu the ideal model gives zero).
+  // solver's creep (with C above mu the ideal model gives zero): within
+  // 10 % of the 200-iteration figure, or, the two near zero, within a
+  // tenth of the paper's (the resistance posed as a constraint crept at
+  // 0.0059 m/s against 0.0006: it fails this).
   SimParams converged = o.params;
   converged.iterations = 200;
   const double rolling200 = runMode(model, converged, 0, start, duration, r.title, nullptr);
   r.simSeconds += duration;
-  const double creep = v[0] > 0 ? std::abs(rolling200 / v[0] - 1) : INFINITY;
-  r.metrics.push_back({"rolling speed at 200 solver iterations (" + num(rolling200, 4) + " m/s) against the default's: change",
-                       "", creep * 100, "%", "<= 10 % (not the solver's creep)", creep <= 0.1, true, Basis::Solver});
+  const double creep = std::abs(v[0] - rolling200);
+  const bool settled = creep <= std::max(0.1 * std::abs(rolling200), rollingFloor);
+  r.metrics.push_back({"rolling speed at 200 solver iterations (" + num(rolling200, 5) +
+                           " m/s) against the default's (" + num(v[0], 5) + " m/s): difference",
+                       "", creep, "m/s", "<= 10 % of it or <= " + num(rollingFloor, 5) + " m/s (not the solver's creep)",
+                       settled, true, Basis::Solver});
   r.metrics.push_back({"for the record: rolling at 1 rad/s, slip (1 - speed / wheel surface speed)", "98 %", slip * 100,
                        "%", "", false, false});
   r.metrics.push_back({"for the record: caterpillar against rolling", num(paper[1] / paper[0], 0) + " x", v[1] / v[0],
@@ -689,25 +699,27 @@ ExperimentResult slipperySurface(const ValidationOptions& o) {
   r.plots.insert(r.plots.begin(), {"slippery_distance", modes.progress});
   const double traction = 0.025 * model.robots[0].model.totalMass() * 9.81;
   r.discussion =
-      "With Coulomb friction mu = 0.025 alone the four tyres can push with up to " + num(traction, 0) +
-      " N and nothing resists rolling, so the robot rolls at the wheels' surface speed (0.2 m/s at 1 rad/s) "
-      "without slipping; the paper's 0.0038 m/s means 98 % slip. Snow resists a tyre moving through it: a "
-      "motion resistance C N against the wheel's travel; the cited report (CRREL TR-01-16) gives C 0.02-0.03 "
-      "only for very light snow with 10-17 cm sinkage, more in deeper snow, and no real surface pairs ice's "
-      "friction with that resistance: this world is a stand-in, not a measured surface. C = " + num(c, 2) + " was taken from the literature before the run, not fitted "
-      "to the paper, and set as a surface property of the world file (contact motion_resistance: a force of at "
-      "most C N on each wheel's hub against its travel, which a braced wheel sliding meets as well, as friction "
-      "mu + C). It exceeds what the tyres can push "
-      "with (mu = 0.025), so the wheels spin: rolling slips " + num(slip * 100, 1) + " % (" + num(v[0], 4) +
-      " m/s). The gaits move by bracing wheels and pushing with the legs: caterpillar " + num(v[1], 3) +
-      " m/s, rolking " + num(v[2], 3) + " m/s, the paper's ordering; their speeds follow from the gait timing "
-      "and hip swing, which the paper does not give (ours are estimates in config/defaults.params). Judged "
-      "against the paper's own speeds: rolling " + num(v[0] / paper[0], 2) + " x, caterpillar " +
-      num(v[1] / paper[1], 2) + " x, rolking " + num(v[2] / paper[2], 2) + " x the paper's. At 200 solver "
-      "iterations rolling runs at " + num(rolling200, 4) + " m/s (" + num(creep * 100, 0) + " % from the "
-      "default's): where C exceeds mu the ideal model does not roll at all, and what rolls is the iterative "
-      "solver's creep, so the rolling figure measures the solver, not the surface, until the wheel-ground "
-      "model is replaced (issue 29)." +
+      "Which surface: the paper gives only mu = 0.025, an ice-like friction (workpartner-facts.md). On ice "
+      "alone (Coulomb friction, nothing resisting the wheels' travel) the four tyres push with up to " +
+      num(traction, 0) + " N and the robot rolls at the wheels' surface speed, 0.2 m/s at 1 rad/s (the "
+      "control in tst_validation: 50 x the paper's), faster than either gait: the paper's order cannot come "
+      "from ice. It comes from snow over the ice: the tyres reach the ice (mu 0.025) and push snow "
+      "ahead of them, a motion resistance C N against each hub's travel (CRREL TR-01-16: C 0.02-0.03 for very "
+      "light snow with 10-17 cm sinkage; C = " + num(c, 2) + " was taken from it before the run, not fitted). "
+      "A braced wheel sliding meets it too, as friction mu + C. Below C N the snow holds the wheel (it gives way "
+      "by at most 0.5 mm, a reset-integrator friction model; docs/architecture.md), so a robot that pushes with "
+      "less stands still. That is what plain rolling does: C exceeds mu, the wheels spin (" +
+      num(slip * 100, 1) + " % slip) and the robot stands, at " + num(v[0], 5) + " m/s (" +
+      num(rolling200, 5) + " m/s at 200 iterations: converged, not the solver's creep, which set it to "
+      "0.0059 m/s before the hold). The paper's 0.0038 m/s (98 % slip) is therefore not reproduced: with the "
+      "resistance above the traction the converged model does not move, and below it the robot rolls off at "
+      "nearly full speed (C 0.02: the sensitivity below); no surface between gives 98 % slip without being fitted "
+      "to it. The paper's figure is most likely its own solver's creep, which ours showed at the same order "
+      "(0.0059 m/s at 40 iterations). The gaits move by bracing wheels and pushing with the legs: caterpillar " +
+      num(v[1], 3) + " m/s, rolking " + num(v[2], 3) + " m/s, the paper's ordering; their speeds follow from the "
+      "gait timing and hip swing, which the paper does not give (ours are estimates in config/defaults.params). "
+      "Judged against the paper's own speeds: rolling " + num(v[0] / paper[0], 2) + " x, caterpillar " +
+      num(v[1] / paper[1], 2) + " x, rolking " + num(v[2] / paper[2], 2) + " x the paper's." +
       sensitivity;
   return r;
 }

@@ -201,16 +201,16 @@ class TestSessionLog : public QObject {
     std::vector<uint8_t> cut(bytes.begin(), bytes.end() - 3);
     QVERIFY(!decodeSnapshot(cut, &error));
     QCOMPARE(error, std::string("truncated snapshot data"));
-    std::vector<uint8_t> v3 = bytes;
-    v3[4] = 3;
-    QVERIFY(!decodeSnapshot(v3, &error));
-    QCOMPARE(error, std::string("snapshot format version 3 is not supported (expected 2)"));
+    std::vector<uint8_t> v4 = bytes;
+    v4[4] = 4;
+    QVERIFY(!decodeSnapshot(v4, &error));
+    QCOMPARE(error, std::string("snapshot format version 4 is not supported (expected 3)"));
   }
 
   // Logs written before motion resistance (snapshot format version 1: no
-  // resistance per link) still restore and re-simulate exactly: the v1
-  // bytes are the v2 ones without that block.
-  void version1StillRead() {
+  // resistance per link) or before its hold (2) still restore and
+  // re-simulate exactly: the older bytes are these without those fields.
+  void versions1And2StillRead() {
     std::unique_ptr<World> world = makeWorld("terrains/flat.world.xml");
     QVERIFY(world);
     QCOMPARE(world->submit(DriveCmd{0.3, 0}), std::string());
@@ -227,8 +227,27 @@ class TestSessionLog : public QObject {
     uint64_t count = 0;
     std::memcpy(&count, bytes.data() + block, 8);
     QCOMPARE(count, uint64_t{links});  // found the block
+    // Version 2: each link's force and share without the hold.
+    std::vector<uint8_t> v2 = bytes;
+    for (size_t l = links; l-- > 0;) {
+      const size_t hold = block + 8 + l * 24 + 16;
+      v2.erase(v2.begin() + static_cast<std::ptrdiff_t>(hold), v2.begin() + static_cast<std::ptrdiff_t>(hold + 8));
+    }
+    v2[4] = 2;
+    std::string error2;
+    std::optional<Snapshot> decoded2 = decodeSnapshot(v2, &error2);
+    QVERIFY2(decoded2, error2.c_str());
+    QCOMPARE(decoded2->robots[0].resistance, original.robots[0].resistance);
+    QCOMPARE(decoded2->robots[0].resistanceHold, std::vector<double>(links, 0.0));
+    {
+      std::unique_ptr<World> reference = makeWorld("terrains/flat.world.xml");  // `world` goes on below
+      QVERIFY(reference);
+      QCOMPARE(reference->restore(original), std::string());
+      verifyRestoresLike(*reference, *decoded2, "terrains/flat.world.xml");
+    }
+    // Version 1: no resistance block at all.
     bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(block),
-                bytes.begin() + static_cast<std::ptrdiff_t>(block + 8 + links * 16));
+                bytes.begin() + static_cast<std::ptrdiff_t>(block + 8 + links * 24));
     bytes[4] = 1;
     std::string error;
     std::optional<Snapshot> decoded = decodeSnapshot(bytes, &error);

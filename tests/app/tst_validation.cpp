@@ -211,12 +211,13 @@ class TestValidation : public QObject {
 
   // 4. On mu 0.025 with a motion resistance C = 0.03: the paper's speeds,
   // each within a factor of 1.5, in its order, and a rolling speed that is
-  // not the solver's creep (<= 10 % change at 200 iterations). Known
-  // failures today: rolling 1.8 x the paper's, and it is the creep (issue
-  // 29's wheel-ground model). Control: the same world without the
-  // resistance rolls at the wheels' surface speed, 50 x the paper's.
+  // not the solver's creep (within 10 % or a tenth of the paper's figure
+  // at 200 iterations). Known failure: rolling, which stands (converged)
+  // where the paper's robot crept at 0.0038 m/s. Control: the same world
+  // without the resistance rolls at the wheels' surface speed, 50 x the
+  // paper's.
   void slipperySurface() {
-    verifyVerdicts(sp::slipperySurface(quick()), {0, 4});
+    verifyVerdicts(sp::slipperySurface(quick()), {0});
     ValidationOptions o = quick();
     o.sourceDir = makeVariant(o.sourceDir, "terrains/ice.world.xml", {{"motion_resistance=\"0.03\"", ""}});
     QVERIFY(!o.sourceDir.empty());

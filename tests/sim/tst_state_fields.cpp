@@ -19,7 +19,7 @@ struct Count {
     (H ? hashed : unhashed) += 1;
   }
   // The motion resistance pair is a field of its own kind (hashed where non-zero).
-  void resistance(const std::vector<double>&, const std::vector<double>&) { ++pairs; }
+  void resistance(const std::vector<double>&, const std::vector<double>&, const std::vector<double>&) { ++pairs; }
 };
 
 std::unique_ptr<World> drivingWorld() {
