@@ -207,12 +207,16 @@ ExperimentResult circularDrive(const ValidationOptions& o) {
   r.number = 1;
   r.title = "Circular drive";
   const WorldModel model = loadModel(o, "terrains/flat.world.xml");
-  const double speed = 0.5, settle = 3, record = o.quick ? 8 : 20;
+  // The quick suite records as long as the full one: over 8 s the arc at
+  // 10 deg is 36 degrees of the circle and the fitted radius moved the
+  // commanded-angle verdict (-1.1 % against -0.31 % over 20 s), and the
+  // quick suite must give the full one's verdicts (issue 29). 3 s of wall time.
+  const double speed = 0.5, settle = 3, record = 20;
   r.conditions = "terrains/flat.world.xml (rubber on ground, mu 1.0); drive " + num(speed, 1) +
                  " m/s at the hinge; " + num(settle, 0) + " s to settle, then the hinge point's path over " +
                  num(record, 0) + " s is fitted with a circle";
   PlotSpec paths{"Circular drive: path of the articulation hinge", "x [m]", "y [m]", {}, 900, 900, {}, {}};
-  // The quick suite checks every angle the full one does, over a shorter record.
+  // The quick suite checks every angle the full one does.
   const std::vector<double> angles = {10, 20, 30};
   double worst = 0;
   for (double gammaDeg : angles) {
