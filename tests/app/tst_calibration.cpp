@@ -177,6 +177,21 @@ class TestCalibration : public QObject {
     }
   }
 
+  // What the twins get of a fused estimate: a value more than half a
+  // deviation from the files' (kSignificance), else the files' own.
+  void significantValuesGateOnHalfADeviation() {
+    constexpr size_t kRadius = static_cast<size_t>(CalParam::WheelRadius);
+    CalEstimate e = filesEstimate();
+    e.observed[kRadius] = true;
+    e.sigma[kRadius] = 0.004;
+    e.value[kRadius] = 1.0019;  // 0.475 deviations
+    QCOMPARE(significantValues(e)[kRadius], 1.0);
+    e.value[kRadius] = 1.0021;  // 0.525
+    QCOMPARE(significantValues(e)[kRadius], 1.0021);
+    e.value[kRadius] = 0.9979;
+    QCOMPARE(significantValues(e)[kRadius], 0.9979);
+  }
+
   void straightDriveLeavesFrictionUnobserved() {
     const WorldModel world = loadWorldFile("flat.world.xml");
     Perturbation p = none(world);
