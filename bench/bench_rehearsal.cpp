@@ -7,10 +7,12 @@
 // robustness samples of the demo sequence (goal: <= 3 s) against the same
 // 16 in the full profile run to their end. Prints figures, asserts nothing.
 //
-//   build/bench/bench_rehearsal [--quick] [--profile-only] [--fast STEP ITERATIONS]
+//   build/bench/bench_rehearsal [--quick] [--profile-only] [--margins] [--fast STEP ITERATIONS]
 //
 // --profile-only: only the fast-profile comparison and robustness; --fast:
-// another fast profile than the defaults' (rehearsal.fast_*) to compare.
+// another fast profile than the defaults' (rehearsal.fast_*) to compare (a
+// finer one too: 0.0005 60 measures the full profile's own step error);
+// --margins: each rule's closest approach in both profiles.
 
 #include <algorithm>
 #include <atomic>
@@ -94,16 +96,17 @@ double median(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false, profileOnly = false;
+  bool quick = false, profileOnly = false, margins = false;
   SimParams defaults;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) quick = true;
     else if (std::strcmp(argv[i], "--profile-only") == 0) profileOnly = true;
+    else if (std::strcmp(argv[i], "--margins") == 0) margins = true;
     else if (std::strcmp(argv[i], "--fast") == 0 && i + 2 < argc) {
       defaults.rehearsalFastStep = std::atof(argv[++i]);
       defaults.rehearsalFastIterations = std::atoi(argv[++i]);
     } else {
-      std::fprintf(stderr, "usage: bench_rehearsal [--quick] [--profile-only] [--fast STEP ITERATIONS]\n");
+      std::fprintf(stderr, "usage: bench_rehearsal [--quick] [--profile-only] [--margins] [--fast STEP ITERATIONS]\n");
       return 2;
     }
   }
@@ -223,6 +226,13 @@ int main(int argc, char** argv) {
                 fast.wallSeconds, full.wallSeconds / fast.wallSeconds, full.passed ? "passed" : "failed",
                 a.sameVerdicts ? "same" : "DIFFER", 100 * a.largestChange, a.largestRule.c_str(),
                 a.differ.empty() ? "" : "  ", a.differ.c_str());
+    if (margins)
+      for (size_t r = 0; r < full.verdicts.size() && r < fast.verdicts.size(); ++r) {
+        const RuleVerdict &u = full.verdicts[r], &v = fast.verdicts[r];
+        std::printf("    %-13s limit %8.3f  full worst %8.3f (margin %8.3f)  fast worst %8.3f (margin %8.3f)\n",
+                    toString(u.rule), u.limit, u.worst, std::abs(std::abs(u.limit) - std::abs(u.worst)), v.worst,
+                    std::abs(std::abs(v.limit) - std::abs(v.worst)));
+      }
   }
   std::printf("%zu sequences (%d failing in the full profile): verdicts the same in %d, every margin within 10 %% in %d; "
               "largest margin change %.1f %%; all together %.1f s full, %.1f s fast (%.2fx)\n",

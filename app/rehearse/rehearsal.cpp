@@ -280,6 +280,16 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   return result;
 }
 
+double ruleMargin(const RuleVerdict& v) {
+  // Lower bounds (the stability margin, a joint's distance from its stop):
+  // how far above. Upper bounds on a magnitude (roll, pitch, yaw rate are
+  // signed: -21.5 deg/s is as near the 60 deg/s limit as +21.5): how far
+  // below. Negative once the rule failed, so a run 3 cm outside its
+  // support polygon is not as good as one 3 cm inside the limit.
+  if (v.rule == Rule::Stability || v.rule == Rule::JointLimit) return v.worst - v.limit;
+  return std::abs(v.limit) - std::abs(v.worst);
+}
+
 ProfileAgreement compareProfiles(const RehearsalResult& reference, const RehearsalResult& other) {
   ProfileAgreement a;
   const bool margins = !reference.stoppedEarly && !other.stoppedEarly;
@@ -292,10 +302,8 @@ ProfileAgreement compareProfiles(const RehearsalResult& reference, const Rehears
                     (r.passed ? "passed" : "failed") + ", " + (o.passed ? "passed" : "failed");
       }
       if (!margins) continue;
-      // Signed rules (roll, pitch, yaw rate) bound the magnitude: a closest
-      // approach of -21.5 deg/s is as near the 60 deg/s limit as +21.5.
-      const double ref = std::abs(std::abs(r.limit) - std::abs(r.worst)), oth = std::abs(std::abs(o.limit) - std::abs(o.worst));
-      const double change = std::abs(oth - ref) / std::max({ref, 0.01 * std::abs(r.limit), 1e-9});
+      const double ref = ruleMargin(r), oth = ruleMargin(o);
+      const double change = std::abs(oth - ref) / std::max({std::abs(ref), 0.01 * std::abs(r.limit), 1e-9});
       if (change > a.largestChange) {
         a.largestChange = change;
         a.largestRule = toString(r.rule);

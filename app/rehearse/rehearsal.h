@@ -134,12 +134,15 @@ struct RehearsalResult {
 /// world that cannot be built or a start that does not fit is `error`.
 RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress = {});
 
+/// A rule's margin: the distance of its closest approach from its limit,
+/// on the safe side positive, beyond the limit negative (signed rules
+/// bound |value|).
+double ruleMargin(const RuleVerdict& verdict);
+
 /// How a rehearsal in another profile (the fast one) agrees with a
-/// reference (the full one), rule by rule. A rule's margin is the distance
-/// of its closest approach from its limit (in magnitude: signed rules bound
-/// |value|); its change is relative to the
-/// reference's margin (at least 1 % of the limit, so a margin near zero
-/// does not divide by nothing).
+/// reference (the full one), rule by rule: each ruleMargin()'s change,
+/// relative to the reference's margin (at least 1 % of the limit, so a
+/// margin near zero does not divide by nothing).
 struct ProfileAgreement {
   bool sameVerdicts = true;       ///< every rule passes or fails in both
   double largestChange = 0;       ///< the largest margin change (0.1 = 10 %)

@@ -236,6 +236,38 @@ class TestRehearsal : public QObject {
     QVERIFY(!coarse.sameVerdicts);
   }
 
+  // A margin keeps its side of the limit: a run whose centre of mass came
+  // 3 cm outside the support polygon (worst -0.03 m, limit 0.05) is 0.108 m
+  // from one that stayed 0.078 m inside, not the same 0.02 m from the limit
+  // (as |limit| - |worst| had it). Upper bounds on signed values compare
+  // magnitudes.
+  void profileMarginsKeepTheirSide() {
+    const auto verdict = [](Rule rule, double worst, double limit) {
+      RuleVerdict v;
+      v.rule = rule;
+      v.worst = worst;
+      v.limit = limit;
+      v.passed = rule == Rule::Stability || rule == Rule::JointLimit ? worst >= limit : std::abs(worst) <= limit;
+      return v;
+    };
+    QCOMPARE(ruleMargin(verdict(Rule::Stability, -0.03, 0.05)), -0.08);
+    QCOMPARE(ruleMargin(verdict(Rule::JointLimit, 2.5, 1)), 1.5);
+    QCOMPARE(ruleMargin(verdict(Rule::YawRate, -21.5, 60)), 38.5);
+    QCOMPARE(ruleMargin(verdict(Rule::Speed, 2.0, 1.94)), 1.94 - 2.0);
+    RehearsalResult full, fast;
+    full.verdicts = {verdict(Rule::Stability, -0.03, 0.05), verdict(Rule::YawRate, -30, 60)};
+    fast.verdicts = {verdict(Rule::Stability, 0.078, 0.05), verdict(Rule::YawRate, 30, 60)};
+    const ProfileAgreement a = compareProfiles(full, fast);
+    QVERIFY(!a.sameVerdicts);
+    QCOMPARE(a.largestRule, std::string("stability"));
+    QVERIFY(std::abs(a.largestChange - 0.108 / 0.08) < 1e-12);
+    // The control: the same runs with the fast one 1 mm closer than the full.
+    fast.verdicts[0] = verdict(Rule::Stability, -0.031, 0.05);
+    const ProfileAgreement b = compareProfiles(full, fast);
+    QVERIFY(b.sameVerdicts);
+    QVERIFY(std::abs(b.largestChange - 0.001 / 0.08) < 1e-12);
+  }
+
   // A failed rule decides the verdict: stopped there, the tipping sequence
   // fails as the whole run does, on the same rule, and in less time.
   void stopsAtTheFirstFailure() {
