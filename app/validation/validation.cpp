@@ -720,7 +720,11 @@ ExperimentResult slipperySurface(const ValidationOptions& o) {
       "0.0059 m/s before the hold). The paper's 0.0038 m/s (98 % slip) is therefore not reproduced: with the "
       "resistance above the traction the converged model does not move, and below it the robot rolls off at "
       "nearly full speed (C 0.02: the sensitivity below); no surface between gives 98 % slip without being fitted "
-      "to it. The paper's figure is most likely its own solver's creep, which ours showed at the same order "
+      "to it. The other candidates were measured and do no better (docs/validation/wheel-ground.md): ODE's "
+      "force-dependent slip reaches the paper's rolling speed only where both gaits lose their grip, Wong's "
+      "published snows sink this wheel deeper than its radius with 16-24 times the paper's friction, and a "
+      "Janosi-Hanamoto slip on the ice gives 98 % only at a resistance fitted to half a percent. The paper's "
+      "figure is most likely its own solver's creep, which ours showed at the same order "
       "(0.0059 m/s at 40 iterations). The gaits move by bracing wheels and pushing with the legs: caterpillar " +
       num(v[1], 3) + " m/s, rolking " + num(v[2], 3) + " m/s, the paper's ordering; their speeds follow from the "
       "gait timing and hip swing, which the paper does not give (ours are estimates in config/defaults.params). "
