@@ -230,8 +230,7 @@ int main(int argc, char** argv) {
       for (size_t r = 0; r < full.verdicts.size() && r < fast.verdicts.size(); ++r) {
         const RuleVerdict &u = full.verdicts[r], &v = fast.verdicts[r];
         std::printf("    %-13s limit %8.3f  full worst %8.3f (margin %8.3f)  fast worst %8.3f (margin %8.3f)\n",
-                    toString(u.rule), u.limit, u.worst, std::abs(std::abs(u.limit) - std::abs(u.worst)), v.worst,
-                    std::abs(std::abs(v.limit) - std::abs(v.worst)));
+                    toString(u.rule), u.limit, u.worst, ruleMargin(u), v.worst, ruleMargin(v));
       }
   }
   std::printf("%zu sequences (%d failing in the full profile): verdicts the same in %d, every margin within 10 %% in %d; "
