@@ -124,7 +124,8 @@ struct Case {
   double oraclePos = 0, oracleHead = 0;                  // the hidden values of the fitted parameters
   double filesHead = 0, calHead = 0, matchedHead = 0;   // [rad]
   double radiusFit = 0, radiusTrue = 0, massFit = 0, massTrue = 0;
-  double rehearseFiles = 0, rehearseCal = 0;  // [m] end position errors
+  double rehearseFiles = 0, rehearseCal = 0, rehearseGhostValues = 0;  // [m] end position errors
+  double checkMs = 0;
   double fitMsMax = 0, fitMsMedian = 0;
   int fits = 0, refused = 0;
   std::string problem;
@@ -253,9 +254,26 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
   };
   const Vec3 end = truth.frames.back().base.p;
   const Vec3 a = rehearsedEnd(SimParams{});
-  const Vec3 b = rehearsedEnd(withCalValues(SimParams{}, values));
+  std::vector<RobotFrame> first;
+  for (const RobotFrame& f : d.frames)
+    if (f.time <= 30) first.push_back(f);
+  const FullPhysicsCheck full = fullPhysicsValues(world, SimParams{}, first, d.commands, values, gWindow);
+  c.checkMs = full.wallMs;
+  if (std::getenv("SP_BENCH_VALUES")) {
+    std::string text;
+    for (CalParam q : kFullPhysicsChecked) {
+      const size_t i = static_cast<size_t>(q);
+      text += std::string(" ") + (calParams()[i].key + 12) + " " + std::to_string(values[i]) + " -> " + std::to_string(full.values[i]) +
+              " (cost " + std::to_string(full.cost) + " vs " + std::to_string(full.costWithout[i]) + ")";
+    }
+    std::fprintf(stderr, "%s %llu full physics:%s %.0f ms %s\n", name.c_str(), static_cast<unsigned long long>(seed), text.c_str(),
+                 full.wallMs, full.problem.c_str());
+  }
+  const Vec3 b = rehearsedEnd(withCalValues(SimParams{}, full.values));
+  const Vec3 g = rehearsedEnd(withCalValues(SimParams{}, values));
   c.rehearseFiles = std::hypot(a.x - end.x, a.y - end.y);
   c.rehearseCal = std::hypot(b.x - end.x, b.y - end.y);
+  c.rehearseGhostValues = std::hypot(g.x - end.x, g.y - end.y);
   return c;
 }
 
@@ -317,18 +335,18 @@ int main(int argc, char** argv) {
   std::atomic<size_t> next{0};
   std::mutex print;
   std::printf("world  seed | ghost pos [cm] files  calib  oracle matched | heading [deg] files calib oracle matched | radius fit/true  "
-              "mass fit/true | rehearsal end [m] files calib | fits (refused) fit ms med/max\n");
+              "mass fit/true | rehearsal end [m] files calib (ghost's values) | fits (refused) fit ms med/max, check ms\n");
   const auto worker = [&] {
     for (size_t i; (i = next++) < work.size();) {
       const auto& [w, seed] = work[i];
       Case c = run(loaded[w].first, loaded[w].second, seed);
       std::lock_guard lock(print);
-      std::printf("%-6s %4llu | %6.2f %6.2f %6.2f %6.2f | %5.2f %5.2f %5.2f %5.2f | %.4f/%.4f %.3f/%.3f | %6.3f %6.3f | %d (%d) %4.0f/%4.0f %s\n",
+      std::printf("%-6s %4llu | %6.2f %6.2f %6.2f %6.2f | %5.2f %5.2f %5.2f %5.2f | %.4f/%.4f %.3f/%.3f | %6.3f %6.3f (%6.3f) | %d (%d) %4.0f/%4.0f %5.0f %s\n",
                   c.world.c_str(), static_cast<unsigned long long>(c.seed), c.filesPos * 100, c.calPos * 100,
                   c.oraclePos * 100, c.matchedPos * 100, c.filesHead * 57.2958, c.calHead * 57.2958, c.oracleHead * 57.2958,
                   c.matchedHead * 57.2958, c.radiusFit,
-                  c.radiusTrue, c.massFit, c.massTrue, c.rehearseFiles, c.rehearseCal, c.fits, c.refused, c.fitMsMedian,
-                  c.fitMsMax, c.problem.c_str());
+                  c.radiusTrue, c.massFit, c.massTrue, c.rehearseFiles, c.rehearseCal, c.rehearseGhostValues, c.fits, c.refused, c.fitMsMedian,
+                  c.fitMsMax, c.checkMs, c.problem.c_str());
       std::fflush(stdout);
       cases[i] = std::move(c);
     }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <thread>
 
 #include "app/console/robot_shapes.h"
@@ -343,12 +344,23 @@ struct Candidate {
 };
 
 std::vector<std::optional<std::vector<double>>> runAll(const Problem& pb, const std::vector<Candidate>& candidates,
-                                                       int threads, std::string& why) {
+                                                       int threads, std::string& why,
+                                                       const std::function<bool()>& abort = {}) {
   std::vector<std::optional<std::vector<double>>> out(candidates.size());
   std::vector<std::string> whys(candidates.size());
   std::atomic<size_t> next{0};
+  std::mutex asking;  // `abort` is asked from one thread at a time
   const auto work = [&] {
-    for (size_t i; (i = next++) < candidates.size();) out[i] = residuals(pb, candidates[i].values, whys[i], nullptr, candidates[i].jitter);
+    for (size_t i; (i = next++) < candidates.size();) {
+      if (abort) {
+        std::lock_guard lock(asking);
+        if (abort()) {
+          whys[i] = "cancelled";
+          continue;
+        }
+      }
+      out[i] = residuals(pb, candidates[i].values, whys[i], nullptr, candidates[i].jitter);
+    }
   };
   std::vector<std::thread> pool;
   for (int t = 1; t < std::min<int>(threads, static_cast<int>(candidates.size())); ++t) pool.emplace_back(work);
@@ -746,6 +758,53 @@ PredictionCheck checkPredictions(const WorldModel& files, const SimParams& profi
     out.heading.push_back(std::abs((*r)[last + 2]) * kResidualScale.heading);
     at += seg.checkpoints.size() * kPerCheckpoint;
   }
+  return out;
+}
+
+FullPhysicsCheck fullPhysicsValues(const WorldModel& files, const SimParams& full, const std::vector<RobotFrame>& in,
+                                   const std::vector<TimedCommand>& commands, const CalValues& applied, double window,
+                                   int threads, const std::function<bool()>& abort) {
+  const auto began = std::chrono::steady_clock::now();
+  FullPhysicsCheck out;
+  out.values = applied;
+  if (files.robots.empty() || !files.robots[0].model.drive) {
+    out.problem = "the world has no robot with a drive";
+    return out;
+  }
+  const std::vector<RobotFrame> frames = usableFrames(in, window);
+  SimParams physics = full;
+  physics.ghostHold = "none";  // the full robot: nothing held
+  CalibrationOptions o;
+  Problem pb;
+  out.problem = makeProblem(files, physics, frames, commands, o, pb);
+  if (!out.problem.empty()) return out;
+  if (pb.segments.size() < static_cast<size_t>(o.minSegments)) {
+    out.problem = "not enough driving";
+    return out;
+  }
+  std::vector<Candidate> candidates{{applied, 0}};
+  std::vector<size_t> tried;
+  for (CalParam p : kFullPhysicsChecked) {
+    const size_t i = static_cast<size_t>(p);
+    if (applied[i] == calParams()[i].files) continue;
+    Candidate c{applied, 0};
+    c.values[i] = calParams()[i].files;
+    candidates.push_back(c);
+    tried.push_back(i);
+  }
+  if (!tried.empty()) {
+    const auto runs = runAll(pb, candidates, threads, out.problem, abort);
+    for (const auto& run : runs)
+      if (!run) return out;  // diverged or cancelled: nothing is judged on a part
+    out.problem.clear();
+    out.cost = meanSquare(*runs[0]);
+    for (size_t k = 0; k < tried.size(); ++k) {
+      const double without = meanSquare(*runs[k + 1]);
+      out.costWithout[tried[k]] = without;
+      if (without <= out.cost) out.values[tried[k]] = calParams()[tried[k]].files;
+    }
+  }
+  out.wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - began).count();
   return out;
 }
 

@@ -16,6 +16,7 @@ constexpr double kCommandMemory = 120;  // [s] of robot time: the commands a win
 LiveCalibrator::LiveCalibrator(WorldModel files, const SimParams& profile, const CalValues& start, const Options& options)
     : files_(std::move(files)), profile_(profile), files0_(filesCalValues()), options_(options) {
   state_.applied = estimate_.value = start;
+  updateFullPhysics();
   worker_ = std::thread([this] { run(); });
 }
 
@@ -64,6 +65,20 @@ CalValues LiveCalibrator::applied() const {
   return state_.applied;
 }
 
+CalValues LiveCalibrator::fullPhysics() const {
+  std::lock_guard lock(mutex_);
+  return state_.fullPhysics;
+}
+
+void LiveCalibrator::updateFullPhysics() {
+  state_.fullPhysics = state_.applied;
+  if (!options_.full) return;
+  for (CalParam p : kFullPhysicsChecked) {
+    const size_t i = static_cast<size_t>(p);
+    if (!state_.confirmed[i]) state_.fullPhysics[i] = calParams()[i].files;
+  }
+}
+
 void LiveCalibrator::freeze(bool frozen) {
   std::lock_guard lock(mutex_);
   if (state_.frozen == frozen) return;
@@ -77,6 +92,9 @@ void LiveCalibrator::reset() {
   state_.applied = files0_;
   state_.sigma = {};
   state_.observed = {};
+  state_.confirmed = state_.refused = {};
+  state_.checkedAt = -1;
+  updateFullPhysics();
   ++state_.version;
 }
 
@@ -106,7 +124,7 @@ void LiveCalibrator::run() {
       std::lock_guard lock(mutex_);
       return stop_;
     });
-    std::lock_guard lock(mutex_);
+    std::unique_lock lock(mutex_);
     if (stop_) return;
     ++state_.fits;
     if (!fit.refused.empty()) {
@@ -120,8 +138,50 @@ void LiveCalibrator::run() {
     }
     state_.history.push_back(fit);
     if (state_.history.size() > CalibrationState::kHistory) state_.history.erase(state_.history.begin());
+    bool pending = false, any = false;  // a split applied that no check judged; any split applied
+    for (CalParam p : kFullPhysicsChecked) {
+      const size_t i = static_cast<size_t>(p);
+      if (state_.applied[i] == calParams()[i].files) state_.confirmed[i] = state_.refused[i] = false;
+      else any = true;
+      pending |= state_.applied[i] != calParams()[i].files && !state_.confirmed[i] && !state_.refused[i];
+    }
+    updateFullPhysics();
     ++state_.version;
+    // A new split is checked soon; the verdicts again now and then (tyres
+    // wear, loads move); nothing while frozen (nothing new is applied).
+    const double since = fit.to - state_.checkedAt;
+    if (!options_.full || state_.frozen || !fit.refused.empty() || !any || since < options_.checkPeriod ||
+        (!pending && since < 4 * options_.checkPeriod))
+      continue;
+    lock.unlock();
+    check(frames, commands);
   }
+}
+
+void LiveCalibrator::check(const std::vector<RobotFrame>& frames, const std::vector<TimedCommand>& commands) {
+  CalValues applied;
+  {
+    std::lock_guard lock(mutex_);
+    applied = state_.applied;
+  }
+  const FullPhysicsCheck c =
+      fullPhysicsValues(files_, *options_.full, frames, commands, applied, options_.fit.window, options_.fit.threads, [&] {
+        if (options_.duringFit) options_.duringFit();
+        std::lock_guard lock(mutex_);
+        return stop_;
+      });
+  std::lock_guard lock(mutex_);
+  // Reset, frozen or refitted meanwhile: the next fit checks again.
+  if (stop_ || state_.frozen || !c.problem.empty() || state_.applied != applied) return;
+  state_.checkedAt = frames.back().time;
+  for (CalParam p : kFullPhysicsChecked) {
+    const size_t i = static_cast<size_t>(p);
+    if (applied[i] == calParams()[i].files) continue;
+    state_.confirmed[i] = c.values[i] == applied[i];
+    state_.refused[i] = !state_.confirmed[i];
+  }
+  updateFullPhysics();
+  ++state_.version;
 }
 
 }  // namespace sp

@@ -38,6 +38,13 @@ struct CalibrationState {
   CalValues applied{};      ///< what the twins use now: the fits fused, where significant (calibration.h)
   CalValues sigma{};        ///< its deviation (0: the files', or never observed)
   CalFlags observed{};      ///< some fit observed it (else the files' or the start's)
+  /// What the full-physics twins (rehearsals, robustness runs, sweeps) use:
+  /// `applied`, with each of kFullPhysicsChecked at the files' value until a
+  /// full-physics check confirmed it (calibration.h, fullPhysicsValues).
+  CalValues fullPhysics{};
+  CalFlags confirmed{};     ///< the last full-physics check kept it
+  CalFlags refused{};       ///< ... put it back to the files' value
+  double checkedAt = -1;    ///< [s] robot time of that check (< 0: none yet)
   bool frozen = false;
   int fits = 0, refusals = 0;
   std::string lastRefusal;  ///< "" or why the last refused fit was
@@ -65,6 +72,13 @@ class LiveCalibrator {
     /// Tests: called on the worker between the twin runs of each fit,
     /// holding no lock (to prove the GUI thread never waits on a fit).
     std::function<void()> duringFit;
+    /// The console's own physics: when set, the radius splits the fits
+    /// applied are checked in it (fullPhysicsValues over the newest
+    /// `fit.window` s) before the full-physics twins are given them: after
+    /// a fit that applied one no check judged, at most every `checkPeriod`
+    /// s of robot time; the verdicts again every 4 `checkPeriod`.
+    std::optional<SimParams> full;
+    double checkPeriod = 12;
   };
   /// Fits the robot of `files` (the console's world, its first robot) with
   /// the physics `profile` (the ghost's: step, iterations, hold) from
@@ -83,14 +97,19 @@ class LiveCalibrator {
   CalibrationState state() const;
   /// The version alone (cheap to poll).
   int64_t version() const;
-  /// What the twins use now (state().applied without copying the history).
+  /// What the ghost uses now (state().applied without copying the history).
   CalValues applied() const;
+  /// What the full-physics twins use now (state().fullPhysics).
+  CalValues fullPhysics() const;
   void freeze(bool frozen);
   /// Back to the files' values; the fits start from them again.
   void reset();
 
  private:
   void run();
+  void check(const std::vector<RobotFrame>& frames, const std::vector<TimedCommand>& commands);
+  // state_.fullPhysics from state_.applied and the last check (mutex_ held).
+  void updateFullPhysics();
 
   const WorldModel files_;
   const SimParams profile_;

@@ -57,12 +57,15 @@ void ConsoleSession::setWorld(WorldModel world) {
   if (options_.ghost) ghost_ = Ghost::create(*world_, params_, options_.ghostOptions, ghostError_);
   ghostCalibration_ = calValues(params_);
   // The calibration fits the ghost's own twin.
-  if (ghost_ && options_.calibrate)
-    calibrator_ = std::make_unique<LiveCalibrator>(*world_, Ghost::profile(params_), ghostCalibration_, options_.calibration);
+  if (ghost_ && options_.calibrate) {
+    LiveCalibrator::Options o = options_.calibration;
+    if (!o.full) o.full = params_;  // the rehearsals' physics checks what they are given
+    calibrator_ = std::make_unique<LiveCalibrator>(*world_, Ghost::profile(params_), ghostCalibration_, o);
+  }
 }
 
 SimParams ConsoleSession::twinParams() const {
-  return calibrator_ ? withCalValues(params_, calibrator_->applied()) : params_;
+  return calibrator_ ? withCalValues(params_, calibrator_->fullPhysics()) : params_;
 }
 
 void ConsoleSession::takeCalibration() {

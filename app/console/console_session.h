@@ -157,7 +157,9 @@ class ConsoleSession {
   LiveCalibrator* calibrator() { return calibrator_.get(); }
   const LiveCalibrator* calibrator() const { return calibrator_.get(); }
   /// The parameters with the calibration applied now: what the twins the
-  /// console starts (rehearsals, robustness runs, sweeps) are built with.
+  /// console starts (rehearsals, robustness runs, sweeps) are built with
+  /// (the calibrator's fullPhysics(): the radius splits once the full
+  /// physics confirmed them).
   SimParams twinParams() const;
   /// The last telemetry frame against the ghost's prediction for its time;
   /// nullopt when the ghost had shown nothing for that time.

@@ -88,6 +88,13 @@ class TestCalibrationDock : public QObject {
     QCOMPARE(panel->table()->item(static_cast<int>(CalParam::Friction), 2)->text(), QStringLiteral("unobserved"));
     QVERIFY(panel->plottedPoints() >= 2);
     QCOMPARE(w.context().session().twinParams().calWheelRadius, s.applied[0]);
+    // The rehearsals get the full-physics values, and the panel shows them.
+    QTRY_VERIFY(calValues(w.context().session().twinParams()) == calibrator->fullPhysics());  // two calls: a fit may land between
+    QCOMPARE(panel->table()->item(0, 4)->text(), QString::number(s.fullPhysics[0], 'f', 4));
+    for (CalParam q : kFullPhysicsChecked) {
+      const size_t i = static_cast<size_t>(q);
+      if (!s.confirmed[i]) QCOMPARE(s.fullPhysics[i], calParams()[i].files);
+    }
     dock->grab().save(dir.filePath(QStringLiteral("dock.png")));
     if (qEnvironmentVariableIsSet("SP_KEEP_SHOT")) dock->grab().save(qEnvironmentVariable("SP_KEEP_SHOT"));
 

@@ -29,8 +29,11 @@ QString shown(size_t param, double v) {
 
 CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(kCalParams) {
   auto* layout = new QVBoxLayout(this);
-  table_ = new QTableWidget(kCalParams, 4, this);
-  table_->setHorizontalHeaderLabels({tr("Parameter"), tr("Value"), tr("±"), tr("Files")});
+  table_ = new QTableWidget(kCalParams, 5, this);
+  table_->setHorizontalHeaderLabels({tr("Parameter"), tr("Value"), tr("±"), tr("Files"), tr("Rehearsals")});
+  table_->horizontalHeaderItem(4)->setToolTip(
+      tr("What the rehearsals, robustness runs and sweeps use: the value, except a tyre radius split the "
+         "full physics has not confirmed (the fits run in the ghost's coarser physics)"));
   table_->verticalHeader()->hide();
   table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   table_->setSelectionMode(QAbstractItemView::NoSelection);
@@ -43,6 +46,7 @@ CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(k
     table_->setItem(i, 0, name);
     table_->setItem(i, 3, new QTableWidgetItem(shown(static_cast<size_t>(i), p.files)));
     showRow(i, p.files, 0, false, tr("files"));
+    table_->setItem(i, 4, new QTableWidgetItem(shown(static_cast<size_t>(i), p.files)));
   }
   table_->resizeColumnsToContents();
   table_->setMinimumHeight(table_->verticalHeader()->length() + table_->horizontalHeader()->height() + 4);
@@ -122,6 +126,11 @@ void CalibrationPanel::setLive(const CalibrationState* state, const QString& why
   for (int i = 0; i < kCalParams; ++i) {
     const size_t p = static_cast<size_t>(i);
     showRow(i, state->applied[p], state->sigma[p], state->observed[p], tr("unobserved"));
+    auto* rehearsed = new QTableWidgetItem(shown(p, state->fullPhysics[p]));
+    if (state->fullPhysics[p] != state->applied[p])
+      rehearsed->setToolTip(state->refused[p] ? tr("The full physics predicts the robot better with the files' value")
+                                              : tr("The files' value until the full physics confirms this one"));
+    table_->setItem(i, 4, rehearsed);
   }
   for (auto& s : series_) s.clear();
   for (const CalibrationFit& fit : state->history)
@@ -167,6 +176,7 @@ void CalibrationPanel::setReplayed(const std::vector<LogCalibration>& rows, cons
     const size_t p = static_cast<size_t>(i);
     if (newest[p]) showRow(i, newest[p]->value, newest[p]->sigma, newest[p]->observed, tr("unobserved"));
     else showRow(i, calParams()[p].files, 0, false, tr("not in the log"));
+    table_->setItem(i, 4, new QTableWidgetItem());  // the log keeps the fits, not what the rehearsals used
   }
   status_->setText(rows.empty() ? tr("The replayed log %1 holds no calibration.").arg(label)
                                 : tr("The calibration the console fitted in %1 (%2 fits).")
