@@ -120,6 +120,9 @@ constexpr const char* kUsage = R"(usage:
       (fitting the twin's predictions) and total mass (from the wheel loads). Prints each with
       its deviation, or "unobserved" when the motion cannot tell, and writes
       the calibration.* keys to FILE (a parameters file; default: none).
+      Fitted in the ghost's physics, the tyre radius splits are checked in
+      the log's own over its last 16 s: a split the full physics predicts
+      worse with is printed and written as the files' value.
       --robot-out FILE  also the log's robot file with the fitted masses,
                         tyre radii and wheel motor gain written in (friction
                         and delay stay parameters: a comment says so)
@@ -623,6 +626,27 @@ int calibrate(const std::vector<std::string>& args) {
   }
   std::printf("%s: %d segments over %.1f - %.1f s, %d twin runs, %.0f ms; cost %.3g -> %.3g\n", log.c_str(),
               fit.segments, fit.from, fit.to, fit.twinRuns, fit.wallMs, fit.costBefore, fit.costAfter);
+  // Fitted in the ghost's profile: the radius splits are checked in the
+  // log's own physics before a file gets them, as the console does for its
+  // rehearsals (calibration.h, fullPhysicsValues), over the newest 16 s.
+  sp::CalibrationFit written = fit;
+  if (profileName == "ghost") {
+    const sp::FullPhysicsCheck check =
+        sp::fullPhysicsValues(in->world, in->params, in->frames, in->commands, fit.value, 16, options.threads);
+    if (!check.problem.empty()) {
+      std::printf("full physics: not checked (%s): the splits are written as fitted\n", check.problem.c_str());
+    } else {
+      for (sp::CalParam q : sp::kFullPhysicsChecked) {
+        const size_t i = static_cast<size_t>(q);
+        if (check.values[i] == fit.value[i]) continue;
+        std::printf("full physics: %s %.5f put back to the files' %.5f (it predicts the robot better without it: cost %.4g "
+                    "against %.4g)\n",
+                    sp::calParams()[i].key, fit.value[i], check.values[i], check.costWithout[i], check.cost);
+        written.value[i] = check.values[i];
+        written.observed[i] = false;
+      }
+    }
+  }
   for (size_t i = 0; i < sp::kCalParams; ++i) {
     const sp::CalParamInfo& p = sp::calParams()[i];
     if (fit.observed[i])
@@ -632,7 +656,7 @@ int calibrate(const std::vector<std::string>& args) {
   }
   if (!out.empty()) {
     std::ofstream f(out);
-    f << sp::calibrationParamsText(fit);
+    f << sp::calibrationParamsText(written);
     if (!f.flush()) {
       std::cerr << out << ": error: cannot write the parameters file\n";
       return 1;
@@ -641,7 +665,7 @@ int calibrate(const std::vector<std::string>& args) {
   }
   if (!robotOut.empty()) {
     const std::optional<std::string> text = sp::calibratedRobotText(
-        in->robotText, in->world.robots[0].model, sp::withCalValues(in->params, fit.value), error);
+        in->robotText, in->world.robots[0].model, sp::withCalValues(in->params, written.value), error);
     std::ofstream f;
     if (text) f.open(robotOut);
     if (!text || !(f << *text).flush()) {

@@ -48,10 +48,15 @@ QString CalibrationJob::save(const QString& path) const {
   const CalibrationState s = c->state();
   std::string text;
   if (!path.endsWith(QLatin1String(".xml"), Qt::CaseInsensitive)) {
-    CalibrationFit fit;  // what the twins use now, as a fit's text
-    fit.value = s.applied;
+    // What the full-physics twins use now, as a fit's text: a file stands
+    // for the robot, and a split the full physics did not confirm is the
+    // ghost's profile speaking, not the robot (calibration.h).
+    CalibrationFit fit;
+    fit.value = s.fullPhysics;
     fit.sigma = s.sigma;
     fit.observed = s.observed;
+    for (size_t i = 0; i < kCalParams; ++i)
+      if (s.fullPhysics[i] != s.applied[i]) fit.observed[i] = false;
     if (!s.history.empty()) {
       fit.from = s.history.front().from;
       fit.to = s.history.back().to;
@@ -67,7 +72,7 @@ QString CalibrationJob::save(const QString& path) const {
     if (!original) return tr("%1: cannot read the robot file").arg(QString::fromStdString(robot.file));
     std::string error;
     std::optional<std::string> calibrated =
-        calibratedRobotText(*original, robot, withCalValues(context_->session().params(), s.applied), error);
+        calibratedRobotText(*original, robot, withCalValues(context_->session().params(), s.fullPhysics), error);
     if (!calibrated) return QString::fromStdString(error);
     text = std::move(*calibrated);
   }

@@ -91,7 +91,7 @@ CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(k
   reset_ = new QPushButton(tr("Reset to files"), this);
   reset_->setToolTip(tr("The twins use the robot and world files' values again"));
   save_ = new QPushButton(tr("Save…"), this);
-  save_->setToolTip(tr("Save the values as a parameters file (calibration.* keys) or as a robot file with them written in"));
+  save_->setToolTip(tr("Save the values the rehearsals use as a parameters file (calibration.* keys) or as a robot file with them written in"));
   for (QPushButton* b : {freeze_, reset_, save_}) buttons->addWidget(b);
   layout->addLayout(buttons);
   status_ = new QLabel(this);
