@@ -18,6 +18,7 @@ LiveCalibrator::LiveCalibrator(WorldModel files, const SimParams& profile, const
   state_.applied = estimate_.value = start;
   updateFullPhysics();
   worker_ = std::thread([this] { run(); });
+  if (options_.full) checker_ = std::thread([this] { runChecks(); });
 }
 
 LiveCalibrator::~LiveCalibrator() {
@@ -26,7 +27,9 @@ LiveCalibrator::~LiveCalibrator() {
     stop_ = true;
   }
   wake_.notify_all();
+  checkWake_.notify_all();
   worker_.join();
+  if (checker_.joinable()) checker_.join();
 }
 
 void LiveCalibrator::frame(const RobotFrame& f) {
@@ -94,6 +97,7 @@ void LiveCalibrator::reset() {
   state_.observed = {};
   state_.confirmed = state_.refused = {};
   state_.checkedAt = -1;
+  ++resets_;
   updateFullPhysics();
   ++state_.version;
 }
@@ -149,34 +153,65 @@ void LiveCalibrator::run() {
     ++state_.version;
     // A new split is checked soon; the verdicts again now and then (tyres
     // wear, loads move); nothing while frozen (nothing new is applied).
-    const double since = fit.to - state_.checkedAt;
-    if (!options_.full || state_.frozen || !fit.refused.empty() || !any || since < options_.checkPeriod ||
+    const double since = state_.checkedAt < 0 ? 1e300 : fit.to - state_.checkedAt;
+    if (!options_.full || state_.frozen || !fit.refused.empty() || !any || checkWanted_ || checking_ ||
+        since < options_.checkPeriod ||
         (!pending && since < 4 * options_.checkPeriod))
       continue;
+    // On the checker's thread: a check takes a few seconds of full physics,
+    // and the fits must land every period meanwhile.
+    checkFrames_ = std::move(frames);
+    checkCommands_ = std::move(commands);
+    checkWanted_ = true;
     lock.unlock();
+    checkWake_.notify_one();
+  }
+}
+
+void LiveCalibrator::runChecks() {
+  pthread_setname_np(pthread_self(), "calib-check");
+  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+  for (;;) {
+    std::vector<RobotFrame> frames;
+    std::vector<TimedCommand> commands;
+    {
+      std::unique_lock lock(mutex_);
+      checkWake_.wait(lock, [&] { return stop_ || checkWanted_; });
+      if (stop_) return;
+      checkWanted_ = false;
+      checking_ = true;
+      frames = std::move(checkFrames_);
+      commands = std::move(checkCommands_);
+    }
     check(frames, commands);
+    std::lock_guard lock(mutex_);
+    checking_ = false;
   }
 }
 
 void LiveCalibrator::check(const std::vector<RobotFrame>& frames, const std::vector<TimedCommand>& commands) {
   CalValues applied;
+  int64_t resets = 0;
   {
     std::lock_guard lock(mutex_);
     applied = state_.applied;
+    resets = resets_;
   }
   const FullPhysicsCheck c =
-      fullPhysicsValues(files_, *options_.full, frames, commands, applied, options_.fit.window, options_.fit.threads, [&] {
+      fullPhysicsValues(files_, *options_.full, frames, commands, applied, options_.fit.window, 1, [&] {
         if (options_.duringFit) options_.duringFit();
         std::lock_guard lock(mutex_);
         return stop_;
       });
   std::lock_guard lock(mutex_);
-  // Reset, frozen or refitted meanwhile: the next fit checks again.
-  if (stop_ || state_.frozen || !c.problem.empty() || state_.applied != applied) return;
+  // Reset or frozen meanwhile: the next fit asks again. The fits that
+  // landed meanwhile moved the values a little; the verdict is on whether
+  // the robot has the split, so it stands.
+  if (stop_ || state_.frozen || !c.problem.empty() || resets_ != resets) return;
   state_.checkedAt = frames.back().time;
   for (CalParam p : kFullPhysicsChecked) {
     const size_t i = static_cast<size_t>(p);
-    if (applied[i] == calParams()[i].files) continue;
+    if (applied[i] == calParams()[i].files || state_.applied[i] == calParams()[i].files) continue;
     state_.confirmed[i] = c.values[i] == applied[i];
     state_.refused[i] = !state_.confirmed[i];
   }

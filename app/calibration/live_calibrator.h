@@ -12,7 +12,9 @@
 //
 // Thread: frame(), command(), state(), freeze(), reset() from any thread
 // (the GUI's); they copy under a mutex and never wait for a fit. The worker
-// runs at nice 10, beside the ghost's threads.
+// runs at nice 10, beside the ghost's threads; the full-physics checks
+// (Options::full) on a thread of their own at nice 10, one core, so that
+// the fits land every period while a check runs.
 
 #include <condition_variable>
 #include <cstdint>
@@ -107,6 +109,7 @@ class LiveCalibrator {
 
  private:
   void run();
+  void runChecks();
   void check(const std::vector<RobotFrame>& frames, const std::vector<TimedCommand>& commands);
   // state_.fullPhysics from state_.applied and the last check (mutex_ held).
   void updateFullPhysics();
@@ -124,6 +127,13 @@ class LiveCalibrator {
   CalibrationState state_;
   CalEstimate estimate_;  // state_'s applied, sigma and observed, fused
   std::thread worker_;
+  // The full-physics check's request (the window to check) and thread.
+  std::condition_variable checkWake_;
+  bool checkWanted_ = false, checking_ = false;
+  int64_t resets_ = 0;  // reset() calls: a check started before one is void
+  std::vector<RobotFrame> checkFrames_;
+  std::vector<TimedCommand> checkCommands_;
+  std::thread checker_;
 };
 
 }  // namespace sp

@@ -17,7 +17,8 @@
 //     the files' (control);
 //   - the full-physics check of a split the fits applied puts a spurious
 //     one (-1.5 % diagonal on a robot that is its twin) back to the files'
-//     and keeps a real one (+2 % hidden and applied: the control);
+//     and keeps a real one (+2 % hidden and applied: the control); the live
+//     calibrator runs it and its rehearsal values follow it;
 //   - a straight-line drive on grip leaves friction unobserved (and its
 //     value the files'); the same robot turning observes it is not claimed;
 //   - a fit the physics cannot follow (telemetry of a robot whose wheels
@@ -341,6 +342,35 @@ class TestCalibration : public QObject {
     }
     live.reset();
     QVERIFY(live.state().applied == filesCalValues());
+  }
+
+  // The live calibrator checks a split it applies before the rehearsals get
+  // it: started from values with a spurious -1.5 % diagonal split (as the
+  // fits gave it on flat ground) on a robot that is its twin, the ghost keeps
+  // a split (10 s of driving fuse it to about -0.9 %, still applied) and the
+  // full-physics values put it back once the checker's thread has run; the
+  // first check does not wait for a period of robot time.
+  void liveCalibratorChecksSplitsInTheFullPhysics() {
+    const WorldModel world = loadWorldFile("flat.world.xml");
+    const RecordedDrive d = recordDrive(world, SimParams{}, none(world), commands(world, kDriveAndTurn), 10.0);
+    QVERIFY2(d.problem.empty(), d.problem.c_str());
+    constexpr size_t kDiag = static_cast<size_t>(CalParam::WheelRadiusDiag);
+    CalValues start = filesCalValues();
+    start[kDiag] = -0.015;
+    LiveCalibrator::Options o;
+    o.full = SimParams{};
+    LiveCalibrator live(world, ghostProfile(), start, o);
+    QCOMPARE(live.fullPhysics()[kDiag], 0.0);  // not confirmed yet: the files'
+    for (const TimedCommand& c : d.commands) live.command(c.command, c.time);
+    for (const RobotFrame& f : d.frames) live.frame(f);
+    QTRY_VERIFY_WITH_TIMEOUT(live.state().checkedAt >= 0, 60000);
+    const CalibrationState s = live.state();
+    qInfo("%d fits; diagonal split applied %.4f +- %.4f, rehearsals %.4f (%s)", s.fits, s.applied[kDiag], s.sigma[kDiag],
+          s.fullPhysics[kDiag], s.confirmed[kDiag] ? "confirmed" : s.refused[kDiag] ? "refused" : "not checked");
+    QVERIFY(s.applied[kDiag] != 0);
+    QVERIFY(s.refused[kDiag] && !s.confirmed[kDiag]);
+    QCOMPARE(s.fullPhysics[kDiag], 0.0);
+    QCOMPARE(live.fullPhysics()[kDiag], 0.0);
   }
 
   // The offline tool on a robot's own log of a straight drive: friction is

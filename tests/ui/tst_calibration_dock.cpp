@@ -93,6 +93,8 @@ class TestCalibrationDock : public QObject {
     QCOMPARE(panel->table()->item(0, 4)->text(), QString::number(s.fullPhysics[0], 'f', 4));
     for (CalParam q : kFullPhysicsChecked) {
       const size_t i = static_cast<size_t>(q);
+      qInfo("%s: applied %.4f, rehearsals %.4f (%s)", calParams()[i].key, s.applied[i], s.fullPhysics[i],
+            s.confirmed[i] ? "confirmed" : s.refused[i] ? "refused" : "not checked");
       if (!s.confirmed[i]) QCOMPARE(s.fullPhysics[i], calParams()[i].files);
     }
     dock->grab().save(dir.filePath(QStringLiteral("dock.png")));
