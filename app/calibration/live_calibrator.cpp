@@ -11,6 +11,15 @@ namespace sp {
 
 namespace {
 constexpr double kCommandMemory = 120;  // [s] of robot time: the commands a window's anchors may need
+
+// Names the calling thread and lowers it to nice 10. Best effort: never at
+// the expense of the twin, the ghost's present thread or the window (Linux:
+// a thread's nice value is its own).
+void inBackground(const char* name) {
+  pthread_setname_np(pthread_self(), name);
+  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+}
+
 }  // namespace
 
 LiveCalibrator::LiveCalibrator(WorldModel files, const SimParams& profile, const CalValues& start, const Options& options)
@@ -103,10 +112,7 @@ void LiveCalibrator::reset() {
 }
 
 void LiveCalibrator::run() {
-  pthread_setname_np(pthread_self(), "calibrate");
-  // Best effort: never at the expense of the twin, the ghost's present
-  // thread or the window (Linux: a thread's nice value is its own).
-  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+  inBackground("calibrate");
   for (;;) {
     std::vector<RobotFrame> frames;
     std::vector<TimedCommand> commands;
@@ -169,8 +175,7 @@ void LiveCalibrator::run() {
 }
 
 void LiveCalibrator::runChecks() {
-  pthread_setname_np(pthread_self(), "calib-check");
-  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+  inBackground("calib-check");
   for (;;) {
     std::vector<RobotFrame> frames;
     std::vector<TimedCommand> commands;
