@@ -655,8 +655,10 @@ class TestLivePlots : public QObject {
     QVERIFY(elapsed >= 200);
     QVERIFY2(replots <= elapsed / plot->replotInterval() + 2, qPrintable(QString::number(replots)));
     QCOMPARE(plot->scansReceived(), 100);
-    QVERIFY(waitForReplot(*plot, replots));
-    QVERIFY(std::abs(plot->shownPoints().first().x() - (1 + 0.05 * 99)) < 1e-9);
+    // The last scan is drawn: by a replot still to come, or by one that ran
+    // after it arrived and before `replots` was read (waiting for a further
+    // replot then waited for nothing: it failed once on a loaded machine).
+    QTRY_VERIFY(!plot->shownPoints().isEmpty() && std::abs(plot->shownPoints().first().x() - (1 + 0.05 * 99)) < 1e-9);
   }
 
   // The cost of one laser replot with a 1081-beam scan (0.25 degrees over
