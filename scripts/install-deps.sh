@@ -11,6 +11,10 @@ packages=(
   python3 clang libclang-rt-14-dev
   desktop-file-utils lintian help2man liburdfdom-tools
   slurmctld slurmd slurm-client munge
+  # The ROS component (ros/, docs/ros.md) and its tests: Debian's own ROS 1.
+  ros-core python3-rosbag libroscpp-dev librosbag-dev libroslz4-dev libconsole-bridge-dev
+  libstd-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libsensor-msgs-dev libtrajectory-msgs-dev libtf2-msgs-dev
+  pluginlib-dev libclass-loader-dev librcpputils-dev librcutils-dev libament-index-cpp-dev
 )
 
 missing=()

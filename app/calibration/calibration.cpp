@@ -795,7 +795,10 @@ FullPhysicsCheck fullPhysicsValues(const WorldModel& files, const SimParams& ful
   if (!tried.empty()) {
     const auto runs = runAll(pb, candidates, threads, out.problem, abort);
     for (const auto& run : runs)
-      if (!run) return out;  // diverged or cancelled: nothing is judged on a part
+      if (!run) {  // diverged or cancelled: nothing is judged on a part
+        if (out.problem.empty()) out.problem = "a full-physics twin failed";
+        return out;
+      }
     out.problem.clear();
     out.cost = meanSquare(*runs[0]);
     for (size_t k = 0; k < tried.size(); ++k) {
