@@ -178,11 +178,14 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
   o.horizon = gHorizon;
   o.iterations = gIterations;
   std::vector<double> fitMs;
-  for (double end = gWindow; end <= 30 + 1e-9; end += 3) {
-    std::vector<RobotFrame> upTo;
+  const auto framesUpTo = [&](double end) {  // the telemetry the console has at robot time `end`
+    std::vector<RobotFrame> out;
     for (const RobotFrame& f : d.frames)
-      if (f.time <= end) upTo.push_back(f);
-    const CalibrationFit fit = fitCalibration(world, profile, upTo, d.commands, estimate.value, o);
+      if (f.time <= end) out.push_back(f);
+    return out;
+  };
+  for (double end = gWindow; end <= 30 + 1e-9; end += 3) {
+    const CalibrationFit fit = fitCalibration(world, profile, framesUpTo(end), d.commands, estimate.value, o);
     fitMs.push_back(fit.wallMs);
     ++c.fits;
     if (!fit.refused.empty()) ++c.refused;
@@ -254,10 +257,7 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
   };
   const Vec3 end = truth.frames.back().base.p;
   const Vec3 a = rehearsedEnd(SimParams{});
-  std::vector<RobotFrame> first;
-  for (const RobotFrame& f : d.frames)
-    if (f.time <= 30) first.push_back(f);
-  const FullPhysicsCheck full = fullPhysicsValues(world, SimParams{}, first, d.commands, values, gWindow);
+  const FullPhysicsCheck full = fullPhysicsValues(world, SimParams{}, framesUpTo(30), d.commands, values, gWindow);
   c.checkMs = full.wallMs;
   if (std::getenv("SP_BENCH_VALUES")) {
     std::string text;

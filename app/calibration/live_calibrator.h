@@ -71,8 +71,9 @@ class LiveCalibrator {
       o.budgetMs = 3000;
       return o;
     }();
-    /// Tests: called on the worker between the twin runs of each fit,
-    /// holding no lock (to prove the GUI thread never waits on a fit).
+    /// Tests: called on the worker between the twin runs of each fit (and
+    /// on the checker between those of a check), holding no lock (to prove
+    /// the GUI thread never waits on a fit).
     std::function<void()> duringFit;
     /// The console's own physics: when set, the radius splits the fits
     /// applied are checked in it (fullPhysicsValues over the newest
