@@ -241,6 +241,11 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
               std::to_string(estimate.sigma[i]) + (values[i] == estimate.value[i] ? "" : " [files]") + " (" +
               std::to_string(oracle[i]) + ")";
     std::fprintf(stderr, "%s %llu:%s\n", name.c_str(), static_cast<unsigned long long>(seed), text.c_str());
+    const RollingRadii rr = radiiFromRolling(world, framesUpTo(30));
+    std::fprintf(stderr, "%s %llu rolling:", name.c_str(), static_cast<unsigned long long>(seed));
+    for (size_t w = 0; w < 4; ++w)
+      std::fprintf(stderr, " %.5f+-%.5f (%.5f, %d, %.3f)", rr.factor[w], rr.sigma[w], radii[w], rr.frames[w], rr.slipping[w]);
+    std::fprintf(stderr, "\n");
   }
   CalValues matchedDelay = filesCalValues();
   matchedDelay[static_cast<size_t>(CalParam::Delay)] = p.delay;

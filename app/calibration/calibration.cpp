@@ -478,6 +478,68 @@ std::optional<std::pair<double, double>> massFromLoads(const WorldModel& files, 
   return std::make_pair(mean, std::sqrt(var / (static_cast<double>(x.size()) / 10)));
 }
 
+}  // namespace
+
+RollingRadii radiiFromRolling(const WorldModel& files, const std::vector<RobotFrame>& in) {
+  RollingRadii out;
+  if (files.robots.empty() || !files.robots[0].model.drive) return out;
+  const RobotModel& robot = files.robots[0].model;
+  const DriveSpec& drive = *robot.drive;
+  const std::vector<RobotFrame> frames = usableFrames(in, 0);
+  std::array<std::vector<std::pair<double, double>>, 4> samples;  // (spin [rad/s], speed across the axle [m/s])
+  for (const RobotFrame& f : frames) {
+    if (f.jointPositions.size() != robot.joints.size() || f.jointRates.size() != robot.joints.size()) continue;
+    const std::vector<LinkMotion> m =
+        linkMotions(robot, f.base, f.baseLinearVelocity, f.baseAngularVelocity, f.jointPositions, f.jointRates);
+    for (size_t w = 0; w < 4; ++w) {
+      if (drive.wheels[w] < 0) continue;
+      const JointSpec& joint = robot.joints[static_cast<size_t>(drive.wheels[w])];
+      const size_t link = static_cast<size_t>(joint.child);
+      const Pose zero = robot.links[link].pose;
+      const Pose& at = m[link].pose;
+      const Vec3 hub = transformPoint(at * inverse(zero), joint.anchor);
+      const Vec3 axle = normalized(rotate(at.q * conjugate(zero.q), joint.axis));
+      const Vec3 v = m[link].linear + cross(m[link].angular, hub - at.p);
+      const double spin = dot(m[link].angular, axle);
+      const Vec3 across = v - dot(v, axle) * axle;
+      if (std::abs(spin) < 0.5) continue;
+      // Signed: the hub moves the way the spin rolls it on level ground.
+      const double sign = dot(across, cross(axle, Vec3{0, 0, 1})) * spin > 0 ? 1.0 : -1.0;
+      samples[w].push_back({std::abs(spin), sign * norm(across)});
+    }
+  }
+  for (size_t w = 0; w < 4; ++w) {
+    std::vector<std::pair<double, double>>& s = samples[w];
+    if (s.size() < 50) continue;
+    std::vector<double> ratio;
+    for (const auto& [spin, speed] : s) ratio.push_back(speed / spin);
+    std::vector<double> sorted = ratio;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+    const double med = sorted[sorted.size() / 2];
+    double ss = 0, sv = 0;
+    std::vector<std::pair<double, double>> kept;
+    for (size_t i = 0; i < s.size(); ++i)
+      if (std::abs(ratio[i] - med) < 0.05 * std::abs(med)) kept.push_back(s[i]);
+    for (const auto& [spin, speed] : kept) {
+      ss += spin * spin;
+      sv += spin * speed;
+    }
+    out.slipping[w] = 1 - static_cast<double>(kept.size()) / static_cast<double>(s.size());
+    if (kept.size() < 50 || ss <= 0) continue;
+    const double r = sv / ss;
+    double e2 = 0;
+    for (const auto& [spin, speed] : kept) e2 += (speed - r * spin) * (speed - r * spin);
+    // Neighbouring frames are not independent: one sample per 10.
+    const double n = static_cast<double>(kept.size());
+    out.factor[w] = r / drive.wheelRadius;
+    out.sigma[w] = std::sqrt(e2 / (n - 1) / ss * 10) / drive.wheelRadius;
+    out.frames[w] = static_cast<int>(kept.size());
+  }
+  return out;
+}
+
+namespace {
+
 // The fit's problem over `frames` (usable, oldest first): the twin's
 // weld, the commands in order, the driving segments. "" or why not.
 std::string makeProblem(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& frames,
@@ -539,6 +601,39 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       fit.observed[kMass] = true;
     }
 
+  // The tyres' radii: from rolling without slip, through the kinematics
+  // alone. Through the twin they were pinned to 0.3-0.7 % at best, and a
+  // weakly pinned split soaked up the ghost profile's own bias; rolling
+  // pins each wheel to about 0.1 % (docs/performance.md). A window in which
+  // a wheel skids leaves them to the twin, which reproduces the skid.
+  constexpr size_t kRadius = static_cast<size_t>(CalParam::WheelRadius);
+  CalFlags rolled{};
+  if (const RollingRadii rr = radiiFromRolling(files, frames); rr.rolled()) {
+    const auto& w = rr.factor;
+    const double sum = w[0] + w[1] + w[2] + w[3];
+    const double spread = std::sqrt(rr.sigma[0] * rr.sigma[0] + rr.sigma[1] * rr.sigma[1] + rr.sigma[2] * rr.sigma[2] +
+                                    rr.sigma[3] * rr.sigma[3]);
+    // The inverse of calibrationPerturbation's product, to first order (as
+    // the radii differ by a few percent, to 0.02 %).
+    const std::array<std::pair<CalParam, double>, 4> radii{{
+        {CalParam::WheelRadius, sum / 4},
+        {CalParam::WheelRadiusSplit, 2 * ((w[0] + w[1]) - (w[2] + w[3])) / sum},
+        {CalParam::WheelRadiusSide, 2 * ((w[0] + w[2]) - (w[1] + w[3])) / sum},
+        {CalParam::WheelRadiusDiag, 2 * ((w[0] + w[3]) - (w[1] + w[2])) / sum},
+    }};
+    for (const auto& [param, value] : radii) {
+      const size_t i = static_cast<size_t>(param);
+      if (o.fixed[i]) continue;
+      const CalParamInfo& info = calParams()[i];
+      if (!std::isfinite(value) || value < info.lower || value > info.upper)
+        return done("the wheels' rolling says " + std::string(info.key) + " = " + shortestText(value) + ", outside [" +
+                    shortestText(info.lower) + ", " + shortestText(info.upper) + "]");
+      fit.value[i] = value;
+      fit.sigma[i] = i == kRadius ? spread / 4 : 2 * spread / sum;
+      fit.observed[i] = rolled[i] = true;
+    }
+  }
+
   Problem pb;
   std::string why = makeProblem(files, profile, frames, commands, o, pb);
   if (!why.empty()) return done(why);
@@ -556,7 +651,7 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   constexpr size_t kGain = static_cast<size_t>(CalParam::MotorGain);
   std::vector<int> free;
   for (int p = 0; p < kFitted; ++p)
-    if (!o.fixed[static_cast<size_t>(p)] && p != static_cast<int>(kGain)) free.push_back(p);
+    if (!o.fixed[static_cast<size_t>(p)] && !rolled[static_cast<size_t>(p)] && p != static_cast<int>(kGain)) free.push_back(p);
   CalValues v = fit.value;
   std::vector<std::pair<double, double>> turns;
   std::optional<std::vector<double>> r = residuals(pb, v, why, &turns);
@@ -586,9 +681,8 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
         // it (a refinement) it is kept by moving the radius with the gain;
         // when not (a first fit) the radius stays. Whichever predicts the
         // window better.
-        constexpr size_t kRadius = static_cast<size_t>(CalParam::WheelRadius);
         std::vector<Candidate> both{{v, 0}};
-        if (!o.fixed[kRadius]) {
+        if (!o.fixed[kRadius] && !rolled[kRadius]) {
           both.push_back({v, 0});
           both.back().values[kRadius] /= k;
         }
@@ -692,7 +786,8 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   // A fit that predicts the window worse than its start (the contacts'
   // noise can defeat a step) keeps the start's values: nothing learnt.
   if (fit.costAfter > fit.costBefore) {
-    for (int p = 0; p < kFitted; ++p) v[static_cast<size_t>(p)] = start[static_cast<size_t>(p)];
+    for (int p = 0; p < kFitted; ++p)
+      if (!rolled[static_cast<size_t>(p)]) v[static_cast<size_t>(p)] = start[static_cast<size_t>(p)];
     fit.costAfter = fit.costBefore;
   }
   // The deviations at the fit, inflated by the residuals' own scatter.
@@ -705,6 +800,7 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   for (int p : on) fit.observed[static_cast<size_t>(p)] = true;
   for (int p = 0; p < kFitted; ++p) {
     const size_t i = static_cast<size_t>(p);
+    if (rolled[i]) continue;  // measured, not fitted
     // Observed is pinned by the data and fitted to it: one pinned only at
     // the last check, never in a step, still has its start value.
     if (i != kGain && (std::find(on.begin(), on.end(), p) == on.end() ||
