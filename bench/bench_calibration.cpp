@@ -223,12 +223,8 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
   // - each link's mass and centre, torque limits, IMU bias - left out).
   CalValues oracle = filesCalValues();
   const auto& radii = p.wheelRadius;  // FL FR RL RR
-  const double front = (radii[0] + radii[1]) / 2, rear = (radii[2] + radii[3]) / 2;
-  oracle[static_cast<size_t>(CalParam::WheelRadius)] = (front + rear) / 2;
-  oracle[static_cast<size_t>(CalParam::WheelRadiusSplit)] = (front - rear) / ((front + rear) / 2);
-  oracle[static_cast<size_t>(CalParam::WheelRadiusSide)] = ((radii[0] + radii[2]) - (radii[1] + radii[3])) / (radii[0] + radii[1] + radii[2] + radii[3]) * 2;
-  oracle[static_cast<size_t>(CalParam::WheelRadiusDiag)] =
-      ((radii[0] + radii[3]) - (radii[1] + radii[2])) / (radii[0] + radii[1] + radii[2] + radii[3]) * 2;
+  const std::array<double, 4> radiusOracle = radiusValues(radii);
+  std::copy(radiusOracle.begin(), radiusOracle.end(), oracle.begin() + static_cast<long>(CalParam::WheelRadius));
   oracle[static_cast<size_t>(CalParam::Friction)] = p.friction;
   oracle[static_cast<size_t>(CalParam::MotorGain)] = p.velocityGain;
   oracle[static_cast<size_t>(CalParam::Delay)] = p.delay;

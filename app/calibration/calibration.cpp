@@ -538,6 +538,12 @@ RollingRadii radiiFromRolling(const WorldModel& files, const std::vector<RobotFr
   return out;
 }
 
+std::array<double, 4> radiusValues(const std::array<double, 4>& w) {
+  const double sum = w[0] + w[1] + w[2] + w[3];
+  return {sum / 4, 2 * ((w[0] + w[1]) - (w[2] + w[3])) / sum, 2 * ((w[0] + w[2]) - (w[1] + w[3])) / sum,
+          2 * ((w[0] + w[3]) - (w[1] + w[2])) / sum};
+}
+
 namespace {
 
 // The fit's problem over `frames` (usable, oldest first): the twin's
@@ -609,20 +615,12 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   constexpr size_t kRadius = static_cast<size_t>(CalParam::WheelRadius);
   CalFlags rolled{};
   if (const RollingRadii rr = radiiFromRolling(files, frames); rr.rolled()) {
-    const auto& w = rr.factor;
-    const double sum = w[0] + w[1] + w[2] + w[3];
+    const double sum = rr.factor[0] + rr.factor[1] + rr.factor[2] + rr.factor[3];
     const double spread = std::sqrt(rr.sigma[0] * rr.sigma[0] + rr.sigma[1] * rr.sigma[1] + rr.sigma[2] * rr.sigma[2] +
                                     rr.sigma[3] * rr.sigma[3]);
-    // The inverse of calibrationPerturbation's product, to first order (as
-    // the radii differ by a few percent, to 0.02 %).
-    const std::array<std::pair<CalParam, double>, 4> radii{{
-        {CalParam::WheelRadius, sum / 4},
-        {CalParam::WheelRadiusSplit, 2 * ((w[0] + w[1]) - (w[2] + w[3])) / sum},
-        {CalParam::WheelRadiusSide, 2 * ((w[0] + w[2]) - (w[1] + w[3])) / sum},
-        {CalParam::WheelRadiusDiag, 2 * ((w[0] + w[3]) - (w[1] + w[2])) / sum},
-    }};
-    for (const auto& [param, value] : radii) {
-      const size_t i = static_cast<size_t>(param);
+    const std::array<double, 4> radii = radiusValues(rr.factor);
+    for (size_t i = kRadius; i < kRadius + radii.size(); ++i) {
+      const double value = radii[i - kRadius];
       if (o.fixed[i]) continue;
       const CalParamInfo& info = calParams()[i];
       if (!std::isfinite(value) || value < info.lower || value > info.upper)

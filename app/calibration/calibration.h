@@ -205,6 +205,11 @@ struct RollingRadii {
   static constexpr double kSlipping = 0.05;
 };
 RollingRadii radiiFromRolling(const WorldModel& files, const std::vector<RobotFrame>& frames);
+/// The wheel radius and its front-rear, left-right and diagonal splits of
+/// four tyre radius factors (FL FR RL RR): the inverse of the product the
+/// twins apply (calibratedWorld), to first order (as the radii differ by a
+/// few percent, to 0.02 %). In CalParam order, WheelRadius first.
+std::array<double, 4> radiusValues(const std::array<double, 4>& factors);
 
 /// The parameters the full-physics twins (rehearsals, robustness runs,
 /// sweeps) are given. The fits run in the ghost's coarser profile, and a
