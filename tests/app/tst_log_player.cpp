@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "tests/default_step.h"
 #include "app/tools/headless_runner.h"
 #include "app/console/console_session.h"
 #include "app/log/log_player.h"
@@ -98,7 +99,7 @@ class TestLogPlayer : public QObject {
     std::string error;
     const std::optional<BranchPoint> b = branchAt(log_, 3.0, error);
     QVERIFY2(b, error.c_str());
-    QCOMPARE(b->step, int64_t{3000});
+    QCOMPARE(b->step, sp::test::stepAt(3.0));
     QVERIFY(b->loggedHash.has_value());
     QCOMPARE(b->hash, *b->loggedHash);
     const std::optional<BranchPoint> later = branchAt(log_, 3.5, error);
@@ -117,7 +118,7 @@ class TestLogPlayer : public QObject {
     robot->stop();
     auto branch = SessionLogReader::open(o.logPath, error);
     QVERIFY2(branch, error.c_str());
-    QCOMPARE(branch->snapshotSteps().front(), int64_t{3000});
+    QCOMPARE(branch->snapshotSteps().front(), sp::test::stepAt(3.0));
     QCOMPARE(branch->snapshot(3000)->second, b->hash);
     QCOMPARE(branch->meta().at("parent_log"), log_);
     QCOMPARE(branch->meta().at("parent_time"), std::string("3"));
@@ -195,7 +196,7 @@ class TestLogPlayer : public QObject {
     const std::optional<BranchPoint> rebuilt = remote->branchAt(3.0, error);
     QVERIFY2(rebuilt, error.c_str());
     QVERIFY(rebuilt->reconstructed);
-    QCOMPARE(rebuilt->step, int64_t{3000});
+    QCOMPARE(rebuilt->step, sp::test::stepAt(3.0));
     const std::optional<BranchPoint> exact = full->branchAt(3.0, error);
     QVERIFY2(exact && !exact->reconstructed, error.c_str());
 

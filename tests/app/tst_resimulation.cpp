@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "tests/default_step.h"
 #include "app/tools/headless_runner.h"
 #include "app/log/resimulation.h"
 #include "app/log/session_log.h"
@@ -65,13 +66,13 @@ class TestResimulation : public QObject {
     // From the snapshot at 1 s, after the edit: the snapshot carries the heights.
     report = resimulate(path, {.from = 1.0, .progress = {}}, error);
     QVERIFY2(report && !report->divergence, error.c_str());
-    QCOMPARE(report->startStep, int64_t{1000});
+    QCOMPARE(report->startStep, sp::test::stepAt(1.0));
 
     QVERIFY(execSql(path, "DELETE FROM commands WHERE text LIKE 'terrain %'"));
     report = resimulate(path, {}, error);
     QVERIFY2(report, error.c_str());
     QVERIFY(report->divergence);
-    QCOMPARE(report->divergence->step, int64_t{1000});
+    QCOMPARE(report->divergence->step, sp::test::stepAt(1.0));
   }
 
   // Issue 35: "every session log re-simulates bit for bit" is claimed for
@@ -205,7 +206,7 @@ class TestResimulation : public QObject {
     QVERIFY(report->divergence);
     QCOMPARE(report->divergence->step, expectedStep);
     QVERIFY(report->divergence->expected != report->divergence->actual);
-    QVERIFY(std::abs(report->divergence->time - 0.001 * static_cast<double>(expectedStep)) < 1e-9);
+    QVERIFY(std::abs(report->divergence->time - sp::test::defaultStep() * static_cast<double>(expectedStep)) < 1e-9);
   }
 
   // Starting from the periodic snapshot at 2 s (asked for 2.5 s) compares
@@ -220,10 +221,10 @@ class TestResimulation : public QObject {
     auto report = resimulate(path, options, error);
     QVERIFY2(report, error.c_str());
     QVERIFY(!report->divergence);
-    QCOMPARE(report->startStep, int64_t{2000});
+    QCOMPARE(report->startStep, sp::test::stepAt(2.0));
     QCOMPARE(report->hashesCompared, 2);  // 2 s and 3 s
     QCOMPARE(report->commandsApplied, 0);
-    QCOMPARE(report->endStep, int64_t{3000});
+    QCOMPARE(report->endStep, sp::test::stepAt(3.0));
   }
 
   // A file that is not a session log is refused with a message naming it.

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <thread>
 
+#include "tests/default_step.h"
 #include "app/tools/headless_runner.h"
 #include "app/log/session_log.h"
 #include "app/log/snapshot_codec.h"
@@ -76,7 +77,7 @@ class TestSessionLog : public QObject {
     const std::string worldFile = "terrains/flat.world.xml";
     std::unique_ptr<World> world = makeWorld(worldFile);
     QVERIFY(world);
-    QCOMPARE(world->params().step, 0.001);
+    QCOMPARE(world->params().step, sp::test::defaultStep());
 
     SessionInfo info;
     info.programVersion = "test";
@@ -384,7 +385,7 @@ class TestSessionLog : public QObject {
     QCOMPARE(logged.size(), std::size_t{2});
     QCOMPARE(logged[0].step, int64_t{0});
     QCOMPARE(logged[0].source, std::string("sequence"));
-    QCOMPARE(logged[1].step, int64_t{500});
+    QCOMPARE(logged[1].step, sp::test::stepAt(0.5));
     QCOMPARE(logged[1].text, std::string("stop"));
     QCOMPARE(reader->samplesBetween(0, 10).size(), std::size_t{201});
     QCOMPARE(reader->laserBetween(0, 10).size(), std::size_t{40});
@@ -437,7 +438,7 @@ class TestSessionLog : public QObject {
     QVERIFY2(reader, error.c_str());
     const std::vector<LogSample> found = reader->samplesBetween(1.0, 1.0999);
     QCOMPARE(found.size(), std::size_t{100});
-    QCOMPARE(found.front().step, int64_t{1000});
+    QCOMPARE(found.front().step, sp::test::stepAt(1.0));
     QCOMPARE(reader->laserBetween(1.0, 1.0999).size(), std::size_t{2});
   }
 };

@@ -20,6 +20,7 @@
 #include <sstream>
 #include <thread>
 
+#include "tests/default_step.h"
 #include "app/log/resimulation.h"
 #include "app/log/session_log.h"
 #include "app/robot/stand_in.h"
@@ -184,14 +185,14 @@ class TestStandIn : public QObject {
     // applied at or after the step its event was written at.
     const auto estop = std::find_if(events.begin(), events.end(), [](const LogEvent& e) { return e.kind == "estop"; });
     QVERIFY(estop->step > commands[0].step && estop->step <= commands[1].step);
-    QCOMPARE(estop->time, static_cast<double>(estop->step) * 0.001);
+    QCOMPARE(estop->time, static_cast<double>(estop->step) * sp::test::defaultStep());
 
     // Samples at 100 Hz, a snapshot at start, every second and at the end.
     const std::vector<int64_t> snapshots = reader->snapshotSteps();
     QVERIFY(snapshots.size() >= 3);
     QCOMPARE(snapshots.front(), int64_t{0});
-    QCOMPARE(snapshots[1], int64_t{1000});
-    const double end = static_cast<double>(snapshots.back()) * 0.001;
+    QCOMPARE(snapshots[1], sp::test::stepAt(1.0));
+    const double end = static_cast<double>(snapshots.back()) * sp::test::defaultStep();
     const std::vector<LogSample> samples = reader->samplesBetween(0, end);
     QVERIFY2(std::abs(static_cast<double>(samples.size()) - end * 100) <= 2, qPrintable(QString::number(samples.size())));
     QVERIFY(!reader->laserBetween(0, end).empty());

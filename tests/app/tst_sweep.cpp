@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "tests/default_step.h"
 #include "app/log/resimulation.h"
 #include "app/sweep/sweep.h"
 #include "tests/app/sweep_results.h"
@@ -196,7 +197,7 @@ class TestSweep : public QObject {
     auto robot = World::create(*world, params, diag);
     QVERIFY(robot);
     QCOMPARE(robot->submit(DriveCmd{0.4, 0}), std::string());
-    for (int i = 0; i < 500; ++i) QVERIFY(robot->step());
+    for (int64_t i = 0; i < sp::test::stepAt(0.5); ++i) QVERIFY(robot->step());
     const RobotReadout r = readRobot(*robot);
     RehearsalStart start{r.base, r.baseLinearVelocity, r.baseAngularVelocity, r.jointPositions, r.jointRates, {}};
     const RehearsalPlan plan{*world, params, rules, *commands, start};

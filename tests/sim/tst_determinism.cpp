@@ -8,6 +8,7 @@
 #include <cstring>
 #include <thread>
 
+#include "tests/default_step.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/world.h"
@@ -183,7 +184,7 @@ class TestDeterminism : public QObject {
     auto seq = loadCommandSequence(std::string(SP_SOURCE_DIR) + "/terrains/demo.seq", diag, &robot);
     QVERIFY(seq);
     size_t next = 0;
-    while (w->stepCount() < 3000) {
+    while (w->stepCount() < sp::test::stepAt(3.0)) {
       while (next < seq->size() && (*seq)[next].time <= w->time() + 1e-9) w->submit((*seq)[next++].command);
       w->step();
     }

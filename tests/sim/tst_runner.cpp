@@ -13,7 +13,14 @@ using namespace sp;
 
 namespace {
 
-std::unique_ptr<World> flatWorld(SimParams params = {}) {
+// The runner's boundaries at a known step: 1 ms, whatever the default.
+SimParams oneMillisecond() {
+  SimParams p;
+  p.step = 0.001;
+  return p;
+}
+
+std::unique_ptr<World> flatWorld(SimParams params = oneMillisecond()) {
   Diagnostics diag;
   std::optional<WorldModel> model = loadWorld("terrains/flat.world.xml", diag);
   if (!model) {

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "tests/default_step.h"
 #include "tests/sim/world_fixture.h"
 
 using namespace sp;
@@ -161,7 +162,7 @@ class TestSensors : public QObject {
     QCOMPARE(pose.pose, world->linkPose(0, 1));
   }
 
-  // Each sensor samples at its own rate: over 1 s at a 1 ms step, the
+  // Each sensor samples at its own rate: over 1 s at the default step, the
   // 20 Hz laser samples 20 times, the 100 Hz pose 100 times, the encoder
   // (rate 0) every step.
   void ratesAreKept() {
@@ -171,14 +172,14 @@ class TestSensors : public QObject {
                          scannerRobot(1.0, 0));
     QVERIFY(world);
     int counts[3] = {0, 0, 0};
-    for (int i = 0; i < 1000; ++i) {
+    for (int64_t i = 0; i < sp::test::stepAt(1.0); ++i) {  // one second
       world->step();
       for (const auto& [robot, sensor] : world->sampledLastStep()) ++counts[sensor];
     }
     QCOMPARE(counts[0], 20);
-    QCOMPARE(counts[1], 1000);
+    QCOMPARE(counts[1], static_cast<int>(sp::test::stepAt(1.0)));  // every step
     QCOMPARE(counts[2], 100);
-    QCOMPARE(world->sensorSample(0, 0).step, int64_t{1000});
+    QCOMPARE(world->sensorSample(0, 0).step, sp::test::stepAt(1.0));
   }
 
   // Noise is seeded by the world: the same seed gives the same readings,
