@@ -131,4 +131,16 @@ std::vector<Pose> linkPoses(const RobotModel& robot, const Pose& base, std::span
   return poses;
 }
 
+WheelRolling wheelRolling(const RobotModel& robot, const JointSpec& joint, const LinkMotion& wheel) {
+  const Pose& zero = robot.links[static_cast<size_t>(joint.child)].pose;
+  const Pose& at = wheel.pose;
+  const Vec3 hub = transformPoint(at * inverse(zero), joint.anchor);
+  WheelRolling r;
+  r.axle = normalized(rotate(at.q * conjugate(zero.q), joint.axis));
+  const Vec3 v = wheel.linear + cross(wheel.angular, hub - at.p);
+  r.spin = dot(wheel.angular, r.axle);
+  r.across = v - dot(v, r.axle) * r.axle;
+  return r;
+}
+
 }  // namespace sp

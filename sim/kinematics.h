@@ -35,4 +35,15 @@ struct LinkMotion {
 std::vector<LinkMotion> linkMotions(const RobotModel& robot, const Pose& base, Vec3 baseLinear, Vec3 baseAngular,
                                     std::span<const double> jointPositions, std::span<const double> jointRates);
 
+/// A wheel's rolling: its spin about its axle and its hub's velocity across
+/// the axle, from the wheel link's motion (world frame). It rolls without
+/// slip when |spin| x radius = |across|.
+struct WheelRolling {
+  double spin = 0;  ///< about the axle, the joint's axis in the world [rad/s]
+  Vec3 axle;        ///< unit, world frame
+  Vec3 across;      ///< the hub's velocity less its part along the axle [m/s]
+};
+/// `joint` is the wheel's joint (robot.joints), `wheel` its child link's motion.
+WheelRolling wheelRolling(const RobotModel& robot, const JointSpec& joint, const LinkMotion& wheel);
+
 }  // namespace sp

@@ -494,18 +494,11 @@ RollingRadii radiiFromRolling(const WorldModel& files, const std::vector<RobotFr
     for (size_t w = 0; w < 4; ++w) {
       if (drive.wheels[w] < 0) continue;
       const JointSpec& joint = robot.joints[static_cast<size_t>(drive.wheels[w])];
-      const size_t link = static_cast<size_t>(joint.child);
-      const Pose zero = robot.links[link].pose;
-      const Pose& at = m[link].pose;
-      const Vec3 hub = transformPoint(at * inverse(zero), joint.anchor);
-      const Vec3 axle = normalized(rotate(at.q * conjugate(zero.q), joint.axis));
-      const Vec3 v = m[link].linear + cross(m[link].angular, hub - at.p);
-      const double spin = dot(m[link].angular, axle);
-      const Vec3 across = v - dot(v, axle) * axle;
-      if (std::abs(spin) < 0.5) continue;
+      const WheelRolling roll = wheelRolling(robot, joint, m[static_cast<size_t>(joint.child)]);
+      if (std::abs(roll.spin) < 0.5) continue;
       // Signed: the hub moves the way the spin rolls it on level ground.
-      const double sign = dot(across, cross(axle, Vec3{0, 0, 1})) * spin > 0 ? 1.0 : -1.0;
-      samples[w].push_back({std::abs(spin), sign * norm(across)});
+      const double sign = dot(roll.across, cross(roll.axle, Vec3{0, 0, 1})) * roll.spin > 0 ? 1.0 : -1.0;
+      samples[w].push_back({std::abs(roll.spin), sign * norm(roll.across)});
     }
   }
   for (size_t w = 0; w < 4; ++w) {

@@ -20,6 +20,20 @@ double angleBetween(const Quat& a, const Quat& b) {
   return 2 * std::atan2(std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z), std::abs(d.w));
 }
 
+/// A base and one child at `child` (zero pose), joined at `anchor` about `axis`.
+RobotModel twoLinks(Vec3 child, Vec3 anchor, Vec3 axis) {
+  RobotModel robot;
+  robot.links.resize(2);
+  robot.links[1].pose.p = child;
+  JointSpec joint;
+  joint.parent = 0;
+  joint.child = 1;
+  joint.anchor = anchor;
+  joint.axis = axis;
+  robot.joints.push_back(joint);
+  return robot;
+}
+
 }  // namespace
 
 class TestKinematics : public QObject {
@@ -29,15 +43,7 @@ class TestKinematics : public QObject {
   // A hinge about z through (1, 0, 0) turned by 90 degrees carries a child
   // at (2, 0, 0) to (1, 1, 0); a slider along x by 0.3 m moves it to 2.3.
   void hingeAndSliderByHand() {
-    RobotModel robot;
-    robot.links.resize(2);
-    robot.links[1].pose.p = {2, 0, 0};
-    JointSpec joint;
-    joint.parent = 0;
-    joint.child = 1;
-    joint.anchor = {1, 0, 0};
-    joint.axis = {0, 0, 1};
-    robot.joints.push_back(joint);
+    RobotModel robot = twoLinks({2, 0, 0}, {1, 0, 0}, {0, 0, 1});
     const Pose base{{10, 0, 0}, Quat{}};
 
     std::vector<double> q{kPi / 2};
@@ -53,6 +59,34 @@ class TestKinematics : public QObject {
     poses = linkPoses(robot, base, q);
     QVERIFY(std::abs(poses[1].p.x - 12.3) < 1e-12);
     QVERIFY(std::abs(poses[1].p.y) < 1e-12);
+  }
+
+  // A wheel of radius 0.2 about y, its link frame 0.1 m beside its hub (the
+  // anchor), turned 90 degrees about z (the axle now along -x), spinning at
+  // 3 rad/s and its hub moving at 0.6 m/s along y: rolling without slip,
+  // spin x radius = |across|; the link origin's own velocity differs from the
+  // hub's by spin x offset (which must be accounted for). Control: the same
+  // hub speed with the wheel locked (a slide) gives spin 0.
+  void wheelRollingByHand() {
+    const RobotModel robot = twoLinks({0, 0.1, 0}, {0, 0, 0}, {0, 1, 0});  // link frame beside the hub
+    const JointSpec& joint = robot.joints[0];
+    const Quat turn = quatFromAxisAngle({0, 0, 1}, kPi / 2);
+    LinkMotion wheel;
+    wheel.pose = {rotate(turn, Vec3{0, 0.1, 0}), turn};  // hub at the world origin
+    const Vec3 axle = rotate(turn, Vec3{0, 1, 0});       // (-1, 0, 0)
+    wheel.angular = 3.0 * axle;
+    const Vec3 hubVelocity{0, 0.6, 0};
+    // The link origin's velocity: the hub's plus angular x (origin - hub).
+    wheel.linear = hubVelocity + cross(wheel.angular, wheel.pose.p - Vec3{0, 0, 0});
+    const WheelRolling r = wheelRolling(robot, joint, wheel);
+    QVERIFY(std::abs(r.spin - 3.0) < 1e-12);
+    QVERIFY(norm(r.axle - axle) < 1e-12);
+    QVERIFY2(norm(r.across - hubVelocity) < 1e-12, qPrintable(QString::number(norm(r.across - hubVelocity))));
+    QVERIFY(std::abs(std::abs(r.spin) * 0.2 - norm(r.across)) < 1e-12);  // rolls without slip
+    wheel.angular = {};
+    wheel.linear = hubVelocity;
+    const WheelRolling locked = wheelRolling(robot, joint, wheel);
+    QVERIFY(std::abs(locked.spin) < 1e-12 && norm(locked.across) > 0.5);  // control: slides
   }
 
   // Every joint of the WorkPartner driven somewhere, the robot driving and
