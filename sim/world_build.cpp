@@ -154,7 +154,6 @@ World::~World() {
   dJointGroupDestroy(m.contacts);
   dSpaceDestroy(m.space);  // destroys the geoms too (cleanup mode on)
   dGeomDestroy(m.ray);
-  dGeomDestroy(m.tyreProxy);
   if (m.heightData) dGeomHeightfieldDataDestroy(m.heightData);
   dWorldSetStepThreadingImplementation(m.world, nullptr, nullptr);
   dWorldDestroy(m.world);
@@ -178,7 +177,6 @@ bool World::build(Diagnostics& diag) {
   m.randState = static_cast<unsigned long>(params_.seed & 0xffffffffu);
   m.random.reseed(params_.seed);
   m.ray = dCreateRay(nullptr, 1.0);
-  m.tyreProxy = dCreateSphere(nullptr, 1.0);
   dGeomRaySetClosestHit(m.ray, 1);
   m.perThreadRandom = odeRandomIsPerThread();
   m.scratch.resize(static_cast<size_t>(std::max(1, params_.maxContacts)));
@@ -229,6 +227,7 @@ bool World::build(Diagnostics& diag) {
     toOde(q, oq);
     dGeomSetQuaternion(m.terrainGeom, oq);
     dGeomSetPosition(m.terrainGeom, t.pose.p.x, t.pose.p.y, t.pose.p.z);
+    m.terrainPose = t.pose;
   }
   dGeomSetData(m.terrainGeom, &m.newInfo(terrainMaterial, -1, -1));
 

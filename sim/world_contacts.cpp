@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <array>
 
+#include "sim/height_grid_sphere.h"
+
 namespace sp {
 using namespace world_detail;
 
@@ -45,30 +47,39 @@ int mergeTyrePatch(dContactGeom* c, int n) {
 
 }  // namespace
 
-// ODE collides a cylinder with a heightfield through the planes of the
-// triangles near it, and at a crease between two triangles a tyre's rim
-// ends up "below" the neighbouring triangle's plane: driving at 0.3 m/s
-// onto a 1 cm step of a 5 cm-sample heightfield, WorkPartner's wheel was
-// thrown 9 cm into the ground and the twin diverged (tst_terrain_edit
-// whatPassesTheCheckIsDriven); ODE's sphere path has no such crease. A
-// sphere of the tyre's radius at its centre touches ground where the tyre
-// does on level ground and within the tread's half-width on side slopes up
-// to about 14 degrees (asin(0.05 / 0.2)).
+// A tyre meets a heightfield as a sphere of its rolling radius at its
+// centre, which touches ground where the tyre does on level ground and
+// within the tread's half-width on side slopes up to about 14 degrees
+// (asin(0.05 / 0.2)). ODE's cylinder path threw a wheel 9 cm into the ground
+// at a crease between two triangles (tst_terrain_edit
+// whatPassesTheCheckIsDriven); ODE's sphere path misses ridges
+// (sim/height_grid_sphere.h), so the sphere is collided here, with the
+// grid ODE reads.
 int World::Impl::collidePair(dGeomID g1, dGeomID g2, dContactGeom* out, int max) {
   const auto* i1 = static_cast<const GeomInfo*>(dGeomGetData(g1));
   const auto* i2 = static_cast<const GeomInfo*>(dGeomGetData(g2));
-  dGeomID a = g1, b = g2;
-  const auto proxy = [&](dGeomID tyre, const GeomInfo* info) {
-    dGeomSphereSetRadius(tyreProxy, info->rollRadius);
-    const dReal* p = dGeomGetPosition(tyre);
-    dGeomSetPosition(tyreProxy, p[0], p[1], p[2]);
-    return tyreProxy;
-  };
-  if (i1->tyre && dGeomGetClass(g2) == dHeightfieldClass) a = proxy(g1, i1);
-  else if (i2->tyre && dGeomGetClass(g1) == dHeightfieldClass) b = proxy(g2, i2);
-  const int n = dCollide(a, b, max, out, sizeof(dContactGeom));
-  for (int k = 0; k < n; ++k) out[k].g1 = g1, out[k].g2 = g2;
-  return n;
+  const bool tyreFirst = i1->tyre && dGeomGetClass(g2) == dHeightfieldClass;
+  if (tyreFirst || (i2->tyre && dGeomGetClass(g1) == dHeightfieldClass)) {
+    const dReal* p = dGeomGetPosition(tyreFirst ? g1 : g2);
+    const Vec3 local = rotate(conjugate(terrainPose.q), Vec3{p[0], p[1], p[2]} - terrainPose.p);
+    std::array<SurfaceContact, 64> found;
+    const int n = sphereContacts(*grid, local, (tyreFirst ? i1 : i2)->rollRadius, found.data(),
+                                 std::min(max, static_cast<int>(found.size())));
+    // ODE's convention: the normal pushes the first geom out of the second.
+    const double sign = tyreFirst ? 1.0 : -1.0;
+    for (int k = 0; k < n; ++k) {
+      const Vec3 at = terrainPose.p + rotate(terrainPose.q, found[static_cast<size_t>(k)].position);
+      const Vec3 normal = sign * rotate(terrainPose.q, found[static_cast<size_t>(k)].normal);
+      out[k] = dContactGeom{};
+      out[k].pos[0] = at.x, out[k].pos[1] = at.y, out[k].pos[2] = at.z;
+      out[k].normal[0] = normal.x, out[k].normal[1] = normal.y, out[k].normal[2] = normal.z;
+      out[k].depth = found[static_cast<size_t>(k)].depth;
+      out[k].g1 = g1, out[k].g2 = g2;
+      out[k].side1 = out[k].side2 = -1;
+    }
+    return n;
+  }
+  return dCollide(g1, g2, max, out, sizeof(dContactGeom));
 }
 
 void World::Impl::nearCallback(void* data, dGeomID g1, dGeomID g2) {

@@ -137,9 +137,9 @@ struct World::Impl {
     gridMax = hi;
     dGeomHeightfieldDataSetBounds(heightData, lo, hi);
   }
+  Pose terrainPose;  // the heightfield's (world frame), for collidePair()
   double planeHeight = 0;
   dGeomID ray = nullptr;  // for castRay(); in no space
-  dGeomID tyreProxy = nullptr;  // collidePair(): a tyre against a heightfield, as a sphere; in no space
   struct RayTarget {
     dGeomID geom;
     std::array<double, 6> box;  // ODE's AABB: min x, max x, min y, ...

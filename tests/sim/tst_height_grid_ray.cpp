@@ -15,10 +15,12 @@
 #include "sim/height_grid.h"
 #include "sim/height_grid_ray.h"
 #include "sim/math.h"
+#include "tests/sim/ode_heightfield.h"
 
 using sp::HeightGrid;
 using sp::intersectRay;
 using sp::Vec3;
+using sp::test::OdeHeightfield;
 
 Q_DECLARE_METATYPE(sp::Vec3)
 
@@ -87,62 +89,6 @@ HeightGrid nonPlanarGrid() {
   return g;
 }
 
-// ODE's heightfield geom built from a grid exactly as sim/world.cpp builds the
-// terrain, and an ODE ray geom to cast against it.
-class OdeHeightfield {
- public:
-  explicit OdeHeightfield(const HeightGrid& grid) : grid_(grid) {
-    data_ = dGeomHeightfieldDataCreate();
-    dGeomHeightfieldDataBuildCallback(data_, &grid_, &OdeHeightfield::heightAt, grid_.width, grid_.depth,
-                                      grid_.columns, grid_.rows, 1.0, 0.0, 1.0, 0);
-    dGeomHeightfieldDataSetBounds(data_, grid_.minHeight(), grid_.maxHeight());
-    geom_ = dCreateHeightfield(nullptr, data_, 1);
-    // ODE's heightfield is y-up: turn it +90 deg about x so heights point up z.
-    const sp::Quat q = sp::quatFromAxisAngle({1, 0, 0}, sp::kPi / 2);
-    const dQuaternion oq = {q.w, q.x, q.y, q.z};
-    dGeomSetQuaternion(geom_, oq);
-    dGeomSetPosition(geom_, 0, 0, 0);
-    ray_ = dCreateRay(nullptr, 1.0);
-  }
-  ~OdeHeightfield() {
-    dGeomDestroy(ray_);
-    dGeomDestroy(geom_);
-    dGeomHeightfieldDataDestroy(data_);
-  }
-  OdeHeightfield(const OdeHeightfield&) = delete;
-  OdeHeightfield& operator=(const OdeHeightfield&) = delete;
-
-  // The nearest of all contacts (ODE reports one per triangle plane crossed,
-  // in no particular order); the contact depth of a ray is its distance.
-  std::optional<double> cast(Vec3 origin, Vec3 dir, double range) {
-    dGeomRaySetLength(ray_, range);
-    dGeomRaySet(ray_, origin.x, origin.y, origin.z, dir.x, dir.y, dir.z);
-    const int n = dCollide(geom_, ray_, kMaxContacts, contacts_.data(), sizeof(dContactGeom));
-    overflowed_ = overflowed_ || n >= kMaxContacts;
-    std::optional<double> best;
-    for (int k = 0; k < n; ++k)
-      if (!best || contacts_[static_cast<std::size_t>(k)].depth < *best) best = contacts_[static_cast<std::size_t>(k)].depth;
-    return best;
-  }
-  bool overflowed() const { return overflowed_; }
-
- private:
-  static constexpr int kMaxContacts = 1024;
-
-  static dReal heightAt(void* data, int x, int z) {
-    const HeightGrid& g = *static_cast<const HeightGrid*>(data);
-    // ODE row z is our row rows-1-z (its z axis points to our -y).
-    return g.at(x, g.rows - 1 - z);
-  }
-
-  HeightGrid grid_;
-  dHeightfieldDataID data_ = nullptr;
-  dGeomID geom_ = nullptr;
-  dGeomID ray_ = nullptr;
-  std::array<dContactGeom, kMaxContacts> contacts_{};
-  bool overflowed_ = false;
-};
-
 QString describe(Vec3 o, Vec3 d, double range) {
   return QString("origin (%1, %2, %3) direction (%4, %5, %6) range %7")
       .arg(o.x, 0, 'g', 17)
@@ -162,10 +108,7 @@ class TestHeightGridRay : public QObject {
   Q_OBJECT
 
  private slots:
-  void initTestCase() {
-    dInitODE2(0);
-    dAllocateODEDataForThread(dAllocateMaskAll);
-  }
+  void initTestCase() { sp::test::initOde(); }
 
   void cleanupTestCase() { dCloseODE(); }
 
