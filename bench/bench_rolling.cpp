@@ -34,6 +34,7 @@
 #include "sim/command_file.h"
 #include "sim/kinematics.h"
 #include "sim/model_loader.h"
+#include "sim/readout.h"
 #include "sim/runner.h"
 #include "sim/world.h"
 
@@ -59,17 +60,13 @@ Bodies bodies(const WorldModel& model, const SimParams& params, const std::vecto
   Runner runner(*w);
   runner.schedule(drive);
   std::array<std::vector<double>, 4> ratio;
-  std::vector<double> q(robot.joints.size()), rates(robot.joints.size());
   Bodies out;
   out.chain = 0;
   for (double t = 1.0; t <= 10.0 + 1e-9; t += 0.02) {
     runner.advanceToTime(t);
-    for (size_t j = 0; j < robot.joints.size(); ++j) {
-      q[j] = w->jointPosition(0, static_cast<int>(j));
-      rates[j] = w->jointRate(0, static_cast<int>(j));
-    }
-    const std::vector<LinkMotion> rebuilt =
-        linkMotions(robot, w->linkPose(0, 0), w->linkLinearVelocity(0, 0), w->linkAngularVelocity(0, 0), q, rates);
+    const RobotReadout now = readRobot(*w);
+    const std::vector<LinkMotion> rebuilt = linkMotions(robot, now.base, now.baseLinearVelocity,
+                                                        now.baseAngularVelocity, now.jointPositions, now.jointRates);
     for (size_t k = 0; k < 4; ++k) {
       const JointSpec& j = robot.joints[static_cast<size_t>(robot.drive->wheels[k])];
       const WheelRolling r = wheelRolling(
