@@ -185,6 +185,7 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
     return out;
   };
   for (double end = gWindow; end <= 30 + 1e-9; end += 3) {
+    o.startSigma = estimate.sigma;
     const CalibrationFit fit = fitCalibration(world, profile, framesUpTo(end), d.commands, estimate.value, o);
     fitMs.push_back(fit.wallMs);
     ++c.fits;

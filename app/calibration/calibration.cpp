@@ -94,8 +94,16 @@ CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit, double ove
       continue;
     }
     const double drift = kDrift * calParams()[i].scale;
-    const double p = prior.sigma[i] * prior.sigma[i] + drift * drift * dt;
+    double p = prior.sigma[i] * prior.sigma[i] + drift * drift * dt;
     const double q = sigma * sigma;
+    // Covariance matching (a fading memory): a fit further from the prior
+    // than their deviations allow says the robot is not the constant the
+    // prior assumed (on the snowy track the mean radius the windows see
+    // moved 1 % in 12 s, each fit pinned to 0.25 %): the prior's variance
+    // grows to what the difference shows, so the newest windows speak for
+    // the next seconds. Within their deviations nothing changes.
+    const double d = fit.value[i] - prior.value[i];
+    p = std::max(p, d * d - q);
     out.value[i] = (prior.value[i] * q + fit.value[i] * p) / (p + q);
     out.sigma[i] = std::sqrt(p * q / (p + q));
   }
@@ -424,14 +432,19 @@ Normal normalEquations(const std::vector<std::vector<double>>& jac, const std::v
 // Observability is judged on the residuals' scales as given (far from the
 // fit they are large for want of fitting, not noise): a parameter is
 // observed when its deviation is at most `threshold` of its scale. The
-// deviations reported grow by the residuals' own scatter and by
+// deviations reported are the residuals' own scatter's, grown by
 // `correlated`, the residuals that move together (a segment's checkpoints
 // share its anchor's error: they count as one), so that fusing fits
-// (fuse()) weighs each window for what it is worth.
+// (fuse()) weighs each window for what it is worth: a window the twin
+// follows closely counts more than one it follows loosely (a fit that has
+// not yet converged). They were floored at the residuals' scales, which
+// made every window's about 1.5-2 % on the radius where the fits' errors
+// were 0.2-0.3 %, and the fusion weighed the first windows (fitted before
+// the splits were pinned) as much as the rest (docs/performance.md).
 std::vector<int> observable(const std::vector<std::vector<double>>& jac, const std::vector<double>& r,
                             std::vector<int> on, CalValues& sigma, double correlated, double threshold) {
   const double dof = std::max<double>(1, static_cast<double>(r.size()) - static_cast<double>(on.size()));
-  const double inflate = correlated * std::max(1.0, meanSquare(r) * static_cast<double>(r.size()) / dof);
+  const double inflate = correlated * meanSquare(r) * static_cast<double>(r.size()) / dof;
   while (!on.empty()) {
     const Normal n = normalEquations(jac, r, on);
     // The covariance's diagonal: one solve per unit vector.
@@ -561,6 +574,24 @@ std::string makeProblem(const WorldModel& files, const SimParams& profile, const
 }
 
 }  // namespace
+
+std::vector<double> consideredVariance(const std::vector<std::vector<double>>& jac, const std::vector<int>& on,
+                                       const std::vector<int>& held, const CalValues& heldVariance) {
+  std::vector<double> add(on.size(), 0);
+  if (on.empty() || held.empty()) return add;
+  const Normal n = normalEquations(jac, std::vector<double>(jac[static_cast<size_t>(on[0])].size(), 0), on);
+  for (int u : held) {
+    const std::vector<double>& ju = jac[static_cast<size_t>(u)];
+    std::vector<double> b(on.size(), 0), x;
+    for (size_t k = 0; k < on.size(); ++k) {
+      const std::vector<double>& jo = jac[static_cast<size_t>(on[k])];
+      for (size_t i = 0; i < ju.size(); ++i) b[k] += jo[i] * ju[i];
+    }
+    if (!solve(n.h, b, x)) return std::vector<double>(on.size(), INFINITY);
+    for (size_t k = 0; k < on.size(); ++k) add[k] += x[k] * x[k] * heldVariance[static_cast<size_t>(u)];
+  }
+  return add;
+}
 
 CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& in,
                               const std::vector<TimedCommand>& commands, const CalValues& start,
@@ -781,12 +812,28 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       if (!rolled[static_cast<size_t>(p)]) v[static_cast<size_t>(p)] = start[static_cast<size_t>(p)];
     fit.costAfter = fit.costBefore;
   }
-  // The deviations at the fit, inflated by the residuals' own scatter.
+  // The deviations at the fit, from the residuals' own scatter.
   std::sort(everSmooth.begin(), everSmooth.end());
   if (!everSmooth.empty()) {
     CalValues sigma{};
     on = observable(jac, *r, everSmooth, sigma, std::max(1.0, o.horizon / o.checkpoint), kUnobserved);
     for (int p : free) fit.sigma[static_cast<size_t>(p)] = sigma[static_cast<size_t>(p)];
+    // What the window moved with but could not pin stays at the start:
+    // the fitted ones carry its uncertainty.
+    std::vector<int> held;
+    CalValues heldVariance{};
+    for (int p : everSmooth)
+      if (std::find(on.begin(), on.end(), p) == on.end()) {
+        const size_t i = static_cast<size_t>(p);
+        held.push_back(p);
+        const double s = (o.startSigma[i] > 0 ? o.startSigma[i] : calParams()[i].scale) / calParams()[i].scale;
+        heldVariance[i] = s * s;
+      }
+    const std::vector<double> add = consideredVariance(jac, on, held, heldVariance);
+    for (size_t k = 0; k < on.size(); ++k) {
+      const size_t i = static_cast<size_t>(on[k]);
+      fit.sigma[i] = std::sqrt(fit.sigma[i] * fit.sigma[i] + add[k] * calParams()[i].scale * calParams()[i].scale);
+    }
   }
   for (int p : on) fit.observed[static_cast<size_t>(p)] = true;
   for (int p = 0; p < kFitted; ++p) {
@@ -802,11 +849,14 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       v[i] = start[i];  // unobserved: left alone
       continue;
     }
-    // Beyond a bound by less than three deviations is the bound (a delay
-    // of 0 fits to -2 +- 3 ms); further is a fit the physics refuses.
+    // Beyond a bound by less than three deviations, or by less than half
+    // the parameter's scale (what the fit calls unobserved), is the bound:
+    // the ghost's coarser profile can pull a value a little way out (a
+    // robot without delay fitted -19 +- 5 ms in a window on flat ground);
+    // further is a fit the physics refuses (tyres 1.3x the files').
     const CalParamInfo& info = calParams()[i];
     const double bounded = std::clamp(v[i], info.lower, info.upper);
-    if (!std::isfinite(v[i]) || std::abs(v[i] - bounded) > 3 * fit.sigma[i])
+    if (!std::isfinite(v[i]) || std::abs(v[i] - bounded) > std::max(3 * fit.sigma[i], kUnobserved * info.scale))
       return done(std::string(info.key) + " = " + shortestText(v[i]) + " is outside its physical bounds [" +
                   shortestText(info.lower) + ", " + shortestText(info.upper) + "]");
     v[i] = bounded;

@@ -28,13 +28,15 @@
 //     nothing linearised by hand has to agree with it, and a new parameter
 //     is one more column.
 //
-// Observability. From J'J, each parameter's standard deviation (inflated by
-// the residuals' own scatter when they exceed their scales); a parameter
-// whose deviation exceeds half its prior range (CalParamInfo::scale) is
-// unobserved: it is taken out of the fit, keeps its previous value and is
-// reported as such (friction while driving straight on grip). A fit's first
-// step takes only those within a quarter: far from the fit, a step along a
-// weakly pinned direction (the tyres' front-rear split) stalls the rest.
+// Observability. From J'J with each residual at its scale, each
+// parameter's standard deviation; a parameter whose deviation exceeds half
+// its prior range (CalParamInfo::scale) is unobserved: it is taken out of
+// the fit, keeps its previous value and is reported as such (friction while
+// driving straight on grip). A fit's first step takes only those within a
+// quarter: far from the fit, a step along a weakly pinned direction (the
+// tyres' front-rear split) stalls the rest. The deviations a fit reports
+// are its residuals' own scatter's, widened by what it held at uncertain
+// start values while the data moved with them (consideredVariance).
 //
 // Refusals: a window without enough driving, a twin that diverges, a fit
 // that lands outside a parameter's physical bounds: the previous values are
@@ -95,6 +97,11 @@ struct CalibrationOptions {
   /// Parameters held at their start values whatever the data says (the
   /// operator's choice, or a test fitting one).
   CalFlags fixed{};
+  /// The start values' deviations where known (a fused estimate's sigma);
+  /// 0 where never observed: the parameter's scale. A parameter the window
+  /// moves but cannot pin is held at its start, and what that start may be
+  /// off by widens the deviations of those fitted with it (fitCalibration).
+  CalValues startSigma{};
 };
 
 /// One fit over a window of telemetry.
@@ -124,6 +131,18 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
                               const std::vector<TimedCommand>& commands, const CalValues& start,
                               const CalibrationOptions& options = {}, const std::function<bool()>& abort = {});
 
+/// Consider covariance (Schmidt): the variance, in scaled units, that the
+/// parameters `on` owe to those `held` at their start values while the data
+/// moves with them. `jac` holds each parameter's column of scaled residual
+/// derivatives (d r / d (value / scale)); fitting `on` alone puts a held
+/// one's error into them by -H_oo^-1 H_ou per unit, and `heldVariance` is
+/// each held one's scaled variance about its start. Why: a first window too
+/// short to pin the tyres' diagonal split fitted the mean radius with the
+/// split held at 0, said it was pinned when it was 2.2 % off, and outweighed
+/// the later windows that fitted both (the test track, docs/performance.md).
+std::vector<double> consideredVariance(const std::vector<std::vector<double>>& jac, const std::vector<int>& on,
+                                       const std::vector<int>& held, const CalValues& heldVariance);
+
 /// What the console holds of the robot across fits: one window's fit is
 /// noisy (the contacts, a window of a few turns), so fits are fused.
 struct CalEstimate {
@@ -137,7 +156,10 @@ CalEstimate filesEstimate();
 /// `prior` updated by `fit` (accepted): each parameter the fit observed is
 /// fused by inverse-variance weighting (a Kalman update of a constant),
 /// its prior deviation first grown by kDrift per second since the prior's
-/// time (a robot's tyres and loads do change, slowly); the rest are kept.
+/// time (a robot's tyres and loads do change, slowly) and, where the fit
+/// lies further from the prior than their deviations allow, to what the
+/// difference shows (covariance matching: the estimate follows a robot
+/// that changed rather than averaging it away); the rest are kept.
 /// `overlap`: how many fits each frame is in (window over period: the live
 /// fitter's 8 s every 3 s is 2.7); the fit's variances are multiplied by
 /// it, so that overlapping windows are not counted as independent.
@@ -149,13 +171,11 @@ constexpr double kDrift = 0.005;
 /// files' (a robot that is its twin keeps its twin: the fits' noise is not
 /// applied).
 CalValues significantValues(const CalEstimate& estimate);
-/// Half a deviation: the fused deviations are conservative (the radius's
-/// about 0.9 % on the test track where the fits' errors over 20 robots
-/// were 0.35 % RMS), and at one a robot whose tyres were 0.3 % off kept the
-/// files' (the track's ghost 1.32x the matched twin's error, 1.14x at a
-/// half); at none a robot that is its twin got a spurious 1.9 % diagonal
-/// split on flat ground (its ghost 16 % worse). docs/performance.md.
-constexpr double kSignificance = 0.5;
+/// Two deviations, the usual test, now that the deviations are the fits'
+/// own scatter's (at half a deviation of the old, floored ones a robot
+/// that is its twin kept its twin; at none it got a spurious 1.9 %
+/// diagonal split on flat ground). docs/performance.md, "Honest deviations".
+constexpr double kSignificance = 2;
 
 /// How far the twin calibrated by `values` lands from the robot `horizon`
 /// seconds after each anchor (every `spacing` s along the driving parts of

@@ -117,6 +117,7 @@ void LiveCalibrator::run() {
     std::vector<RobotFrame> frames;
     std::vector<TimedCommand> commands;
     CalValues start{};
+    CalibrationOptions fitOptions;
     {
       std::unique_lock lock(mutex_);
       wake_.wait(lock, [&] {
@@ -127,9 +128,11 @@ void LiveCalibrator::run() {
       frames.assign(frames_.begin(), frames_.end());
       commands.assign(commands_.begin(), commands_.end());
       start = estimate_.value;
+      fitOptions = options_.fit;
+      fitOptions.startSigma = estimate_.sigma;
       lastFitAt_ = frames.back().time;
     }
-    const CalibrationFit fit = fitCalibration(files_, profile_, frames, commands, start, options_.fit, [&] {
+    const CalibrationFit fit = fitCalibration(files_, profile_, frames, commands, start, fitOptions, [&] {
       if (options_.duringFit) options_.duringFit();
       std::lock_guard lock(mutex_);
       return stop_;
