@@ -94,16 +94,8 @@ CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit, double ove
       continue;
     }
     const double drift = kDrift * calParams()[i].scale;
-    double p = prior.sigma[i] * prior.sigma[i] + drift * drift * dt;
+    const double p = prior.sigma[i] * prior.sigma[i] + drift * drift * dt;
     const double q = sigma * sigma;
-    // Covariance matching (a fading memory): a fit further from the prior
-    // than their deviations allow says the robot is not the constant the
-    // prior assumed (on the snowy track the mean radius the windows see
-    // moved 1 % in 12 s, each fit pinned to 0.25 %): the prior's variance
-    // grows to what the difference shows, so the newest windows speak for
-    // the next seconds. Within their deviations nothing changes.
-    const double d = fit.value[i] - prior.value[i];
-    p = std::max(p, d * d - q);
     out.value[i] = (prior.value[i] * q + fit.value[i] * p) / (p + q);
     out.sigma[i] = std::sqrt(p * q / (p + q));
   }
