@@ -85,7 +85,7 @@ CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit, double ove
   out.time = std::max(prior.time, fit.to);
   const double dt = std::max(0.0, fit.to - prior.time);
   for (size_t i = 0; i < kCalParams; ++i) {
-    if (!fit.observed[i] || !(fit.sigma[i] > 0)) continue;
+    if (!fit.observed[i] || !(fit.sigma[i] > 0) || !std::isfinite(fit.sigma[i])) continue;  // no information
     const double sigma = fit.sigma[i] * std::sqrt(std::max(1.0, overlap));
     if (!prior.observed[i]) {
       out.value[i] = fit.value[i];

@@ -308,6 +308,8 @@ class TestCalibration : public QObject {
     QVERIFY(std::abs(e.sigma[kRadius] - std::sqrt(4e-6 * 1e-6 / 5e-6)) < 1e-12);
     for (size_t i = 0; i < kCalParams; ++i)
       if (i != kRadius) QCOMPARE(e.value[i], prior.value[i]);
+    fit.sigma[kRadius] = INFINITY;  // a fit that cannot say: no information, not a NaN
+    QCOMPARE(fuse(prior, fit).value[kRadius], prior.value[kRadius]);
   }
 
   // A parameter held at its start widens the deviation of one fitted with
