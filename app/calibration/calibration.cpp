@@ -571,16 +571,18 @@ std::vector<double> consideredVariance(const std::vector<std::vector<double>>& j
                                        const std::vector<int>& held, const CalValues& heldVariance) {
   std::vector<double> add(on.size(), 0);
   if (on.empty() || held.empty()) return add;
-  const Normal n = normalEquations(jac, std::vector<double>(jac[static_cast<size_t>(on[0])].size(), 0), on);
-  for (int u : held) {
-    const std::vector<double>& ju = jac[static_cast<size_t>(u)];
-    std::vector<double> b(on.size(), 0), x;
-    for (size_t k = 0; k < on.size(); ++k) {
-      const std::vector<double>& jo = jac[static_cast<size_t>(on[k])];
-      for (size_t i = 0; i < ju.size(); ++i) b[k] += jo[i] * ju[i];
-    }
-    if (!solve(n.h, b, x)) return std::vector<double>(on.size(), INFINITY);
-    for (size_t k = 0; k < on.size(); ++k) add[k] += x[k] * x[k] * heldVariance[static_cast<size_t>(u)];
+  // One normal matrix over both: its `on` block is H_oo, each held one's
+  // column below it H_ou.
+  std::vector<int> both = on;
+  both.insert(both.end(), held.begin(), held.end());
+  const Normal n = normalEquations(jac, std::vector<double>(jac[static_cast<size_t>(on[0])].size(), 0), both);
+  std::vector<std::vector<double>> hoo(on.size());
+  for (size_t k = 0; k < on.size(); ++k) hoo[k].assign(n.h[k].begin(), n.h[k].begin() + static_cast<long>(on.size()));
+  for (size_t u = 0; u < held.size(); ++u) {
+    std::vector<double> b(on.size()), x;
+    for (size_t k = 0; k < on.size(); ++k) b[k] = n.h[k][on.size() + u];
+    if (!solve(hoo, b, x)) return std::vector<double>(on.size(), INFINITY);
+    for (size_t k = 0; k < on.size(); ++k) add[k] += x[k] * x[k] * heldVariance[static_cast<size_t>(held[u])];
   }
   return add;
 }
