@@ -654,10 +654,12 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
   std::string why = makeProblem(files, profile, frames, commands, o, pb);
   if (!why.empty()) return done(why);
   fit.segments = static_cast<int>(pb.segments.size());
-  if (fit.segments < o.minSegments)
+  if (fit.segments < o.minSegments) {
+    fit.wantsDriving = true;
     return done("not enough driving: " + std::to_string(fit.segments) + " segments of " + shortestText(o.horizon) +
                 " s with the wheels turning and the legs still in " + tenths(fit.to - fit.from) +
                 " s of telemetry (need " + std::to_string(o.minSegments) + ")");
+  }
 
   // The motor gain in closed form, the rest by Levenberg-Marquardt: the
   // wheels' turns are the motors' own output, so the robot's over the

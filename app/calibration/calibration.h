@@ -119,6 +119,9 @@ struct CalibrationFit {
   double wallMs = 0;
   /// "" when accepted; else why it was refused (value = the start's).
   std::string refused;
+  /// Refused only for want of driving (the robot stood, or walked): not a
+  /// fault, nothing to fit yet. The console says it waits, not that it refused.
+  bool wantsDriving = false;
 };
 
 /// Fits the calibration of the robot that reported `frames` (oldest first;

@@ -143,6 +143,7 @@ void LiveCalibrator::run() {
     if (!fit.refused.empty()) {
       ++state_.refusals;
       state_.lastRefusal = fit.refused;
+      state_.lastRefusalWantsDriving = fit.wantsDriving;
     } else if (!state_.frozen && estimate_.value == start) {  // not reset meanwhile
       estimate_ = fuse(estimate_, fit, options_.fit.window / options_.period);
       state_.applied = significantValues(estimate_);

@@ -50,6 +50,7 @@ struct CalibrationState {
   bool frozen = false;
   int fits = 0, refusals = 0;
   std::string lastRefusal;  ///< "" or why the last refused fit was
+  bool lastRefusalWantsDriving = false;  ///< ... for want of driving only (CalibrationFit::wantsDriving)
   std::vector<CalibrationFit> history;  ///< the fits, oldest first (at most kHistory)
   static constexpr size_t kHistory = 600;
 };

@@ -378,6 +378,7 @@ class TestCalibration : public QObject {
     if (refused) {
       QVERIFY2(fit.refused.find("calibration.wheel_radius") != std::string::npos, fit.refused.c_str());
       QVERIFY(fit.value == start);
+      QVERIFY(!fit.wantsDriving);  // a fault, not a wait
     } else {
       QVERIFY(std::abs(fit.value[0] - stretch) < 0.01);
     }
@@ -389,6 +390,7 @@ class TestCalibration : public QObject {
     QVERIFY2(d.problem.empty(), d.problem.c_str());
     const CalibrationFit fit = fitCalibration(world, ghostProfile(), d.frames, d.commands, filesCalValues());
     QVERIFY2(fit.refused.find("not enough driving: 0 segments") != std::string::npos, fit.refused.c_str());
+    QVERIFY(fit.wantsDriving);
   }
   // The console's fitter as it runs live: frames handed in one by one,
   // fits on its worker, fused. It learns the hidden radius, and the calls

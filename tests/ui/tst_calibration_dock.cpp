@@ -31,7 +31,8 @@ class TestCalibrationDock : public QObject {
 
  private slots:
   // A robot standing still has every fit refused for want of driving: the
-  // event list says so once, not every 3 s (three refusals, one line).
+  // event list says once that calibration waits (not that a fit was
+  // refused: nothing is wrong), not every 3 s (three refusals, one line).
   void standingStillSaysItOnce() {
     QTemporaryDir dir;
     QVERIFY(dir.isValid());
@@ -40,9 +41,10 @@ class TestCalibrationDock : public QObject {
     const QString error = test::startConsole(dir, QStringLiteral("terrains/flat.world.xml"), options, window);
     QVERIFY2(error.isEmpty(), qPrintable(error));
     MainWindow& w = *window;
-    int said = 0;
+    int said = 0, refusedSaid = 0;
     connect(&w.context(), &ConsoleContext::eventShown, this, [&](const QString& text) {
-      said += text.startsWith(QLatin1String("Calibration fit refused"));
+      said += text.startsWith(QLatin1String("Calibration waits for driving"));
+      refusedSaid += text.startsWith(QLatin1String("Calibration fit refused"));
     });
     LiveCalibrator* calibrator = w.context().session().calibrator();
     QVERIFY(calibrator);
@@ -51,6 +53,12 @@ class TestCalibrationDock : public QObject {
     qInfo("%d refusals standing still, %d said", calibrator->state().refusals, said);
     QVERIFY2(calibrator->state().lastRefusal.rfind("not enough driving", 0) == 0, calibrator->state().lastRefusal.c_str());
     QCOMPARE(said, 1);
+    QCOMPARE(refusedSaid, 0);
+    QVERIFY(calibrator->state().lastRefusalWantsDriving);
+    auto* job = w.job<CalibrationJob>();
+    QVERIFY(job);
+    QVERIFY2(job->panel()->statusLabel()->text().startsWith(QLatin1String("Waiting for driving")),
+             qPrintable(job->panel()->statusLabel()->text()));
   }
 
   void fitsShowFreezeResetSave() {

@@ -120,7 +120,9 @@ void CalibrationJob::refresh() {
     const int accepted = s.fits - s.refusals;
     if (kind != refusalSaid_ || accepted != acceptedWhenSaid_)
       context_->event(QStringLiteral("calibration"),
-                      tr("Calibration fit refused, the values kept: %1").arg(QString::fromStdString(s.lastRefusal)),
+                      (s.lastRefusalWantsDriving ? tr("Calibration waits for driving (the values kept): %1")
+                                                 : tr("Calibration fit refused, the values kept: %1"))
+                          .arg(QString::fromStdString(s.lastRefusal)),
                       false);  // the session logs the fit itself
     refusalSaid_ = kind;
     acceptedWhenSaid_ = accepted;

@@ -145,15 +145,19 @@ void CalibrationPanel::setLive(const CalibrationState* state, const QString& why
     text = tr("Drive to calibrate: a fit needs a few seconds of the wheels turning.");
   } else {
     const CalibrationFit& last = state->history.back();
-    text = last.refused.empty()
-               ? tr("Fit %1 at %2 s: %3 segments, cost %4 → %5, %6 ms.")
-                     .arg(state->fits)
-                     .arg(last.to, 0, 'f', 1)
-                     .arg(last.segments)
-                     .arg(last.costBefore, 0, 'g', 3)
-                     .arg(last.costAfter, 0, 'g', 3)
-                     .arg(last.wallMs, 0, 'f', 0)
-               : tr("Fit %1 refused, the values kept: %2").arg(state->fits).arg(QString::fromStdString(last.refused));
+    const QString reason = QString::fromStdString(last.refused);
+    if (last.wantsDriving)
+      text = tr("Waiting for driving (the values kept): %1").arg(reason);
+    else if (!last.refused.empty())
+      text = tr("Fit %1 refused, the values kept: %2").arg(state->fits).arg(reason);
+    else
+      text = tr("Fit %1 at %2 s: %3 segments, cost %4 → %5, %6 ms.")
+                 .arg(state->fits)
+                 .arg(last.to, 0, 'f', 1)
+                 .arg(last.segments)
+                 .arg(last.costBefore, 0, 'g', 3)
+                 .arg(last.costAfter, 0, 'g', 3)
+                 .arg(last.wallMs, 0, 'f', 0);
   }
   if (state->frozen) text += tr(" Frozen: new fits are not applied.");
   status_->setText(text);
