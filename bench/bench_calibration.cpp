@@ -193,8 +193,7 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
     return out;
   };
   for (double end = gWindow; end <= 30 + 1e-9; end += 3) {
-    o.startSigma = estimate.sigma;
-    const CalibrationFit fit = fitCalibration(world, profile, framesUpTo(end), d.commands, estimate.value, o);
+    const CalibrationFit fit = fitCalibration(world, profile, framesUpTo(end), d.commands, estimate, o);
     fitMs.push_back(fit.wallMs);
     ++c.fits;
     if (!fit.refused.empty()) ++c.refused;

@@ -567,6 +567,13 @@ std::string makeProblem(const WorldModel& files, const SimParams& profile, const
 
 }  // namespace
 
+CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& frames,
+                              const std::vector<TimedCommand>& commands, const CalEstimate& from, CalibrationOptions options,
+                              const std::function<bool()>& abort) {
+  options.startSigma = from.sigma;
+  return fitCalibration(files, profile, frames, commands, from.value, options, abort);
+}
+
 std::vector<double> consideredVariance(const std::vector<std::vector<double>>& jac, const std::vector<int>& on,
                                        const std::vector<int>& held, const CalValues& heldVariance) {
   std::vector<double> add(on.size(), 0);

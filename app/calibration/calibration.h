@@ -156,6 +156,11 @@ struct CalEstimate {
 };
 /// The files' values, none observed.
 CalEstimate filesEstimate();
+/// fitCalibration from a fused estimate: its values are the start, its
+/// deviations the start's (`options.startSigma`, set here).
+CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& frames,
+                              const std::vector<TimedCommand>& commands, const CalEstimate& from,
+                              CalibrationOptions options = {}, const std::function<bool()>& abort = {});
 /// `prior` updated by `fit` (accepted): each parameter the fit observed is
 /// fused by inverse-variance weighting (a Kalman update of a constant),
 /// its prior deviation first grown by kDrift per second since the prior's

@@ -116,8 +116,7 @@ void LiveCalibrator::run() {
   for (;;) {
     std::vector<RobotFrame> frames;
     std::vector<TimedCommand> commands;
-    CalValues start{};
-    CalibrationOptions fitOptions;
+    CalEstimate start;
     {
       std::unique_lock lock(mutex_);
       wake_.wait(lock, [&] {
@@ -127,12 +126,10 @@ void LiveCalibrator::run() {
       if (stop_) return;
       frames.assign(frames_.begin(), frames_.end());
       commands.assign(commands_.begin(), commands_.end());
-      start = estimate_.value;
-      fitOptions = options_.fit;
-      fitOptions.startSigma = estimate_.sigma;
+      start = estimate_;
       lastFitAt_ = frames.back().time;
     }
-    const CalibrationFit fit = fitCalibration(files_, profile_, frames, commands, start, fitOptions, [&] {
+    const CalibrationFit fit = fitCalibration(files_, profile_, frames, commands, start, options_.fit, [&] {
       if (options_.duringFit) options_.duringFit();
       std::lock_guard lock(mutex_);
       return stop_;
@@ -144,7 +141,7 @@ void LiveCalibrator::run() {
       ++state_.refusals;
       state_.lastRefusal = fit.refused;
       state_.lastRefusalWantsDriving = fit.wantsDriving;
-    } else if (!state_.frozen && estimate_.value == start) {  // not reset meanwhile
+    } else if (!state_.frozen && estimate_.value == start.value) {  // not reset meanwhile
       estimate_ = fuse(estimate_, fit, options_.fit.window / options_.period);
       state_.applied = significantValues(estimate_);
       state_.sigma = estimate_.sigma;

@@ -221,8 +221,7 @@ class TestCalibration : public QObject {
       std::vector<RobotFrame> upTo;
       for (const RobotFrame& f : d.frames)
         if (f.time <= end) upTo.push_back(f);
-      o.startSigma = estimate.sigma;
-      const CalibrationFit fit = fitCalibration(world, ghostProfile(), upTo, d.commands, estimate.value, o);
+      const CalibrationFit fit = fitCalibration(world, ghostProfile(), upTo, d.commands, estimate, o);
       print(fit);
       QVERIFY2(fit.refused.empty(), fit.refused.c_str());
       estimate = fuse(estimate, fit, o.window / 3);
