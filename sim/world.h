@@ -186,6 +186,10 @@ class World {
   /// A 64-bit hash of the dynamic state (bodies bit for bit, controllers,
   /// random states, step), to compare runs.
   uint64_t stateHash() const;
+  /// Which of ODE's broad phases finds this world's contact pairs: "simple"
+  /// for few geoms, "hash" for many (world_build.cpp). Either gives the
+  /// same contacts in the same order, so the same run.
+  const char* broadPhase() const;
 
   /// Latest sample of each sensor of a robot (step -1 until first sampled).
   const SensorSample& sensorSample(int robot, int sensor) const;
