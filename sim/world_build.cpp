@@ -10,9 +10,6 @@ namespace sp {
 using namespace world_detail;
 namespace {
 
-/// Mass properties of `geoms` (in their owner's frame) with `total` mass
-/// spread by volume, or with each geom's own mass when every geom has one
-/// (a link holdRigid() merged). A geom-less link gets a 5 cm sphere's inertia.
 // The broad phase. For the few geoms of a robot on its terrain (31 for
 // WorkPartner on flat ground) ODE's simple space, which tests every pair's
 // boxes, makes a rehearsal ~11 % faster than the hash space, whose every
@@ -30,6 +27,9 @@ dSpaceID collisionSpaceFor(const WorldModel& world) {
   return geoms <= kSimpleSpaceGeoms ? dSimpleSpaceCreate(nullptr) : dHashSpaceCreate(nullptr);
 }
 
+/// Mass properties of `geoms` (in their owner's frame) with `total` mass
+/// spread by volume, or with each geom's own mass when every geom has one
+/// (a link holdRigid() merged). A geom-less link gets a 5 cm sphere's inertia.
 dMass massOf(const std::vector<GeomSpec>& geoms, double total) {
   dMass sum;
   dMassSetZero(&sum);
