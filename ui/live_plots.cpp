@@ -159,7 +159,7 @@ WheelForcePlot::WheelForcePlot(QWidget* parent, std::size_t capacity)
   chart_->setTitle(tr("Wheel normal forces"));
   chart_->legend()->setAlignment(Qt::AlignRight);  // beside the plot: height is what a docked plot lacks
   xAxis_ = makeAxis(tr("robot time [s]"));
-  yAxis_ = makeAxis(tr("normal force [N]"));
+  yAxis_ = makeAxis(tr("force [N]"));  // the title says which: a longer one is elided
   chart_->addAxis(xAxis_, Qt::AlignBottom);
   chart_->addAxis(yAxis_, Qt::AlignLeft);
   const std::array<QString, kWheels> names = {tr("FL"), tr("FR"), tr("RL"), tr("RR")};
@@ -497,10 +497,12 @@ bool WheelForcePlot::replot(bool force) {
 // --------------------------------------------------------------- LaserPlot
 
 LaserPlot::LaserPlot(QWidget* parent) : LivePlot(parent), farthest_(std::numeric_limits<double>::infinity()) {
-  chart_->setTitle(tr("Laser scan (sensor frame)"));
+  // The frame in the tooltip: a docked plot is narrow, and the title
+  // "Laser scan (sensor frame)" came out elided at 1280 px.
+  chart_->setTitle(tr("Laser scan"));
   // No legend: a docked plot is short, and dots and a triangle say enough.
   chart_->legend()->hide();
-  setToolTip(tr("Dots: laser hits; triangle: the sensor, pointing forward"));
+  setToolTip(tr("Laser scan in the sensor's frame. Dots: laser hits; triangle: the sensor, pointing forward"));
   leftAxis_ = makeAxis(tr("y, left [m]"));
   leftAxis_->setReverse(true);  // seen from above with x up, +y is to the left
   forwardAxis_ = makeAxis(tr("x, forward [m]"));
