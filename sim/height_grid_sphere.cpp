@@ -72,9 +72,22 @@ int sphereContacts(const HeightGrid& g, Vec3 centre, double radius, SurfaceConta
   // to a face that holds it would press it twice for one penetration.
   std::vector<SurfaceContact> found;
   SurfaceContact edge{{}, {}, 0};
+  // A cell whose box (its four corners' bounds) lies farther from the
+  // centre than the radius holds no point of the sphere: neither of its
+  // triangles can touch it, and both are skipped. On a fine grid (the test
+  // track's 5 cm cells under 0.3 m tyres) that is nearly every cell of the
+  // square scanned, and the tyres' contacts were a third of a twin's time.
+  // The margin keeps the skip to cells the exact test would reject beyond
+  // any rounding, so the contacts stay the same bit for bit.
+  const double reach = radius + 1e-6;
   for (int j = j0; j <= j1; ++j)
     for (int i = i0; i <= i1; ++i) {
       const Vec3 v00 = vertex(i, j), v10 = vertex(i + 1, j), v11 = vertex(i + 1, j + 1), v01 = vertex(i, j + 1);
+      const double zLow = std::min({v00.z, v10.z, v11.z, v01.z}), zHigh = std::max({v00.z, v10.z, v11.z, v01.z});
+      const double dx = std::max({v00.x - centre.x, 0.0, centre.x - v10.x});
+      const double dy = std::max({v00.y - centre.y, 0.0, centre.y - v01.y});
+      const double dz = std::max({zLow - centre.z, 0.0, centre.z - zHigh});
+      if (dx * dx + dy * dy + dz * dz > reach * reach) continue;
       for (int t = 0; t < 2; ++t) {
         SurfaceContact c;
         const Touch k = t == 0 ? touch(centre, radius, v00, v10, v11, c)   // u >= v, as heightAt
