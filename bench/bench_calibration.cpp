@@ -4,7 +4,7 @@
 // 3 s, two steps each from the last values), then judged over the next 30 s
 // and on a rehearsed sequence. Prints a table; asserts nothing.
 //
-//   build/bench/bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J] [--seed S] [--iterations 1|2] [--window S] [--horizon S]
+//   build/bench/bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J] [--seed S] [--iterations N] [--window S] [--horizon S]
 //
 // Per world and seed:
 //   ghost error   the ghost's prediction over a 1 s each way link is 2 s
@@ -48,6 +48,7 @@
 #include <vector>
 
 #include "app/calibration/calibration.h"
+#include "app/calibration/live_calibrator.h"
 #include "app/calibration/recorded_drive.h"
 #include "app/ghost/ghost.h"
 #include "app/rehearse/rehearsal.h"
@@ -117,13 +118,13 @@ const char* const kRehearsedAlong =
     "20 drive 0.3 -5\n"
     "30 stop\n";
 
-// Levenberg-Marquardt steps per online fit: the console takes two when the
-// first leaves time within its period (app/calibration/live_calibrator.h),
-// else one; --iterations 1 measures the loaded case.
-int gIterations = 2;
+// Levenberg-Marquardt steps per online fit: the console's (it takes a
+// further one while the last left time within its period,
+// app/calibration/live_calibrator.h); --iterations 1 measures the loaded case.
+int gIterations = LiveCalibrator::Options{}.fit.iterations;
 // The fit's window and each segment's horizon [s]: the console's (8, 2)
 // unless --window / --horizon measure others.
-double gWindow = 8, gHorizon = 2;
+double gWindow = LiveCalibrator::Options{}.fit.window, gHorizon = LiveCalibrator::Options{}.fit.horizon;
 
 struct Case {
   std::string world;
@@ -305,7 +306,7 @@ int main(int argc, char** argv) {
     else if (a == "--window" && i + 1 < argc) gWindow = std::clamp(std::atof(argv[++i]), 3.0, 30.0);
     else if (a == "--horizon" && i + 1 < argc) gHorizon = std::clamp(std::atof(argv[++i]), 0.5, 8.0);
     else {
-      std::fprintf(stderr, "usage: bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J] [--seed S] [--iterations 1|2] [--window S] [--horizon S]\n");
+      std::fprintf(stderr, "usage: bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J] [--seed S] [--iterations N] [--window S] [--horizon S]\n");
       return 2;
     }
   }
