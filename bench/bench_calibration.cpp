@@ -118,13 +118,16 @@ const char* const kRehearsedAlong =
     "20 drive 0.3 -5\n"
     "30 stop\n";
 
+// The console's fit (app/calibration/live_calibrator.h), whose settings the
+// bench measures unless told otherwise.
+const CalibrationOptions kLive = LiveCalibrator::Options{}.fit;
 // Levenberg-Marquardt steps per online fit: the console's (it takes a
-// further one while the last left time within its period,
-// app/calibration/live_calibrator.h); --iterations 1 measures the loaded case.
-int gIterations = LiveCalibrator::Options{}.fit.iterations;
+// further one while the last left time within its period); --iterations 1
+// measures the loaded case.
+int gIterations = kLive.iterations;
 // The fit's window and each segment's horizon [s]: the console's (8, 2)
 // unless --window / --horizon measure others.
-double gWindow = LiveCalibrator::Options{}.fit.window, gHorizon = LiveCalibrator::Options{}.fit.horizon;
+double gWindow = kLive.window, gHorizon = kLive.horizon;
 
 struct Case {
   std::string world;

@@ -88,9 +88,9 @@ class TestDeterminism : public QObject {
   }
 
   // The broad phase chosen by the number of geoms does not change the run:
-  // the same world with 200 boxes far away (out of every reach) is found
-  // its pairs by the hash space instead of the simple one, step for step
-  // to the same hashes.
+  // with 200 boxes far away (out of every reach) the world's pairs are
+  // found by the hash space instead of the simple one, and it steps to the
+  // same hashes, step for step.
   void broadPhaseDoesNotChangeTheRun() {
     const WorldModel model = loadModel();
     WorldModel crowded = model;
