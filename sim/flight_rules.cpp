@@ -232,7 +232,37 @@ double supportMargin(Vec3 point, const std::vector<Vec3>& support) {
 }
 
 RuleMonitor::RuleMonitor(const FlightRules& rules, const RobotModel& robot, int robotIndex)
-    : rules_(rules), robot_(robot), robotIndex_(robotIndex) {
+    : rules_(rules), robot_(&robot), robotIndex_(robotIndex) {
+  bind();
+  for (int r = 0; r < kRuleCount; ++r) {
+    RuleVerdict v;
+    v.rule = static_cast<Rule>(r);
+    verdicts_.push_back(v);
+  }
+  closest_.assign(kRuleCount, -std::numeric_limits<double>::infinity());
+}
+
+void RuleMonitor::rebind(const RobotModel& robot) {
+  const RobotModel& was = *robot_;
+  const std::vector<Wheel> wheels = wheels_;
+  std::vector<std::pair<std::string, Limited>> limited;
+  for (const Limited& l : limited_) limited.emplace_back(was.joints[static_cast<size_t>(l.joint)].name, l);
+  robot_ = &robot;
+  bind();
+  for (Wheel& w : wheels_)
+    for (const Wheel& old : wheels)
+      if (old.name == w.name) w.offSince = old.offSince;
+  for (Limited& l : limited_)
+    for (const auto& [name, old] : limited)
+      if (name == robot.joints[static_cast<size_t>(l.joint)].name) {
+        l.parked = old.parked;
+        l.fresh = old.fresh;
+      }
+}
+
+void RuleMonitor::bind() {
+  const RobotModel& robot = *robot_;
+  wheels_.clear();
   if (robot.drive)
     for (int j : robot.drive->wheels) {
       if (j < 0) continue;
@@ -247,21 +277,16 @@ RuleMonitor::RuleMonitor(const FlightRules& rules, const RobotModel& robot, int 
   isWheel_.assign(robot.links.size(), false);
   for (const Wheel& w : wheels_) isWheel_[w.link] = true;
   touchAllowed_.assign(robot.links.size(), false);
-  for (const std::string& name : splitNames(rules.collisionAllowed))
+  for (const std::string& name : splitNames(rules_.collisionAllowed))
     if (const int l = robot.findLink(name); l >= 0) touchAllowed_[l] = true;
-  const std::vector<std::string> exempt = splitNames(rules.jointLimitExempt);
+  const std::vector<std::string> exempt = splitNames(rules_.jointLimitExempt);
+  limited_.clear();
   for (const ActuatorSpec& a : robot.actuators) {
     const JointSpec& j = robot.joints[a.joint];
     if (!j.limited || a.continuous || std::find(exempt.begin(), exempt.end(), j.name) != exempt.end()) continue;
-    const double margin = j.type == JointType::Slider ? rules.jointLimitMargin / 100 : degToRad(rules.jointLimitMargin);
+    const double margin = j.type == JointType::Slider ? rules_.jointLimitMargin / 100 : degToRad(rules_.jointLimitMargin);
     limited_.push_back({a.joint, j.lower, j.upper, margin});
   }
-  for (int r = 0; r < kRuleCount; ++r) {
-    RuleVerdict v;
-    v.rule = static_cast<Rule>(r);
-    verdicts_.push_back(v);
-  }
-  closest_.assign(kRuleCount, -std::numeric_limits<double>::infinity());
 }
 
 bool RuleMonitor::passed() const {
@@ -299,8 +324,8 @@ void RuleMonitor::check(const World& world) {
   if (!health.healthy()) return;
 
   // Collisions; which wheels touch the ground, and where.
-  std::vector<Vec3> wheelContactSum(robot_.links.size());
-  std::vector<int> wheelContactCount(robot_.links.size(), 0);
+  std::vector<Vec3> wheelContactSum(robot_->links.size());
+  std::vector<int> wheelContactCount(robot_->links.size(), 0);
   bool collided = false;
   double depth = 0;
   std::string collidedWhere;
@@ -316,8 +341,8 @@ void RuleMonitor::check(const World& world) {
     if (!collided || c.depth > depth) {
       depth = c.depth;
       std::string with = c.terrain ? "the ground" : c.object >= 0 ? "object " + std::to_string(c.object) : "a robot link";
-      if (c.otherRobot == r && c.otherLink >= 0) with = robot_.links[c.otherLink].name;
-      collidedWhere = robot_.links[c.link].name + " touches " + with;
+      if (c.otherRobot == r && c.otherLink >= 0) with = robot_->links[c.otherLink].name;
+      collidedWhere = robot_->links[c.link].name + " touches " + with;
     }
     collided = true;
   }
@@ -325,7 +350,7 @@ void RuleMonitor::check(const World& world) {
 
   // Support polygon: wheels on the ground, or as close to it as rocking takes them.
   std::vector<Vec3> support;
-  double radius = robot_.drive ? robot_.drive->wheelRadius : 0;
+  double radius = robot_->drive ? robot_->drive->wheelRadius : 0;
   double longestOff = 0;
   std::string offWheel;
   double force = 0;
@@ -381,14 +406,15 @@ void RuleMonitor::check(const World& world) {
   for (Limited& l : limited_) {
     const double q = world.jointPosition(r, l.joint);
     const double room = std::min(q - l.lower, l.upper - q);
-    if (!started_) l.parked = room < l.margin;
+    if (l.fresh) l.parked = room < l.margin;
+    l.fresh = false;
     if (l.parked && room < l.margin) continue;
     l.parked = false;
     if (room - l.margin < nearest - nearestMargin) {
       nearest = room;
       nearestMargin = l.margin;
-      nearestJoint = robot_.joints[l.joint].name;
-      slider = robot_.joints[l.joint].type == JointType::Slider;
+      nearestJoint = robot_->joints[l.joint].name;
+      slider = robot_->joints[l.joint].type == JointType::Slider;
     }
   }
   if (!nearestJoint.empty()) {
@@ -403,7 +429,6 @@ void RuleMonitor::check(const World& world) {
   const double yawRate = radToDeg(world.linkAngularVelocity(r, 0).z);
   record(Rule::Speed, speed > rules_.maxSpeed, speed, rules_.maxSpeed, speed, t, "");
   record(Rule::YawRate, std::abs(yawRate) > rules_.maxYawRate, yawRate, rules_.maxYawRate, std::abs(yawRate), t, "");
-  started_ = true;
 }
 
 }  // namespace sp

@@ -108,6 +108,12 @@ double supportMargin(Vec3 point, const std::vector<Vec3>& support);
 class RuleMonitor {
  public:
   RuleMonitor(const FlightRules& rules, const RobotModel& robot, int robotIndex = 0);
+  /// Goes on checking another form of the same robot (`robot` outlives the
+  /// monitor): a rehearsal that welds or frees joints mid-run. The verdicts
+  /// so far are kept; wheels and joints carry their state by name, and a
+  /// joint it did not watch before is judged parked or not at its next check,
+  /// as at the first (it was held still meanwhile).
+  void rebind(const RobotModel& robot);
   /// Checks the World's state now (after a step).
   void check(const World& world);
   /// One verdict per Rule, in Rule order.
@@ -127,14 +133,16 @@ class RuleMonitor {
     int joint;
     double lower, upper, margin;  // margin in the joint's unit
     bool parked = false;  // within the margin at the first check (a closed gripper): exempt until it leaves
+    bool fresh = true;    // not checked yet: its first check decides `parked`
   };
+  void bind();  // the per-link and per-joint tables for robot_
   // Records one rule's state: `bad` when the limit is broken; `closeness`
   // orders values for "worst" (larger = closer to breaking).
   void record(Rule rule, bool bad, double value, double limit, double closeness, double time,
               const std::string& where);
 
   FlightRules rules_;
-  const RobotModel& robot_;
+  const RobotModel* robot_;
   int robotIndex_;
   std::vector<Wheel> wheels_;
   std::vector<Limited> limited_;
@@ -143,7 +151,6 @@ class RuleMonitor {
   std::vector<RuleVerdict> verdicts_;
   std::vector<double> closest_;     // per rule: closeness of `worst`
   double margin_ = 0;
-  bool started_ = false;  // checked once: parked joints known
 };
 
 }  // namespace sp

@@ -38,6 +38,22 @@ std::vector<int> subtreeJoints(const RobotModel& robot, std::string_view name) {
   return out;
 }
 
+std::vector<int> unmovedSubtrees(const RobotModel& robot, const std::vector<bool>& moved) {
+  std::vector<int> held;
+  std::vector<bool> taken(robot.joints.size(), false);
+  for (size_t j = 0; j < robot.joints.size(); ++j) {
+    if (taken[j]) continue;
+    const std::vector<int> sub = subtreeJoints(robot, robot.joints[j].name);
+    if (std::any_of(sub.begin(), sub.end(), [&](int k) { return moved[static_cast<size_t>(k)]; })) continue;
+    for (int k : sub) {
+      taken[static_cast<size_t>(k)] = true;
+      held.push_back(k);
+    }
+  }
+  std::sort(held.begin(), held.end());
+  return held;
+}
+
 std::optional<RigidRobot> holdRigid(const RobotModel& robot, std::span<const double> jointPositions,
                                     const std::vector<int>& held, std::string& error) {
   const size_t nj = robot.joints.size(), nl = robot.links.size();

@@ -52,4 +52,9 @@ std::vector<double> rigidJoints(const RigidRobot& rigid, std::span<const double>
 /// in model order; empty if there is no such joint.
 std::vector<int> subtreeJoints(const RobotModel& robot, std::string_view name);
 
+/// The joints whose subtrees hold no joint marked in `moved` (one flag per
+/// joint), as whole subtrees, outermost first, sorted: what may be welded
+/// while the marked ones move.
+std::vector<int> unmovedSubtrees(const RobotModel& robot, const std::vector<bool>& moved);
+
 }  // namespace sp

@@ -1,5 +1,7 @@
 #include "app/rehearse/rehearsal.h"
 
+#include "app/rehearse/held_twin.h"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -107,19 +109,7 @@ std::vector<int> unmovedJoints(const RobotModel& robot, const std::vector<TimedC
     for (int w : robot.drive->wheels)
       if (w >= 0) moved[static_cast<size_t>(w)] = true;
   }
-  std::vector<int> held;
-  std::vector<bool> taken(robot.joints.size(), false);
-  for (size_t j = 0; j < robot.joints.size(); ++j) {
-    if (taken[j]) continue;
-    const std::vector<int> sub = subtreeJoints(robot, robot.joints[j].name);
-    if (std::any_of(sub.begin(), sub.end(), [&](int k) { return moved[static_cast<size_t>(k)]; })) continue;
-    for (int k : sub) {
-      taken[static_cast<size_t>(k)] = true;
-      held.push_back(k);
-    }
-  }
-  std::sort(held.begin(), held.end());
-  return held;
+  return unmovedSubtrees(robot, moved);
 }
 
 std::string placeRobot(World& world, const RehearsalStart& s, const RigidRobot* held) {
@@ -219,59 +209,45 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
                    std::to_string(full.joints.size());
     return result;
   }
-  // The joints the sequence leaves alone, welded where the start has them.
-  std::optional<RigidRobot> rigid;
-  WorldModel model = calibrated;
-  if (plan.holdUnmoved) {
-    const std::vector<int> held = unmovedJoints(full, plan.commands);
-    std::string why;
-    const std::vector<double>& at = start->jointPositions;
-    if (!held.empty() && (rigid = holdRigid(full, at, held, why))) {
-      model.robots[0].model = rigid->model;
-      result.heldJoints = static_cast<int>(held.size());
-    }
-  }
-  Diagnostics diag;
-  std::unique_ptr<World> world = World::create(model, params, diag);
-  if (!world) {
-    result.error = "cannot build the twin: " + diag.format();
-    return result;
-  }
-  const RobotModel& robot = world->robotModel(0);
-  const RigidRobot* held = rigid ? &*rigid : nullptr;
-  if (std::string why = placeRobot(*world, *start, held); !why.empty()) {
-    result.error = "the start state does not fit: " + why;
-    return result;
-  }
   result.duration = (plan.commands.empty() ? 0.0 : plan.commands.back().time) + params.calDelay + plan.rules.settle;
-  RuleMonitor monitor(plan.rules, robot);
-  Runner runner(*world);
   std::vector<TimedCommand> acting = plan.commands;
   for (TimedCommand& c : acting) c.time += params.calDelay;
-  runner.schedule(acting);
-  runner.setSubmitHook([&](const ScheduledCommand& c, const std::string& why) {
+  // The joints no command is moving welded (app/rehearse/held_twin.h);
+  // those the whole sequence leaves alone are welded throughout.
+  if (plan.holdUnmoved) result.heldJoints = static_cast<int>(unmovedJoints(full, plan.commands).size());
+  HeldTwin twin(calibrated, params, acting, plan.holdUnmoved);
+  if (std::string why = twin.start(*start); !why.empty()) {
+    result.error = why;
+    return result;
+  }
+  RuleMonitor monitor(plan.rules, twin.world().robotModel(0));
+  twin.setSwitchHook([&](const World& w) { monitor.rebind(w.robotModel(0)); });
+  twin.setSubmitHook([&](const ScheduledCommand& c, const std::string& why) {
     if (!why.empty())
-      result.refused.push_back("line " + std::to_string(c.line) + " at " + shortestText(world->time()) + " s: " + why);
+      result.refused.push_back("line " + std::to_string(c.line) + " at " + shortestText(twin.world().time()) +
+                               " s: " + why);
   });
   const int64_t total = std::max<int64_t>(1, std::llround(result.duration / params.step));
   const int64_t sampleEvery = std::max<int64_t>(1, std::llround(RehearsalResult::kSampleInterval / params.step));
   const int64_t progressEvery = std::max<int64_t>(1, total / 100);
-  result.path.push_back(sampleOf(*world, 0, held));
-  runner.setMonitor([&](const World& w) {
+  result.path.push_back(sampleOf(twin.world(), 0, twin.rigid()));
+  twin.setMonitor([&](const World& w) {
     monitor.check(w);
     if (plan.stopAtFirstFailure && !monitor.passed()) {
       result.stoppedEarly = true;
       return false;
     }
     const int64_t n = w.stepCount();
-    if (n % sampleEvery == 0) result.path.push_back(sampleOf(w, monitor.margin(), held));
+    if (n % sampleEvery == 0) result.path.push_back(sampleOf(w, monitor.margin(), twin.rigid()));
     if (progress && n % progressEvery == 0 && !progress(static_cast<double>(n) / static_cast<double>(total))) {
       result.cancelled = true;
       return false;
     }
     return true;
   });
-  const RunOutcome out = runner.advanceTo(total);
+  const RunOutcome out = twin.advanceTo(total);
+  const World* world = &twin.world();
+  result.switches = twin.switches();
   if (out.stop == RunOutcome::Stop::Diverged) monitor.check(*world);  // the health verdict
   result.verdicts = monitor.verdicts();
   result.passed = !result.cancelled && monitor.passed() && world->health().healthy() && result.refused.empty();

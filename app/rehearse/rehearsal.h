@@ -112,7 +112,8 @@ struct RehearsalResult {
   double duration = 0;     ///< [s] simulated: last command's time + rules.settle
   double wallSeconds = 0;  ///< what it took
   uint64_t endHash = 0;    ///< World::stateHash() at the end
-  int heldJoints = 0;      ///< joints held rigid (plan.holdUnmoved)
+  int heldJoints = 0;      ///< joints held rigid throughout (plan.holdUnmoved)
+  int switches = 0;        ///< times the twin welded or freed joints mid-run (app/rehearse/held_twin.h)
   bool fast = false;       ///< run in the fast profile (plan.fast)
   bool stoppedEarly = false;  ///< a rule failed and plan.stopAtFirstFailure stopped the run there
   /// [s] how long the robot settled from the world's start before t = 0

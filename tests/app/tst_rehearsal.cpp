@@ -179,6 +179,45 @@ class TestRehearsal : public QObject {
     QVERIFY(std::find(moved.begin(), moved.end(), robot.findJoint("elbow_r")) != moved.end());
   }
 
+  // Issue 32: joints are welded only while nothing moves them. Criterion
+  // (before the run): a drive that raises an arm at 2 s frees the arm then
+  // and welds it again once it has rested (two switches at least), the
+  // arm reaches its target, and the run ends within 1 cm and 0.1 deg of the
+  // full robot's with the same verdicts and nothing refused; the control,
+  // the same arm retargeted every 0.4 s to the end, is never welded again.
+  void heldJointsAreFreedWhileMoved() {
+    RehearsalPlan plan{loadOrFail("terrains/flat.world.xml"), {}, {}, {}, {}};
+    const RobotModel& robot = plan.world.robots[0].model;
+    plan.commands = parseOrFail("0.5 drive 0.5 0\n2 target shoulder_pitch_l -30\n4 drive 0.5 10\n", robot);
+    plan.rules.settle = 5;
+    const RehearsalResult held = rehearse(plan);
+    plan.holdUnmoved = false;
+    const RehearsalResult full = rehearse(plan);
+    QVERIFY2(held.error.empty() && held.refused.empty(), held.summary().c_str());
+    const Pose a = held.path.back().base, b = full.path.back().base;
+    const size_t shoulder = static_cast<size_t>(robot.findJoint("shoulder_pitch_l"));
+    qInfo("%d switches: %.2f s vs %.2f s in the full robot; ends %.2f mm, %.4f deg apart; shoulder %.2f deg", held.switches,
+          held.wallSeconds, full.wallSeconds, 1000 * std::hypot(a.p.x - b.p.x, a.p.y - b.p.y),
+          radToDeg(std::abs(std::remainder(heading(a.q) - heading(b.q), 2 * kPi))),
+          radToDeg(held.path.back().jointPositions[shoulder]));
+    QVERIFY(held.switches >= 2);
+    QCOMPARE(full.switches, 0);
+    QVERIFY(std::abs(held.path.back().jointPositions[shoulder] - degToRad(-30)) < degToRad(1));
+    QVERIFY(std::hypot(a.p.x - b.p.x, a.p.y - b.p.y) < 0.01);
+    QVERIFY(std::abs(std::remainder(heading(a.q) - heading(b.q), 2 * kPi)) < degToRad(0.1));
+    for (int i = 0; i < kRuleCount; ++i) QCOMPARE(held.verdicts[i].passed, full.verdicts[i].passed);
+
+    std::string restless = "0.5 drive 0.5 0\n";
+    for (int i = 0; i < 20; ++i)
+      restless += std::to_string(2 + 0.4 * i) + " target shoulder_pitch_l " + (i % 2 ? "-30\n" : "-10\n");
+    plan.commands = parseOrFail(restless.c_str(), robot);
+    plan.rules.settle = 0.5;
+    plan.holdUnmoved = true;
+    const RehearsalResult moving = rehearse(plan);
+    QVERIFY2(moving.error.empty() && moving.refused.empty(), moving.summary().c_str());
+    QCOMPARE(moving.switches, 1);
+  }
+
   // Issue 32: the fast profile (2 ms, 40 iterations) is a speed lever, not
   // another verdict. Criterion (before the run): on the shipped sequences
   // (demo on flat, pick_place on its world) and the tipping one, each rule
