@@ -53,6 +53,10 @@ struct SimParams {
   /// bench_rehearsal and tst_rehearsal.
   double rehearsalFastStep = 0.002;
   int rehearsalFastIterations = 40;
+  /// The fast profile also welds these joints' subtrees (the drive's
+  /// joints turn) while no command or gait moves them: the legs, as the
+  /// ghost holds them (app/rehearse/held_twin.h).
+  std::string rehearsalFastHold = "hip_fl,hip_fr,hip_rl,hip_rr";
   double ghostStep = 0.004;       ///< [s] console's predictive ghost: its physics step
   int ghostIterations = 20;       ///< ghost: quick solver iterations
   double ghostHorizon = 5;        ///< [s] ghost: how far the trail looks ahead of the ghost

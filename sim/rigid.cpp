@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "sim/kinematics.h"
+#include "sim/params.h"
 
 namespace sp {
 namespace {
@@ -49,6 +50,32 @@ std::vector<int> unmovedSubtrees(const RobotModel& robot, const std::vector<bool
       taken[static_cast<size_t>(k)] = true;
       held.push_back(k);
     }
+  }
+  std::sort(held.begin(), held.end());
+  return held;
+}
+
+std::optional<std::vector<int>> holdableJoints(const RobotModel& robot, std::string_view names, std::string_view key,
+                                               std::string& error) {
+  std::vector<int> drive;  // the wheels and the articulation keep turning in a held subtree
+  if (robot.drive) {
+    drive.assign(robot.drive->wheels.begin(), robot.drive->wheels.end());
+    drive.push_back(robot.drive->articulation);
+  }
+  std::vector<int> held;
+  for (const std::string& name : splitNames(names)) {
+    const std::vector<int> subtree = subtreeJoints(robot, name);
+    if (subtree.empty()) {
+      error = std::string(key) + ": the robot has no joint '" + name + "'";
+      return std::nullopt;
+    }
+    if (std::find(drive.begin(), drive.end(), robot.findJoint(name)) != drive.end()) {
+      error = std::string(key) + ": joint '" + name + "' drives the robot and cannot be held";
+      return std::nullopt;
+    }
+    for (int j : subtree)
+      if (std::find(drive.begin(), drive.end(), j) == drive.end() && std::find(held.begin(), held.end(), j) == held.end())
+        held.push_back(j);
   }
   std::sort(held.begin(), held.end());
   return held;

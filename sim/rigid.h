@@ -57,4 +57,12 @@ std::vector<int> subtreeJoints(const RobotModel& robot, std::string_view name);
 /// while the marked ones move.
 std::vector<int> unmovedSubtrees(const RobotModel& robot, const std::vector<bool>& moved);
 
+/// The joints a twin of `robot` may hold rigid for the joint names of
+/// `names` (comma-separated, or none: ghost.hold, rehearsal.fast_hold):
+/// their subtrees, but the drive's wheels and articulation, which keep
+/// turning; sorted. nullopt and `error` ("KEY: ...") for a name the robot
+/// lacks or one that drives it.
+std::optional<std::vector<int>> holdableJoints(const RobotModel& robot, std::string_view names, std::string_view key,
+                                               std::string& error);
+
 }  // namespace sp

@@ -553,7 +553,7 @@ std::string makeProblem(const WorldModel& files, const SimParams& profile, const
   pb.profile = profile;
   pb.frames = &frames;
   std::string why;
-  const std::optional<std::vector<int>> held = holdableJoints(robot, profile.ghostHold, why);
+  const std::optional<std::vector<int>> held = holdableJoints(robot, profile.ghostHold, "ghost.hold", why);
   if (!held) return why;
   pb.held = *held;
   pb.weld = frames.back().jointPositions;

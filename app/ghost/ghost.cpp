@@ -37,7 +37,7 @@ std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& p
   std::unique_ptr<Ghost> g(new Ghost(calibratedWorld(world, params), profile(params), options));
   g->delay_ = params.calDelay;
   const RobotModel& robot = world.robots[0].model;
-  std::optional<std::vector<int>> held = holdableJoints(robot, params.ghostHold, error);
+  std::optional<std::vector<int>> held = holdableJoints(robot, params.ghostHold, "ghost.hold", error);
   if (!held) return nullptr;
   g->held_ = std::move(*held);
   // The worlds are built on the first telemetry (the pose to weld at);

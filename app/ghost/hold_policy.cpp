@@ -9,31 +9,6 @@
 
 namespace sp {
 
-std::optional<std::vector<int>> holdableJoints(const RobotModel& robot, std::string_view holdList, std::string& error) {
-  std::vector<int> drive;  // the wheels and the articulation keep turning in a held subtree
-  if (robot.drive) {
-    drive.assign(robot.drive->wheels.begin(), robot.drive->wheels.end());
-    drive.push_back(robot.drive->articulation);
-  }
-  std::vector<int> held;
-  for (const std::string& name : splitNames(holdList)) {
-    const std::vector<int> subtree = subtreeJoints(robot, name);
-    if (subtree.empty()) {
-      error = "ghost.hold: the robot has no joint '" + name + "'";
-      return std::nullopt;
-    }
-    if (std::find(drive.begin(), drive.end(), robot.findJoint(name)) != drive.end()) {
-      error = "ghost.hold: joint '" + name + "' drives the robot and cannot be held";
-      return std::nullopt;
-    }
-    for (int j : subtree)
-      if (std::find(drive.begin(), drive.end(), j) == drive.end() && std::find(held.begin(), held.end(), j) == held.end())
-        held.push_back(j);
-  }
-  std::sort(held.begin(), held.end());
-  return held;
-}
-
 bool HoldPolicy::movesHeld(const Command& command) const {
   const auto held = [&](const std::string& joint) {
     return std::binary_search(held_.begin(), held_.end(), robot_.findJoint(joint));

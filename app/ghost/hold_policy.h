@@ -23,12 +23,6 @@
 
 namespace sp {
 
-/// The joints a twin of `robot` may hold rigid for the joint names of
-/// `holdList` (ghost.hold): their subtrees, but the drive's wheels and
-/// articulation, which keep turning; sorted. nullopt and `error` for a name
-/// the robot lacks or one that drives it.
-std::optional<std::vector<int>> holdableJoints(const RobotModel& robot, std::string_view holdList, std::string& error);
-
 /// What the anchor thread does with the next frame.
 struct HoldDecision {
   bool hold = false;     ///< weld the held joints (else the full robot)

@@ -13,15 +13,19 @@ namespace sp {
 namespace {
 
 // The joint a command moves by name (targets, velocities, torques, modes),
-// -1 for the rest: the drive and a gait move only drive joints' subtrees,
-// which are never welded, and stop holds every joint where it is.
-int jointMoved(const RobotModel& robot, const Command& command) {
+// `legs` for a gait (it walks the legs), `none` for the rest: the drive
+// turns only drive joints, which are never welded, and stop holds every
+// joint where it is.
+int jointMoved(const RobotModel& robot, const Command& command, int none, int legs) {
   return std::visit(
       [&](const auto& c) {
+        using T = std::decay_t<decltype(c)>;
         if constexpr (requires { c.joint; })
           return robot.findJoint(c.joint);
+        else if constexpr (std::is_same_v<T, GaitCmd>)
+          return c.gait == Gait::Off ? none : legs;
         else
-          return -1;
+          return none;
       },
       command);
 }
@@ -36,8 +40,10 @@ int64_t boundaryOf(double time, double step) {
 
 }  // namespace
 
-HeldTwin::HeldTwin(WorldModel model, SimParams params, std::vector<TimedCommand> acting, bool hold)
-    : model_(std::move(model)), params_(std::move(params)), acting_(std::move(acting)), hold_(hold) {
+HeldTwin::HeldTwin(WorldModel model, SimParams params, std::vector<TimedCommand> acting, bool hold,
+                   std::vector<int> alsoHeld)
+    : model_(std::move(model)), params_(std::move(params)), acting_(std::move(acting)), hold_(hold),
+      alsoHeld_(std::move(alsoHeld)) {
   const RobotModel& full = model_.robots[0].model;
   drive_.assign(full.joints.size(), false);
   if (full.drive) {
@@ -49,22 +55,45 @@ HeldTwin::HeldTwin(WorldModel model, SimParams params, std::vector<TimedCommand>
   touched_.assign(full.links.size(), std::numeric_limits<int64_t>::min() / 2);
   for (const TimedCommand& c : acting_) {
     dueAt_.push_back(boundaryOf(c.time, params_.step));
-    moves_.push_back(jointMoved(full, c.command));
+    moves_.push_back(jointMoved(full, c.command, kNone, kLegs));
   }
+  std::sort(alsoHeld_.begin(), alsoHeld_.end());
+  for (int j : alsoHeld_) {
+    const std::vector<int> below = subtreeJoints(full, full.joints[static_cast<size_t>(j)].name);
+    if (std::any_of(below.begin(), below.end(), [&](int k) { return drive_[static_cast<size_t>(k)]; }))
+      legs_.push_back(j);
+  }
+}
+
+// Marks in `freed` what the acting command `c` frees: its joint, or the
+// legs for a gait.
+void HeldTwin::markFreed(size_t c, std::vector<bool>& freed) const {
+  if (moves_[c] >= 0) freed[static_cast<size_t>(moves_[c])] = true;
+  if (moves_[c] == kLegs)
+    for (int j : legs_) freed[static_cast<size_t>(j)] = true;
+}
+
+// Whether the acting command `c` moves a joint welded now.
+bool HeldTwin::movesWelded(size_t c) const {
+  const auto welded = [&](int j) { return std::binary_search(held_.begin(), held_.end(), j); };
+  return moves_[c] >= 0 ? welded(moves_[c]) : moves_[c] == kLegs && std::any_of(legs_.begin(), legs_.end(), welded);
 }
 
 std::vector<int> HeldTwin::heldFor(const std::vector<bool>& freed) const {
   if (!hold_) return {};
   std::vector<bool> moved = drive_;
   for (size_t j = 0; j < moved.size(); ++j) moved[j] = moved[j] || freed[j];
-  return unmovedSubtrees(model_.robots[0].model, moved);
+  std::vector<int> held = unmovedSubtrees(model_.robots[0].model, moved);
+  for (int j : alsoHeld_)
+    if (!freed[static_cast<size_t>(j)] && !std::binary_search(held.begin(), held.end(), j)) held.push_back(j);
+  std::sort(held.begin(), held.end());
+  return held;
 }
 
 std::string HeldTwin::start(const RehearsalStart& state) {
   const RobotModel& full = model_.robots[0].model;
   // What the commands due at the start move is free from the start.
-  for (size_t c = 0; c < acting_.size() && dueAt_[c] == 0; ++c)
-    if (moves_[c] >= 0) freed_[static_cast<size_t>(moves_[c])] = true;
+  for (size_t c = 0; c < acting_.size() && dueAt_[c] == 0; ++c) markFreed(c, freed_);
   held_ = heldFor(freed_);
   WorldModel model = model_;
   std::string why;
@@ -72,6 +101,8 @@ std::string HeldTwin::start(const RehearsalStart& state) {
     model.robots[0].model = rigid_->model;
   else
     held_.clear();  // the full robot, slower but the same
+  always_.assign(full.joints.size(), false);
+  for (int j : held_) always_[static_cast<size_t>(j)] = true;
   Diagnostics diag;
   world_ = World::create(model, params_, diag);
   if (!world_) return "cannot build the twin: " + diag.format();
@@ -108,15 +139,14 @@ RunOutcome HeldTwin::advanceTo(int64_t step) {
     // A command due now to a welded joint frees it before it is submitted.
     std::vector<bool> freed = freed_;
     for (size_t c = next; c < acting_.size() && dueAt_[c] == now; ++c)
-      if (const int j = moves_[c]; j >= 0 && std::binary_search(held_.begin(), held_.end(), j))
-        freed[static_cast<size_t>(j)] = true;
+      if (movesWelded(c)) markFreed(c, freed);
     if (freed != freed_) {
       freed_ = freed;
       switchTo(heldFor(freed_));
     }
     int64_t until = step;
     for (size_t c = next; c < acting_.size(); ++c)
-      if (dueAt_[c] > now && moves_[c] >= 0 && std::binary_search(held_.begin(), held_.end(), moves_[c])) {
+      if (dueAt_[c] > now && movesWelded(c)) {
         until = std::min(until, dueAt_[c]);
         break;
       }
@@ -201,6 +231,8 @@ bool HeldTwin::switchTo(const std::vector<int>& held) {
   world_ = std::move(world);
   rigid_ = std::move(rigid);
   held_ = held;
+  for (size_t j = 0; j < always_.size(); ++j)
+    always_[j] = always_[j] && std::binary_search(held_.begin(), held_.end(), static_cast<int>(j));
   recent_.clear();
   ++switches_;
   if (switchHook_) switchHook_(*world_);

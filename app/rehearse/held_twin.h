@@ -7,6 +7,8 @@
 // kBand over kStill) and touched nothing, their servos holding a position.
 // So a sequence that moves the arms for 3 s of 60 runs welded for the other
 // 57 (issue 32; the ghost does the same from telemetry: app/ghost/hold_policy.h).
+// The fast profile welds the legs' hips and knees too (`alsoHeld`), the
+// wheels below them turning; a command to one or a gait frees them.
 //
 // A switch builds the other form of the twin and carries the run across at
 // the step boundary: the links from the base's motion and the joints', the
@@ -22,6 +24,7 @@
 //
 // Thread: the caller's; not shared.
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -45,8 +48,11 @@ class HeldTwin {
 
   /// `model`'s robots[0] is the full robot; `acting`: the commands at the
   /// times the twin acts on them (non-decreasing). `hold` false: the full
-  /// robot throughout.
-  HeldTwin(WorldModel model, SimParams params, std::vector<TimedCommand> acting, bool hold);
+  /// robot throughout. `alsoHeld`: joints welded too while nothing moves
+  /// them though the drive's joints below them turn (the fast profile's
+  /// legs, rehearsal.fast_hold; a gait frees them).
+  HeldTwin(WorldModel model, SimParams params, std::vector<TimedCommand> acting, bool hold,
+           std::vector<int> alsoHeld = {});
 
   /// Builds the twin at `start` (the full robot's joints), its controllers
   /// holding that pose (placeRobot). "" or why not (a sentence).
@@ -68,9 +74,13 @@ class HeldTwin {
   const std::vector<int>& held() const { return held_; }
   /// Switches made so far.
   int switches() const { return switches_; }
+  /// How many of the full robot's joints were welded all along.
+  int heldThroughout() const { return static_cast<int>(std::count(always_.begin(), always_.end(), true)); }
 
  private:
   std::vector<int> heldFor(const std::vector<bool>& freed) const;
+  void markFreed(size_t command, std::vector<bool>& freed) const;
+  bool movesWelded(size_t command) const;
   // Builds the form that welds `held` and carries the run into it; false
   // (and the run stays in its form) if it cannot.
   bool switchTo(const std::vector<int>& held);
@@ -83,10 +93,14 @@ class HeldTwin {
   SimParams params_;
   std::vector<TimedCommand> acting_;
   std::vector<int64_t> dueAt_;   // per acting command: its step boundary
-  std::vector<int> moves_;       // per acting command: the full robot's joint it moves, -1 none
+  std::vector<int> moves_;       // per acting command: the full robot's joint it moves, kNone, or kLegs (a gait)
+  static constexpr int kNone = -1, kLegs = -2;
   bool hold_;
   std::vector<bool> drive_;      // per full joint: the drive's (never welded)
+  std::vector<int> alsoHeld_;    // sorted
+  std::vector<int> legs_;        // alsoHeld_ joints above a drive joint: what a gait moves
   std::vector<bool> freed_;      // per full joint: a command freed it and it has not come to rest
+  std::vector<bool> always_;     // per full joint: welded in every form so far
   std::vector<int> held_;
   std::optional<RigidRobot> rigid_;
   std::unique_ptr<World> world_;

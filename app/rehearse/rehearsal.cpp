@@ -212,10 +212,19 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   result.duration = (plan.commands.empty() ? 0.0 : plan.commands.back().time) + params.calDelay + plan.rules.settle;
   std::vector<TimedCommand> acting = plan.commands;
   for (TimedCommand& c : acting) c.time += params.calDelay;
-  // The joints no command is moving welded (app/rehearse/held_twin.h);
-  // those the whole sequence leaves alone are welded throughout.
-  if (plan.holdUnmoved) result.heldJoints = static_cast<int>(unmovedJoints(full, plan.commands).size());
-  HeldTwin twin(calibrated, params, acting, plan.holdUnmoved);
+  // The joints no command is moving welded (app/rehearse/held_twin.h),
+  // in the fast profile the legs too.
+  std::vector<int> legs;
+  if (plan.fast && plan.holdUnmoved) {
+    std::string why;
+    const std::optional<std::vector<int>> named = holdableJoints(full, params.rehearsalFastHold, "rehearsal.fast_hold", why);
+    if (!named) {
+      result.error = why;
+      return result;
+    }
+    legs = *named;
+  }
+  HeldTwin twin(calibrated, params, acting, plan.holdUnmoved, legs);
   if (std::string why = twin.start(*start); !why.empty()) {
     result.error = why;
     return result;
@@ -248,6 +257,7 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   const RunOutcome out = twin.advanceTo(total);
   const World* world = &twin.world();
   result.switches = twin.switches();
+  result.heldJoints = twin.heldThroughout();
   if (out.stop == RunOutcome::Stop::Diverged) monitor.check(*world);  // the health verdict
   result.verdicts = monitor.verdicts();
   result.passed = !result.cancelled && monitor.passed() && world->health().healthy() && result.refused.empty();

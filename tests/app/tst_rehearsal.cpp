@@ -218,14 +218,49 @@ class TestRehearsal : public QObject {
     QCOMPARE(moving.switches, 1);
   }
 
+  // The fast profile welds the legs' hips and knees too (rehearsal.fast_hold),
+  // the wheels below them turning, until a gait or a command moves them.
+  // Criterion: a drive holds the upper body and the 8 leg joints all along
+  // in the fast profile and only the upper body in the full one; with a
+  // caterpillar gait the legs are freed (not welded all along, a switch);
+  // a name the robot lacks is refused naming the key.
+  void fastProfileWeldsTheLegs() {
+    RehearsalPlan plan{loadOrFail("terrains/flat.world.xml"), {}, {}, {}, {}};
+    const RobotModel& robot = plan.world.robots[0].model;
+    const int upper = static_cast<int>(subtreeJoints(robot, "waist_yaw").size());
+    plan.commands = parseOrFail("0.5 drive 0.5 0\n2 drive 0.5 10\n", robot);
+    plan.rules.settle = 1;
+    const RehearsalResult full = rehearse(plan);
+    plan.fast = true;
+    const RehearsalResult fast = rehearse(plan);
+    qInfo("drive: %d joints welded all along (full profile %d), %d switches", fast.heldJoints, full.heldJoints,
+          fast.switches);
+    QCOMPARE(full.heldJoints, upper);
+    QCOMPARE(fast.heldJoints, upper + 8);
+    QCOMPARE(fast.switches, 0);
+    QVERIFY(fast.passed && full.passed);
+
+    plan.commands = parseOrFail("0.5 gait caterpillar\n4 gait off\n", robot);
+    const RehearsalResult gait = rehearse(plan);
+    qInfo("gait: %d joints welded all along, %d switches; %s", gait.heldJoints, gait.switches, gait.summary().c_str());
+    QCOMPARE(gait.heldJoints, upper);
+    QVERIFY(gait.switches >= 1);
+    QVERIFY(gait.refused.empty());
+
+    plan.params.rehearsalFastHold = "hip_fl,hip_xx";
+    const RehearsalResult bad = rehearse(plan);
+    QVERIFY(bad.error.find("rehearsal.fast_hold") != std::string::npos);
+    QVERIFY(bad.error.find("hip_xx") != std::string::npos);
+  }
+
   // Issue 32: the fast profile (2 ms, 40 iterations) is a speed lever, not
   // another verdict. Criterion (before the run): on the shipped sequences
   // (demo on flat, pick_place on its world) and the tipping one, each rule
   // passes or fails as in the full profile, in less time; every margin is
   // within 10 % of the full run's on demo (a falling robot's margins after
   // its failure are chaos: the tipping one is held to its verdicts). On pick_place the
-  // knee comes within 2.5 deg of its stop and the fast profile brings it
-  // 0.2 deg nearer (14 % of that margin, measured): the issue's 10 % is not
+  // knee comes within 2.6 deg of its stop and the fast profile brings it
+  // 0.3 deg nearer (22 % of that margin, measured): the issue's 10 % is not
   // met there, so that case is held to its verdicts (docs/performance.md,
   // "Rehearsals", has every rule over 24 sequences). The control: a much
   // coarser profile (4 ms, 10 iterations) fails pick_place where the full

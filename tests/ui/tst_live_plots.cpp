@@ -187,11 +187,13 @@ class TestLivePlots : public QObject {
 
   void addSampleDefersDrawing() {
     auto plot = shownWheelPlot();
-    QCOMPARE(plot->replots(), 0);
+    // Showing may draw the empty plot once (its layout marks it dirty, and a
+    // slow window exposure lets the timer fire): count from here.
+    const int64_t shown = plot->replots();
     feed(*plot, 0, 500);
     QCOMPARE(plot->samplesReceived(), 500);
     QCOMPARE(plot->bufferedSamples(), std::size_t{500});
-    QCOMPARE(plot->replots(), 0);
+    QCOMPARE(plot->replots(), shown);
     QVERIFY(plot->shownPoints(0).isEmpty());
     QVERIFY(waitForReplot(*plot, 0));
     const QString problem = mismatch(*plot, 0, 500);
