@@ -24,6 +24,7 @@
 #include <utility>
 #include <vector>
 
+#include "app/rehearse/held_twin.h"
 #include "sim/command.h"
 #include "sim/flight_rules.h"
 #include "sim/math.h"
@@ -31,15 +32,6 @@
 #include "sim/robot_model.h"
 
 namespace sp {
-
-/// The robot's state to rehearse from, as telemetry reports it.
-struct RehearsalStart {
-  Pose base;
-  Vec3 baseLinear, baseAngular;        ///< world frame [m/s], [rad/s]
-  std::vector<double> jointPositions;  ///< model joint order
-  std::vector<double> jointRates;
-  std::vector<std::pair<std::string, Pose>> objects;  ///< dynamic objects by name
-};
 
 /// What to rehearse.
 struct RehearsalPlan {
@@ -64,9 +56,6 @@ struct RehearsalPlan {
   bool stopAtFirstFailure = false;
 };
 
-class World;
-struct RigidRobot;
-
 /// A world's start settled: the robot let down onto the ground (worlds
 /// place it a little above) until it touches it and its base stays within
 /// kSettleDrift over kSettleStill, at most kSettleLimit of sim time.
@@ -80,13 +69,6 @@ constexpr double kSettleDrift = 0.003;  ///< [m]
 /// nullopt and `why` (off the ground, or how fast the base still moves)
 /// when it does not settle, or the twin diverges.
 std::optional<SettledStart> settleWorldStart(const WorldModel& world, const SimParams& params, std::string& why);
-
-/// Puts robot 0 of `world` in `start` (links' poses and velocities, the
-/// objects named) with its controllers holding that pose: position joints
-/// target where they are, velocity joints 0. `held`: the world runs this
-/// rigid form of the robot (start joints are the full robot's). "" or why
-/// the state does not fit.
-std::string placeRobot(World& world, const RehearsalStart& start, const RigidRobot* held = nullptr);
 
 /// The joints `commands` leave alone, as held subtrees: every joint whose
 /// subtree holds no commanded joint and no drive joint, outermost first.
