@@ -94,6 +94,7 @@ HeldTwin::HeldTwin(WorldModel model, SimParams params, std::vector<TimedCommand>
 // Marks in `freed` what the acting command `c` frees: its joint, or the
 // legs for a gait.
 void HeldTwin::markFreed(size_t c, std::vector<bool>& freed) const {
+  if (!hold_) return;  // nothing is welded: nothing to watch for rest
   if (moves_[c] >= 0) freed[static_cast<size_t>(moves_[c])] = true;
   if (moves_[c] == kLegs)
     for (int j : legs_) freed[static_cast<size_t>(j)] = true;
