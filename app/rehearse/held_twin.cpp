@@ -139,11 +139,11 @@ std::string HeldTwin::start(const RehearsalStart& state) {
   return "";
 }
 
-Runner::Monitor HeldTwin::watch() {
-  return [this](const World& w) {
+Runner::Monitor HeldTwin::watch(bool anyFreed) {
+  return [this, anyFreed](const World& w) {
     // Which links touch anything, while some joints are freed: a hand on
     // an object is not at rest however still it holds.
-    if (std::find(freed_.begin(), freed_.end(), true) != freed_.end())
+    if (anyFreed)
       for (const LinkContact& c : w.linkContacts())
         if (c.robot == 0 && c.link >= 0) {
           const int full = rigid_ ? rigid_->linkOf[static_cast<size_t>(c.link)] : c.link;
@@ -179,7 +179,7 @@ RunOutcome HeldTwin::advanceTo(int64_t step) {
       }
     const bool resting = std::find(freed_.begin(), freed_.end(), true) != freed_.end();
     if (resting) until = std::min(until, (now / checkEvery + 1) * checkEvery);
-    runner_->setMonitor(watch());
+    runner_->setMonitor(watch(resting));
     runner_->setSubmitHook(submitHook_);
     const RunOutcome part = runner_->advanceTo(until);
     out.steps += part.steps;

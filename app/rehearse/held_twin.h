@@ -101,7 +101,9 @@ class HeldTwin {
   // (and the run stays in its form) if it cannot.
   bool switchTo(const std::vector<int>& held);
   std::string carryInto(World& to, const RigidRobot* toRigid);
-  Runner::Monitor watch();
+  // The monitor run after each step; `anyFreed`: some joints are freed in
+  // this stretch (freed_ changes only between stretches), so contacts count.
+  Runner::Monitor watch(bool anyFreed);
   void lookForRest();
   std::vector<double> fullPositions() const;
 
