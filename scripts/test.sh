@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, fuzzes the robot link's codec for 30 s
 # (scripts/fuzz.sh), and runs every test (GUI tests under xvfb-run, so a
-# display is never needed). ctest's summary is the last thing printed.
+# display is never needed). ctest's summary comes last, then the time taken.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
+echo "test.sh: installed in ${SECONDS} s"
 scripts/build.sh
+echo "test.sh: installed and built in ${SECONDS} s"
 echo "fuzzing the link codec for 30 s"
 scripts/fuzz.sh 30
 cd build
@@ -37,4 +39,5 @@ for t in $skipped; do
     status=1
   fi
 done
+echo "test.sh: done in ${SECONDS} s"
 exit "$status"
