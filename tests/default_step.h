@@ -13,7 +13,7 @@ namespace sp::test {
 /// The default physics step [s].
 inline double defaultStep() { return SimParams{}.step; }
 
-/// The step at which `seconds` of sim time end at the default step.
-inline int64_t stepAt(double seconds) { return std::llround(seconds / defaultStep()); }
+/// The step at which `seconds` of sim time end at `step` (the default's unless given).
+inline int64_t stepAt(double seconds, double step = defaultStep()) { return std::llround(seconds / step); }
 
 }  // namespace sp::test

@@ -125,8 +125,8 @@ class TestResimulation : public QObject {
     // 2 ms and 40 iterations (healthy on such ground) halve the two
     // ten-minute runs, the longest test of all.
     constexpr double kStep = 0.002;
-    const auto stepAt = [](double seconds) { return std::llround(seconds / kStep); };
-    auto run = sp::test::logRun(path, world, seq, 600, {"physics.step=0.002", "physics.iterations=40"});
+    const auto stepAt = [](double seconds) { return sp::test::stepAt(seconds, kStep); };
+    auto run = sp::test::logRun(path, world, seq, 600, {"physics.step=" + std::to_string(kStep), "physics.iterations=40"});
     QVERIFY(run);
     QVERIFY2(run->health.healthy(), run->health.message().c_str());
     QCOMPARE(run->commandsApplied, 30 * 12);
