@@ -43,7 +43,8 @@
 //     calibration.* keys make of the files (1e-6), friction and delay named
 //     in its comment; the files' own values (control) leave it unchanged.
 
-#include <QtTest>
+#include <QProcess>
+#include <QTest>
 
 #include <algorithm>
 #include <atomic>

@@ -2,7 +2,7 @@
 // without its window. A real stand-in robot on loopback, real session logs.
 
 #include <QFileInfo>
-#include <QtTest>
+#include <QTest>
 
 #include <QTemporaryDir>
 

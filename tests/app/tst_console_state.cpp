@@ -1,7 +1,7 @@
 // Tests of sp::ConsoleState (app/console/console_state.h): what the console
 // shows and allows, computed from link events and frames without a window.
 
-#include <QtTest>
+#include <QTest>
 
 #include "app/console/console_state.h"
 

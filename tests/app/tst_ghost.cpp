@@ -11,7 +11,7 @@
 // the test track. Control: the same run with a ghost that does not apply the
 // commands still in flight must fail it at the 2 s round trip.
 
-#include <QtTest>
+#include <QTest>
 
 #include <algorithm>
 #include <chrono>

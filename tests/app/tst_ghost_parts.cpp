@@ -3,7 +3,7 @@
 // record of what it showed against what came. No threads, no physics:
 // each is checked against the arithmetic it promises.
 
-#include <QtTest>
+#include <QTest>
 
 #include <cmath>
 

@@ -2,7 +2,7 @@
 // the terminal or pipe behind them; lines dropped while it is blocked are
 // counted and said once it drains (issue 36: the notice was never written).
 
-#include <QtTest>
+#include <QTest>
 
 #include <fcntl.h>
 #include <poll.h>

@@ -5,7 +5,7 @@
 // the robot moves, no telemetry lost or dropped. Then the link fades on
 // purpose: a fade the deadman must ride out, and the control, one it cannot.
 
-#include <QtTest>
+#include <QTest>
 
 #include <chrono>
 #include <cmath>

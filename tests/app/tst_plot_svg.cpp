@@ -2,7 +2,7 @@
 // (app/validation/plot.h): the report plots of `simpartner-sim validate`, without Qt.
 // The SVG is parsed back with Qt's XML reader to check what it draws.
 
-#include <QtTest>
+#include <QTest>
 
 #include <QFile>
 #include <QTemporaryDir>

@@ -7,7 +7,7 @@
 // the last command `drive 0.5 0` (the control that these criteria fail).
 
 #include <QTemporaryDir>
-#include <QtTest>
+#include <QTest>
 
 #include <signal.h>
 #include <sys/wait.h>

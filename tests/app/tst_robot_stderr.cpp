@@ -5,7 +5,7 @@
 // 4.2 s when the link thread wrote its lines itself). SIGTERM then stops it
 // cleanly, without waiting for the reader that never comes.
 
-#include <QtTest>
+#include <QTest>
 
 #include <arpa/inet.h>
 #include <fcntl.h>

@@ -4,7 +4,9 @@
 // resume runs only those. Real files in a temporary folder, the real
 // `simpartner-sim` through QProcess.
 
-#include <QtTest>
+#include <QProcess>
+#include <QProcessEnvironment>
+#include <QTest>
 
 #include <filesystem>
 #include <fstream>

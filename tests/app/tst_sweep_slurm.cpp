@@ -7,7 +7,10 @@
 
 #include <unistd.h>
 
-#include <QtTest>
+#include <QProcess>
+#include <QProcessEnvironment>
+#include <QStandardPaths>
+#include <QTest>
 
 #include <fstream>
 #include <set>

@@ -6,7 +6,7 @@
 // refuses the edit and its robot stays where it was.
 
 #include <QTemporaryDir>
-#include <QtTest>
+#include <QTest>
 
 #include <chrono>
 #include <cmath>

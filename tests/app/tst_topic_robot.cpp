@@ -5,7 +5,7 @@
 // a silent controller's deadman publishes a zero velocity within deadman +
 // 100 ms, and odometry gone stale fires the failsafe with its reason.
 
-#include <QtTest>
+#include <QTest>
 
 #include <atomic>
 #include <mutex>

@@ -2,7 +2,7 @@
 // thread behind the robot port, stepping through sp::Runner and publishing
 // sp::readRobot's read-out.
 
-#include <QtTest>
+#include <QTest>
 
 #include <QTemporaryDir>
 

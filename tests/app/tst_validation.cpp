@@ -1,7 +1,7 @@
 // The founding paper's experiments in their quick versions, with the targets
 // asserted (docs/validation/report.md has the full runs).
 
-#include <QtTest>
+#include <QTest>
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 // out with timeouts, and nothing of RobotClient's own behaviour (no
 // keep-alives of its own: a test decides when it goes silent).
 
-#include <QtTest>
+#include <QTest>
 
 #include <asio.hpp>
 

@@ -2,7 +2,7 @@
 // implementation computes it, it binds nonce, name, role and token, and
 // nonces do not repeat.
 
-#include <QtTest>
+#include <QTest>
 
 #include <set>
 

@@ -1,6 +1,6 @@
 // Tests of the CRC-32 (net/crc32.h).
 
-#include <QtTest>
+#include <QTest>
 
 #include <string>
 

@@ -1,7 +1,7 @@
 // Tests of the frame codec (net/frame.h): layout, decoding in pieces of any
 // size, every error kind with its exact message, and bounded memory.
 
-#include <QtTest>
+#include <QTest>
 
 #include <random>
 #include <string>

@@ -3,7 +3,7 @@
 // compiler, so that its properties are checked in every build; and checks
 // that the corpus still seeds every message type and every frame error.
 
-#include <QtTest>
+#include <QTest>
 
 #include <QDir>
 #include <QFile>

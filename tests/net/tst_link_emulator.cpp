@@ -1,7 +1,7 @@
 // Link emulation (net/link_emulator.h): delay and jitter bounds, loss
 // fraction, bandwidth, order, determinism.
 
-#include <QtTest>
+#include <QTest>
 
 #include <cmath>
 #include <vector>

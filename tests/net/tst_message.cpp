@@ -2,7 +2,7 @@
 // every type round-trips, the text is as documented, and every decoding
 // error names the type and the key in exact words.
 
-#include <QtTest>
+#include <QTest>
 
 #include <cmath>
 #include <limits>

@@ -1,7 +1,7 @@
 // The robot side of the link without sockets, on a fake clock: tokens,
 // lease, command checks, deadman, latched failsafe, e-stop, re-arm.
 
-#include <QtTest>
+#include <QTest>
 
 #include <deque>
 

@@ -12,7 +12,7 @@
 
 #include <QProcess>
 #include <QTcpServer>
-#include <QtTest>
+#include <QTest>
 
 #include <signal.h>
 

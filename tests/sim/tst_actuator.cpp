@@ -1,6 +1,6 @@
 // The actuator control law alone, without ODE: modes, limits, PID wind-up.
 
-#include <QtTest>
+#include <QTest>
 
 #include "sim/actuator.h"
 

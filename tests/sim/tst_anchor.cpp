@@ -3,7 +3,7 @@
 // twist and joint positions and rates, against the twin's own, link by
 // link; and the prediction error it causes.
 
-#include <QtTest>
+#include <QTest>
 
 #include <algorithm>
 #include <cmath>

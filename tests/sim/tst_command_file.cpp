@@ -1,7 +1,7 @@
 // Tests of command sequence files (sim/command_file.h) and of the command
 // texts they share with sim/command.h (toText, toString).
 
-#include <QtTest>
+#include <QTest>
 
 #include <QTemporaryDir>
 

@@ -3,7 +3,7 @@
 // two threads at once, and in two processes.
 
 #include <QProcess>
-#include <QtTest>
+#include <QTest>
 
 #include <cstring>
 #include <thread>

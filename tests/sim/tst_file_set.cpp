@@ -2,7 +2,7 @@
 // a world and its robot held in memory load without the disk, the set takes
 // precedence over the disk, and only regular files are read from the disk.
 
-#include <QtTest>
+#include <QTest>
 
 #include <QDir>
 #include <QTemporaryDir>

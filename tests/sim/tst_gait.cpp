@@ -2,7 +2,7 @@
 // smooth hip targets, braced and free wheels, and the wheel keeping pace with
 // a reaching foot.
 
-#include <QtTest>
+#include <QTest>
 
 #include <cmath>
 

@@ -1,7 +1,7 @@
 // The twin notices when it diverges: it stops stepping and says what broke,
 // where and when; it never crashes or resets silently.
 
-#include <QtTest>
+#include <QTest>
 
 #include <cmath>
 #include <limits>

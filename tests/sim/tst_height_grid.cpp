@@ -1,7 +1,7 @@
 // Tests of sp::HeightGrid: extremes and interpolation on the two triangles of
 // each cell, split by the diagonal from (i, j) to (i+1, j+1).
 
-#include <QtTest>
+#include <QTest>
 #include <cmath>
 
 #include "sim/height_grid.h"

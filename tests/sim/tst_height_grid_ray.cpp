@@ -3,7 +3,7 @@
 
 #include <ode/ode.h>
 
-#include <QtTest>
+#include <QTest>
 #include <algorithm>
 #include <array>
 #include <cmath>

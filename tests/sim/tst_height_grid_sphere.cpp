@@ -2,7 +2,7 @@
 // against a HeightGrid's triangles, checked against geometry and against
 // ODE's own sphere-vs-heightfield where that one is right.
 
-#include <QtTest>
+#include <QTest>
 #include <cmath>
 #include <random>
 

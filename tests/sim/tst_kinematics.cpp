@@ -2,7 +2,7 @@
 // WorkPartner has moved many joints, the links drawn from its base pose and
 // joint positions are where ODE has them.
 
-#include <QtTest>
+#include <QTest>
 
 #include <cmath>
 

@@ -3,7 +3,7 @@
 // read from good files (degrees in files, radians inside).
 // Fixtures are small inline XML strings; line 1 is the line of the root tag.
 
-#include <QtTest>
+#include <QTest>
 
 #include <cmath>
 #include <string>

@@ -1,7 +1,7 @@
 // Tests of sp::Pacer (sim/pacer.h) against a fake clock: a plain double the
 // test advances the way a sleeping physics thread would see a real one.
 
-#include <QtTest>
+#include <QTest>
 
 #include <algorithm>
 #include <cmath>

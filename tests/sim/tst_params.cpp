@@ -1,7 +1,7 @@
 // Tests of the simulation parameters (sim/params.h) and of
 // config/defaults.params.
 
-#include <QtTest>
+#include <QTest>
 
 #include <QTemporaryDir>
 

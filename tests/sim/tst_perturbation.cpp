@@ -2,7 +2,7 @@
 // drawn from the seed alone, within their ranges, applied where the physics
 // feels them, and they change what the robot does.
 
-#include <QtTest>
+#include <QTest>
 
 #include <cmath>
 

@@ -1,7 +1,7 @@
 // Tests of sp::readRobot (sim/readout.h): the one read-out of a robot's
 // state that telemetry, the session log and validation share.
 
-#include <QtTest>
+#include <QTest>
 
 #include <memory>
 

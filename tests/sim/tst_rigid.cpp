@@ -3,7 +3,7 @@
 // also with joints below held ones still moving (wheels below held legs);
 // what cannot be held is refused, naming the joint.
 
-#include <QtTest>
+#include <QTest>
 
 #include <cmath>
 

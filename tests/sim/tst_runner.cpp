@@ -1,7 +1,7 @@
 // Tests of sp::Runner (sim/runner.h): the one step loop the headless runner,
 // re-simulation, the stand-in and validation share.
 
-#include <QtTest>
+#include <QTest>
 
 #include <memory>
 

@@ -3,7 +3,9 @@
 // and deliberately bad documents fail with the expected complaint, so the
 // schemas are known to be strict. Runs xmllint (package libxml2-utils).
 
-#include <QtTest>
+#include <QProcess>
+#include <QStandardPaths>
+#include <QTest>
 
 #include <QRegularExpression>
 

@@ -2,7 +2,7 @@
 // from a tilted scanner and to a slope; encoders, poses, joint and wheel
 // forces, the IMU at rest; rates and seeded noise.
 
-#include <QtTest>
+#include <QTest>
 
 #include <cmath>
 

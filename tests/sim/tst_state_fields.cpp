@@ -1,7 +1,7 @@
 // The state fields listed once (sim/state_fields.h): what the state hash
 // takes is what the list marks hashed, and nothing else.
 
-#include <QtTest>
+#include <QTest>
 
 #include "sim/model_loader.h"
 #include "sim/state_fields.h"

@@ -3,7 +3,7 @@
 // grids saved as .asc, .pgm and .csv load back as they were, and a world
 // file saved with its terrain loads.
 
-#include <QtTest>
+#include <QTest>
 
 #include <cmath>
 #include <filesystem>

@@ -1,7 +1,7 @@
 // Tests of sp::loadHeightGrid: every file format, the north-first row flip,
 // scaling and extents, and the exact text of each diagnostic, line included.
 
-#include <QtTest>
+#include <QTest>
 #include <cmath>
 #include <optional>
 

@@ -5,7 +5,8 @@
 // liburdfdom-tools) parses the WorkPartner's with every joint; what URDF
 // cannot say is refused with the reason.
 
-#include <QtTest>
+#include <QProcess>
+#include <QTest>
 
 #include <tinyxml2.h>
 

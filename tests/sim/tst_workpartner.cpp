@@ -1,7 +1,7 @@
 // The shipped WorkPartner model on the shipped worlds: mass and balance,
 // standing still, rolling at v = omega r, steering by the articulation hinge.
 
-#include <QtTest>
+#include <QTest>
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 // Physics of the twin checked against mathematics: free fall, resting
 // contact, rolling, friction, joint limits, actuators, terrain edits.
 
-#include <QtTest>
+#include <QTest>
 
 #include <algorithm>
 #include <cmath>

@@ -2,7 +2,7 @@
 // Builds worlds from small inline XML for the sim tests.
 
 #include <QTemporaryDir>
-#include <QtTest>
+#include <QTest>
 
 #include <fstream>
 #include <memory>

@@ -23,7 +23,7 @@
 #include <QStandardPaths>
 #include <QSurfaceFormat>
 #include <QTemporaryDir>
-#include <QtTest>
+#include <QTest>
 
 #include <signal.h>
 

@@ -4,7 +4,8 @@
 // No OpenGL: runs under QT_QPA_PLATFORM=offscreen and under xvfb-run alike.
 // grabReadsWell leaves SP_BINARY_DIR/live_plots.png behind to look at.
 
-#include <QtTest>
+#include <QSignalSpy>
+#include <QTest>
 
 #include <QApplication>
 #include <QCheckBox>

@@ -18,7 +18,9 @@
 #include <QTreeWidget>
 #include <QPushButton>
 #include <QDialog>
-#include <QtTest>
+#include <QSignalSpy>
+#include <QTimer>
+#include <QTest>
 
 #include <sqlite3.h>
 

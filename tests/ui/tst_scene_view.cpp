@@ -3,7 +3,7 @@
 // Needs real GL: run under `xvfb-run -a` (ctest label gl). Skips on the
 // offscreen platform, where Qt cannot show a GL widget (shared/STACK.md).
 
-#include <QtTest>
+#include <QTest>
 
 #include <QApplication>
 #include <QImage>

@@ -14,7 +14,8 @@
 #include <QTemporaryDir>
 #include <QTreeWidget>
 #include <QLabel>
-#include <QtTest>
+#include <QSignalSpy>
+#include <QTest>
 
 #include <chrono>
 #include <cmath>
