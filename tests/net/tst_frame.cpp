@@ -283,7 +283,10 @@ void TestFrame::garbage() {
   for (int i = 0; i < 2000; ++i) {
     std::string junk(3 + rng() % 62, '\0');
     for (char& c : junk) c = static_cast<char>(rng() & 0xFF);
-    if (i % 2) junk.replace(0, 2, "SP");
+    if (i % 2) {  // not replace(0, 2, "SP"): GCC 12 at -O3 warns of a bound it imagines there
+      junk[0] = 'S';
+      junk[1] = 'P';
+    }
     if (i % 4 == 1) junk[2] = 1;
     if (i % 8 == 1 && junk.size() >= 8) junk.replace(4, 4, std::string("\x10\0\0\0", 4));
     const Result whole = decodeWhole(junk);
