@@ -8,13 +8,17 @@
 // 16 in the full profile run to their end. Prints figures, asserts nothing.
 //
 //   build/bench/bench_rehearsal [--quick] [--profile-only] [--margins] [--fast STEP ITERATIONS]
+//                               [--random SEED COUNT]
 //
 // --profile-only: only the fast-profile comparison and robustness; --fast:
 // another fast profile than the defaults' (rehearsal.fast_*) to compare (a
 // finer one too: 0.0005 60 measures the full profile's own step error);
-// --margins: each rule's closest approach in both profiles.
+// --margins: each rule's closest approach in both profiles; --random: only
+// the profile comparison, over COUNT random sequences drawn from SEED (the
+// table's 20 are seed 32's: other seeds are sequences nothing was tuned on).
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -97,6 +101,8 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   bool quick = false, profileOnly = false, margins = false;
+  uint64_t randomSeed = 32;
+  int randomOnly = 0;  // > 0: only that many random sequences (--random)
   SimParams defaults;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) quick = true;
@@ -105,8 +111,12 @@ int main(int argc, char** argv) {
     else if (std::strcmp(argv[i], "--fast") == 0 && i + 2 < argc) {
       defaults.rehearsalFastStep = std::atof(argv[++i]);
       defaults.rehearsalFastIterations = std::atoi(argv[++i]);
+    } else if (std::strcmp(argv[i], "--random") == 0 && i + 2 < argc) {
+      randomSeed = std::strtoull(argv[++i], nullptr, 10);
+      randomOnly = std::atoi(argv[++i]);
+      profileOnly = true;
     } else {
-      std::fprintf(stderr, "usage: bench_rehearsal [--quick] [--profile-only] [--margins] [--fast STEP ITERATIONS]\n");
+      std::fprintf(stderr, "usage: bench_rehearsal [--quick] [--profile-only] [--margins] [--fast STEP ITERATIONS] [--random SEED COUNT]\n");
       return 2;
     }
   }
@@ -196,13 +206,23 @@ int main(int argc, char** argv) {
   };
   cases[0].text = readFile(root + "/terrains/demo.seq");
   cases[1].text = readFile(root + "/terrains/pick_place.seq");
-  Random random(32);
-  const int randomCount = quick ? 6 : 20;
+  if (randomOnly > 0) cases.clear();
+  Random random(randomSeed);
+  const int randomCount = randomOnly > 0 ? randomOnly : quick ? 6 : 20;
   for (int k = 0; k < randomCount; ++k)
     cases.push_back({"random " + std::to_string(k + 1) + (k % 2 ? " on bumpy" : " on flat"),
                      root + (k % 2 ? "/terrains/bumpy.world.xml" : "/terrains/flat.world.xml"), randomSequence(random)});
-  int same = 0, within = 0, failedFull = 0;
-  double fullTotal = 0, fastTotal = 0, largest = 0;
+  // Each fast run is run once without refinement (the fast profile's own
+  // verdicts and margins); where untrusted() would refine it, the refined
+  // result is the full run's (the same plan at full fidelity: deterministic,
+  // tst_rehearsal checks the hashes agree) and its time both runs'.
+  int same = 0, within = 0, failedFull = 0, refinedCount = 0, sameRefined = 0, withinRefined = 0;
+  double fullTotal = 0, fastTotal = 0, refinedTotal = 0, largest = 0;
+  // The largest |margin change| per rule over the runs the fast profile
+  // passed (a failed one is refined whatever its margins): what the bands
+  // must cover.
+  std::array<double, kRuleCount> error{};
+  std::array<std::string, kRuleCount> errorCase;
   for (const Case& c : cases) {
     Diagnostics d;
     const std::optional<WorldModel> w = loadWorld(c.world, d);
@@ -214,18 +234,33 @@ int main(int argc, char** argv) {
     RehearsalPlan casePlan{*w, defaults, {}, *commands, std::nullopt};
     const RehearsalResult full = rehearse(casePlan);
     casePlan.fast = true;
+    casePlan.refine = false;
     const RehearsalResult fast = rehearse(casePlan);
+    const std::string why = untrusted(fast, defaults);
     const ProfileAgreement a = compareProfiles(full, fast);
+    const ProfileAgreement b = why.empty() ? a : compareProfiles(full, full);
     same += a.sameVerdicts;
     within += a.within(0.1);
+    sameRefined += b.sameVerdicts;
+    withinRefined += b.within(0.1);
+    refinedCount += !why.empty();
     failedFull += !full.passed;
     largest = std::max(largest, a.largestChange);
     fullTotal += full.wallSeconds;
     fastTotal += fast.wallSeconds;
-    std::printf("%-26s %8.2f %8.2f %6.2fx %-8s %-9s %5.1f %% (%s)%s%s\n", c.name.c_str(), full.wallSeconds,
+    refinedTotal += fast.wallSeconds + (why.empty() ? 0 : full.wallSeconds);
+    for (size_t r = 0; r < full.verdicts.size() && r < fast.verdicts.size(); ++r) {
+      const RuleVerdict &u = full.verdicts[r], &v = fast.verdicts[r];
+      const double e = std::abs(ruleMargin(u) - ruleMargin(v));
+      if (fast.passed && u.rule == v.rule && v.rule != Rule::Health && e > error[static_cast<int>(v.rule)]) {
+        error[static_cast<int>(v.rule)] = e;
+        errorCase[static_cast<int>(v.rule)] = c.name;
+      }
+    }
+    std::printf("%-26s %8.2f %8.2f %6.2fx %-8s %-9s %5.1f %% (%s)%s%s%s%s\n", c.name.c_str(), full.wallSeconds,
                 fast.wallSeconds, full.wallSeconds / fast.wallSeconds, full.passed ? "passed" : "failed",
                 a.sameVerdicts ? "same" : "DIFFER", 100 * a.largestChange, a.largestRule.c_str(),
-                a.differ.empty() ? "" : "  ", a.differ.c_str());
+                a.differ.empty() ? "" : "  ", a.differ.c_str(), why.empty() ? "" : "; refined: ", why.c_str());
     if (margins)
       for (size_t r = 0; r < full.verdicts.size() && r < fast.verdicts.size(); ++r) {
         const RuleVerdict &u = full.verdicts[r], &v = fast.verdicts[r];
@@ -236,7 +271,16 @@ int main(int argc, char** argv) {
   std::printf("%zu sequences (%d failing in the full profile): verdicts the same in %d, every margin within 10 %% in %d; "
               "largest margin change %.1f %%; all together %.1f s full, %.1f s fast (%.2fx)\n",
               cases.size(), failedFull, same, within, 100 * largest, fullTotal, fastTotal, fullTotal / fastTotal);
+  std::printf("refined where untrusted (rehearsal.refine_*): %d of %zu run again at full fidelity; verdicts the same in "
+              "%d, every margin within 10 %% in %d; %.1f s (%.2fx faster than full)\n",
+              refinedCount, cases.size(), sameRefined, withinRefined, refinedTotal, fullTotal / refinedTotal);
+  std::printf("the fast profile's largest margin error per rule (runs it passed), against its refine band:\n");
+  for (int r = 0; r < kRuleCount; ++r)
+    if (static_cast<Rule>(r) != Rule::Health)
+      std::printf("    %-15s %9.4f  x11 = %9.4f   band %9.4f  (%s)\n", toString(static_cast<Rule>(r)), error[r],
+                  11 * error[r], refineBand(static_cast<Rule>(r), defaults), errorCase[r].c_str());
 
+  if (randomOnly > 0) return 0;
   // 16 robustness samples of the demo sequence on flat ground: as
   // robustness() runs them (fast, stopped at a failure) against the same 16
   // in the full profile run to their end, both on two threads.
@@ -267,8 +311,8 @@ int main(int argc, char** argv) {
       fullTimes.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
     }
     std::printf("robustness, 16 samples of demo.seq on flat ground, 2 threads: %.2f s (fast profile, stopped at a "
-                "failure; %d passed) against %.2f s in the full profile (%.2fx)\n",
-                median(fastTimes), r.passed, median(fullTimes), median(fullTimes) / median(fastTimes));
+                "failure; %d passed, %d refined) against %.2f s in the full profile (%.2fx)\n",
+                median(fastTimes), r.passed, r.refined, median(fullTimes), median(fullTimes) / median(fastTimes));
   }
   return 0;
 }

@@ -57,6 +57,23 @@ struct SimParams {
   /// joints turn) while no command or gait moves them: the legs, as the
   /// ghost holds them (app/rehearse/held_twin.h).
   std::string rehearsalFastHold = "hip_fl,hip_fr,hip_rl,hip_rr";
+  /// Where the fast profile is not trusted: a fast run that fails a rule,
+  /// or comes closer to a rule's limit than its band here, is run again at
+  /// full fidelity (RehearsalPlan::refine). A band is 11 times the largest
+  /// margin error the fast profile made for that rule over the random
+  /// sequences it passed (24 of 40: bench_rehearsal --random 132 40,
+  /// docs/performance.md), so the margins it reports stay within 10 % of
+  /// the full profile's. In the rule's unit, one per rule of
+  /// sim/flight_rules.h but collisions and the twin's health: they have no
+  /// distance to a limit, only a failure, which refines.
+  double refineStability = 0.015;    ///< [m] of support margin
+  double refineRoll = 1.6;           ///< [deg]
+  double refinePitch = 1.2;          ///< [deg]
+  double refineJointLimit = 2.4;     ///< [deg] from a joint's stop margin
+  double refineLiftoff = 0.4;        ///< [s]
+  double refineWheelForce = 1150;    ///< [N]
+  double refineSpeed = 0.48;         ///< [m/s]
+  double refineYawRate = 28;         ///< [deg/s]
   double ghostStep = 0.004;       ///< [s] console's predictive ghost: its physics step
   int ghostIterations = 20;       ///< ghost: quick solver iterations
   double ghostHorizon = 5;        ///< [s] ghost: how far the trail looks ahead of the ghost

@@ -147,7 +147,10 @@ std::optional<SettledStart> settleWorldStart(const WorldModel& model, const SimP
   return std::nullopt;
 }
 
-RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress) {
+namespace {
+
+// One run in the plan's profile.
+RehearsalResult rehearseOnce(const RehearsalPlan& plan, const std::function<bool(double)>& progress) {
   const auto t0 = Clock::now();
   RehearsalResult result;
   result.fast = plan.fast;
@@ -237,6 +240,56 @@ RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(dou
   result.endHash = world->stateHash();
   result.wallSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return result;
+}
+
+}  // namespace
+
+double refineBand(Rule rule, const SimParams& p) {
+  switch (rule) {
+    case Rule::Stability: return p.refineStability;
+    case Rule::Roll: return p.refineRoll;
+    case Rule::Pitch: return p.refinePitch;
+    case Rule::JointLimit: return p.refineJointLimit;
+    case Rule::WheelLiftoff: return p.refineLiftoff;
+    case Rule::WheelForce: return p.refineWheelForce;
+    case Rule::Speed: return p.refineSpeed;
+    case Rule::YawRate: return p.refineYawRate;
+    case Rule::Collision:  // touching or not: a failure refines
+    case Rule::Health: return 0;
+  }
+  return 0;
+}
+
+std::string untrusted(const RehearsalResult& fast, const SimParams& params) {
+  if (!fast.refused.empty()) return "a command was refused";
+  for (const RuleVerdict& v : fast.verdicts) {
+    if (!v.passed) return std::string(toString(v.rule)) + " failed";
+    // Stopped early, the rules not yet failed have partial margins: the
+    // failure above decides.
+    const double band = refineBand(v.rule, params);
+    if (!fast.stoppedEarly && ruleMargin(v) < band) {
+      char text[120];
+      std::snprintf(text, sizeof text, "%s %.3g from its limit, within the fast profile's %.3g", toString(v.rule),
+                    ruleMargin(v), band);
+      return text;
+    }
+  }
+  return fast.passed ? "" : "it did not pass";
+}
+
+RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress) {
+  RehearsalResult first = rehearseOnce(plan, progress);
+  if (!plan.fast || !plan.refine || first.cancelled || !first.error.empty()) return first;
+  std::string why = untrusted(first, plan.params);
+  if (why.empty()) return first;
+  // Near a limit (or past it) the fast profile's error could change the
+  // verdict or move the margin by more than 10 %: the full profile decides.
+  RehearsalPlan full = plan;
+  full.fast = false;
+  RehearsalResult r = rehearseOnce(full, progress);
+  r.refined = std::move(why);
+  r.wallSeconds += first.wallSeconds;
+  return r;
 }
 
 double ruleMargin(const RuleVerdict& v) {
@@ -336,7 +389,7 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
   // Per sample, written by the worker threads: chars, not vector<bool>'s
   // shared bits, so two threads never write one word.
   std::vector<char> passed(static_cast<size_t>(n), 0), ranToTheEnd(static_cast<size_t>(n), 0);
-  std::atomic<int> next{0}, done{0};
+  std::atomic<int> next{0}, done{0}, refined{0};
   std::atomic<bool> cancelled{false};
   std::mutex progressMutex;
   auto work = [&] {
@@ -347,6 +400,7 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
       if (!r.path.empty()) out.endPoses[i] = r.path.back().base;
       out.endHashes[static_cast<size_t>(i)] = r.endHash;
       ranToTheEnd[static_cast<size_t>(i)] = !r.stoppedEarly;
+      refined += !r.refined.empty();
       const int d = ++done;
       if (progress) {
         std::lock_guard lock(progressMutex);
@@ -360,6 +414,7 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
   for (std::thread& t : pool) t.join();
   out.samplePassed.assign(passed.begin(), passed.end());
   out.passed = static_cast<int>(std::count(passed.begin(), passed.end(), 1));
+  out.refined = refined;
   Vec3 mean;
   const auto ended = std::count(ranToTheEnd.begin(), ranToTheEnd.end(), 1);
   for (size_t k = 0; k < out.endPoses.size(); ++k)

@@ -54,6 +54,12 @@ struct RehearsalPlan {
   /// Stop at the first failed rule (the verdict is known; the other rules
   /// are judged only up to then).
   bool stopAtFirstFailure = false;
+  /// With `fast`: where the fast profile is not to be trusted (a rule
+  /// failed, or a margin is within params' rehearsal.refine_* band of its
+  /// limit, untrusted()), run again at full fidelity and return that
+  /// (RehearsalResult::refined says why). Off for a preview that the full
+  /// rehearsal follows anyway (the console's first verdicts).
+  bool refine = true;
 };
 
 /// A world's start settled: the robot let down onto the ground (worlds
@@ -96,7 +102,10 @@ struct RehearsalResult {
   uint64_t endHash = 0;    ///< World::stateHash() at the end
   int heldJoints = 0;      ///< joints held rigid throughout (plan.holdUnmoved)
   int switches = 0;        ///< times the twin welded or freed joints mid-run (app/rehearse/held_twin.h)
-  bool fast = false;       ///< run in the fast profile (plan.fast)
+  bool fast = false;       ///< run in the fast profile (plan.fast; false once refined)
+  /// Why a fast run was run again at full fidelity (plan.refine), "" if it
+  /// was not; wallSeconds then counts both runs.
+  std::string refined;
   bool stoppedEarly = false;  ///< a rule failed and plan.stopAtFirstFailure stopped the run there
   /// [s] how long the robot settled from the world's start before t = 0
   /// (0 when the plan gave a start).
@@ -116,6 +125,13 @@ struct RehearsalResult {
 /// simulated time; returning false cancels. Never throws for bad input: a
 /// world that cannot be built or a start that does not fit is `error`.
 RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress = {});
+
+/// The margin [the rule's unit] within which the fast profile is not
+/// trusted for `rule` (params' rehearsal.refine_*; 0 for twin health).
+double refineBand(Rule rule, const SimParams& params);
+/// Why a fast run's verdicts are not to be trusted ("" when they are): a
+/// refused command, a failed rule, or a margin within refineBand().
+std::string untrusted(const RehearsalResult& fast, const SimParams& params);
 
 /// A rule's margin: the distance of its closest approach from its limit,
 /// on the safe side positive, beyond the limit negative (signed rules
@@ -153,6 +169,7 @@ RehearsalPlan perturbed(const RehearsalPlan& plan, uint64_t seed);
 /// rule; a sweep's samples, the same draws, at full fidelity to the end).
 struct RobustnessResult {
   int samples = 0, passed = 0;
+  int refined = 0;  ///< fast samples run again at full fidelity (RehearsalPlan::refine)
   double probability() const { return samples ? static_cast<double>(passed) / samples : 0; }
   std::vector<Pose> endPoses;         ///< per sample
   std::vector<uint64_t> endHashes;    ///< per sample: World::stateHash() at its end (a sweep's `hash`)

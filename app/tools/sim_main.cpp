@@ -426,9 +426,10 @@ int rehearseCommand(const std::vector<std::string>& args) {
   std::cout << "rehearsal of " << commandsFile << " (hash " << sp::sequenceHash(sp::sequenceText(*commands, &world->robots[0].model))
             << ") on " << worldFile << ": " << r.duration << " s simulated in " << r.wallSeconds << " s, after "
             << r.settled << " s for the robot to settle from the world's start"
-            << (fast ? " (fast profile: step " + sp::shortestText(params.rehearsalFastStep * 1000) + " ms, " +
-                           std::to_string(params.rehearsalFastIterations) + " iterations; a preview, not sendable)"
-                     : std::string())
+            << (!r.refined.empty() ? " (fast profile, run again at full fidelity: " + r.refined + "; not sendable)"
+                : fast ? " (fast profile: step " + sp::shortestText(params.rehearsalFastStep * 1000) + " ms, " +
+                             std::to_string(params.rehearsalFastIterations) + " iterations; a preview, not sendable)"
+                       : std::string())
             << "\n";
   for (const sp::RuleVerdict& v : r.verdicts) std::cout << "  " << (v.passed ? "pass  " : "FAIL  ") << v.message() << "\n";
   for (const std::string& why : r.refused) std::cerr << commandsFile << ": error: refused: " << why << "\n";
@@ -438,7 +439,8 @@ int rehearseCommand(const std::vector<std::string>& args) {
     samples.fast = samples.stopAtFirstFailure = true;
     const sp::RobustnessResult rob = sp::robustness(samples, 1, 2);
     std::cout << "robustness: " << rob.passed << " of " << rob.samples << " passed (" << 100 * rob.probability()
-              << " %), end positions within " << rob.spread << " m of their mean, " << rob.wallSeconds << " s\n";
+              << " %), end positions within " << rob.spread << " m of their mean, " << rob.wallSeconds << " s; "
+              << rob.refined << " run again at full fidelity (failed or near a limit)\n";
     for (int i = 0; i < rob.samples; ++i)
       if (!rob.samplePassed[i]) std::cout << "  sample " << i << ": " << rob.failures[i] << "\n";
   }

@@ -285,6 +285,7 @@ class TestRehearsal : public QObject {
       plan.commands = parseOrFail(c.commands.c_str(), plan.world.robots[0].model);
       const RehearsalResult full = rehearse(plan);
       plan.fast = true;
+      plan.refine = false;  // the fast profile's own verdicts
       const RehearsalResult fast = rehearse(plan);
       const ProfileAgreement a = compareProfiles(full, fast);
       qInfo("%s: full %s in %.2f s, fast in %.2f s; verdicts %s, largest margin change %.1f %% (%s)", c.world,
@@ -308,6 +309,80 @@ class TestRehearsal : public QObject {
     const ProfileAgreement coarse = compareProfiles(pickPlaceFull, rehearse(pickPlace));
     qInfo("4 ms / 10 iterations on pick_place: %s", coarse.differ.c_str());
     QVERIFY(!coarse.sameVerdicts);
+  }
+
+  // Where the fast profile is not trusted it is run again at full
+  // fidelity: a run that fails a rule, or passes within a rule's
+  // rehearsal.refine.* band. Criterion (before the run): the tipping
+  // sequence fails, so it comes back refined, its result the full run's to
+  // the state hash (margins 0 % apart), `fast` false, never relayed; demo's
+  // margins are all outside their bands, so it stays fast; with the yaw
+  // rate's band as wide as its limit (60 deg/s) demo is refined too, and is
+  // then the full run. (On pick_place, where the knee comes 1.24 deg from
+  // its stop margin and the fast profile moves that margin 22 %, the bands
+  // refine it: bench_rehearsal, docs/performance.md.)
+  void untrustedFastRunsAreRefined() {
+    QFile demoFile(QStringLiteral(SP_SOURCE_DIR "/terrains/demo.seq"));
+    QVERIFY(demoFile.open(QIODevice::ReadOnly));
+    struct Case {
+      const char* world;
+      std::string commands;
+      double yawRateBand;
+      bool refined;
+    };
+    const Case cases[] = {{"terrains/test_track.world.xml", kTip, SimParams{}.refineYawRate, true},
+                          {"terrains/flat.world.xml", demoFile.readAll().toStdString(), SimParams{}.refineYawRate, false},
+                          {"terrains/flat.world.xml", "", 60, true}};
+    RehearsalResult full;
+    for (const Case& c : cases) {
+      RehearsalPlan plan{loadOrFail(c.world), {}, {}, {}, {}};
+      plan.commands = parseOrFail((c.commands.empty() ? cases[1].commands : c.commands).c_str(),
+                                  plan.world.robots[0].model);
+      plan.params.refineYawRate = c.yawRateBand;
+      if (!c.commands.empty()) full = rehearse(plan);  // the last case reuses demo's
+      plan.fast = true;
+      const RehearsalResult r = rehearse(plan);
+      qInfo("%s, yaw rate band %g deg/s: %s in %.2f s (full alone %.2f s); %s", c.world, c.yawRateBand,
+            r.refined.empty() ? "fast" : "refined", r.wallSeconds, full.wallSeconds, r.refined.c_str());
+      QCOMPARE(!r.refined.empty(), c.refined);
+      QCOMPARE(r.fast, !c.refined);
+      QCOMPARE(r.passed, full.passed);
+      if (c.refined) {
+        QCOMPARE(r.endHash, full.endHash);
+        QVERIFY(compareProfiles(full, r).within(0.0));
+        QVERIFY(r.wallSeconds > full.wallSeconds);
+      } else {
+        QVERIFY(r.endHash != full.endHash);
+      }
+      std::string why;
+      QVERIFY(!sequenceMessage(plan, r, why));
+    }
+  }
+
+  // Which runs untrusted() sends back: a failed rule, a refused command, a
+  // margin inside its band; not one outside it, nor a collision rule that
+  // passed (no distance to a limit: its margin is 0).
+  void untrustedNamesWhy() {
+    SimParams params;
+    RehearsalResult r;
+    r.passed = true;
+    RuleVerdict stability;
+    stability.rule = Rule::Stability;
+    stability.limit = 0.05;
+    stability.worst = 0.05 + params.refineStability * 1.01;
+    RuleVerdict collision;
+    collision.rule = Rule::Collision;
+    r.verdicts = {stability, collision};
+    QCOMPARE(untrusted(r, params), std::string());
+    r.verdicts[0].worst = 0.05 + params.refineStability * 0.99;
+    QVERIFY(untrusted(r, params).find("stability") == 0);
+    r.verdicts[0].worst = 0.2;
+    r.verdicts[1].passed = false;
+    r.passed = false;
+    QCOMPARE(untrusted(r, params), std::string("collision failed"));
+    r.verdicts[1].passed = r.passed = true;
+    r.refused = {"line 2 at 1 s: no such joint"};
+    QCOMPARE(untrusted(r, params), std::string("a command was refused"));
   }
 
   // A margin keeps its side of the limit: a run whose centre of mass came

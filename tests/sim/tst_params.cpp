@@ -61,6 +61,8 @@ SimParams allChanged() {
   p.maxAngularSpeed = 6;
   p.maxJointError = 7;
   p.maxPenetration = 8;
+  p.refineJointLimit = 5;
+  p.refineYawRate = 9;
   return p;
 }
 
@@ -136,7 +138,7 @@ void TestParams::tableDefaultsAreSimParamsDefaults() {
   std::set<std::string> seen;
   const QRegularExpression keyPattern("^[a-z]+(\\.[a-z_]+)+$");
   const std::vector<ParamInfo> table = paramTable();
-  QCOMPARE(table.size(), size_t(50));
+  QCOMPARE(table.size(), size_t(58));
   for (const ParamInfo& info : table) {
     QVERIFY2(seen.insert(info.key).second, info.key.c_str());
     QVERIFY2(keyPattern.match(q(info.key)).hasMatch(), info.key.c_str());
@@ -181,6 +183,7 @@ void TestParams::setParamAccepts_data() {
   QTest::newRow("angular acceleration") << "health.max_angular_acceleration" << "5e4" << "50000";
   QTest::newRow("joint error") << "health.max_joint_error" << "0.01" << "0.01";
   QTest::newRow("penetration") << "health.max_penetration" << "0.2" << "0.2";
+  QTest::newRow("refine band 0") << "rehearsal.refine.joint_limit" << "0" << "0";
 }
 
 // Valid values within each key's range are stored and read back.
@@ -235,6 +238,8 @@ void TestParams::setParamRejects_data() {
   QTest::newRow("step zero") << "physics.step" << "0" << "physics.step: must be >= 1e-05, got 0";
   QTest::newRow("step vanishing") << "physics.step" << "1e-300" << "physics.step: must be >= 1e-05, got 1e-300";
   QTest::newRow("step too big") << "physics.step" << "0.2" << "physics.step: must be <= 0.1, got 0.2";
+  QTest::newRow("refine band negative") << "rehearsal.refine.speed" << "-0.1"
+                                        << "rehearsal.refine.speed: must be >= 0, got -0.1";
   QTest::newRow("solver") << "physics.solver" << "fast" << "physics.solver: expected 'quick' or 'exact', got 'fast'";
   QTest::newRow("solver case") << "physics.solver" << "Quick"
                                << "physics.solver: expected 'quick' or 'exact', got 'Quick'";

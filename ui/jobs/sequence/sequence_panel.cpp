@@ -418,6 +418,7 @@ bool SequencePanel::rehearse() {
     // the one Send relays, runs (issue 32).
     auto preview = std::make_shared<RehearsalPlan>(plan);
     preview->fast = preview->stopAtFirstFailure = true;
+    preview->refine = false;  // the full rehearsal follows anyway
     auto first = std::make_shared<RehearsalResult>(
         sp::rehearse(*preview, [&](double f) { return progress(0.25 * f) && !cancel->load(); }));
     if (!first->cancelled)
@@ -551,12 +552,14 @@ void SequencePanel::robustnessFinished(RobustnessResult r) {
   QString worst;
   for (int i = 0; i < robust_->samples && worst.isEmpty(); ++i)
     if (!robust_->samplePassed[i]) worst = QString::fromStdString(robust_->failures[i]);
-  setStatus(tr("Robustness: %1 of %2 passed (%3 %), end positions within %4 m of their mean%5")
+  setStatus(tr("Robustness: %1 of %2 passed (%3 %), end positions within %4 m of their mean%5%6")
                 .arg(robust_->passed)
                 .arg(robust_->samples)
                 .arg(100 * robust_->probability(), 0, 'f', 0)
                 .arg(robust_->spread, 0, 'f', 3)
-                .arg(worst.isEmpty() ? QString() : tr("; e.g. %1").arg(worst)));
+                .arg(worst.isEmpty() ? QString() : tr("; e.g. %1").arg(worst))
+                .arg(robust_->refined ? tr("; %1 near a limit or failing run again at full fidelity").arg(robust_->refined)
+                                      : QString()));
   emit logEvent("rehearsal", QStringLiteral("robustness: %1 of %2 passed, end spread %3 m")
                                  .arg(robust_->passed)
                                  .arg(robust_->samples)
