@@ -146,6 +146,14 @@ class TestRehearsal : public QObject {
     const RobustnessResult tip = robustness(plan, 7, 2);
     qInfo("tipping: %d of %d passed; sample 0: %s", tip.passed, tip.samples, tip.failures[0].c_str());
     QCOMPARE(tip.passed, 0);
+    QCOMPARE(tip.refined, 0);  // full profile: nothing to refine
+    // As the console runs them: fast, stopped at a failure; each failed
+    // sample is judged again at full fidelity, and fails there too.
+    plan.fast = plan.stopAtFirstFailure = true;
+    const RobustnessResult fastTip = robustness(plan, 7, 2);
+    qInfo("tipping, fast: %d of %d passed, %d refined", fastTip.passed, fastTip.samples, fastTip.refined);
+    QCOMPARE(fastTip.passed, 0);
+    QCOMPARE(fastTip.refined, 4);
   }
 
   // Holding the joints no command moves is a speed lever, not another
@@ -350,7 +358,6 @@ class TestRehearsal : public QObject {
       if (c.refined) {
         QCOMPARE(r.endHash, full.endHash);
         QVERIFY(compareProfiles(full, r).within(0.0));
-        QVERIFY(r.wallSeconds > full.wallSeconds);
       } else {
         QVERIFY(r.endHash != full.endHash);
       }
