@@ -219,7 +219,7 @@ const std::vector<Entry>& table() {
             real(&SimParams::refineRoll, closed(0, 90))),
       entry("rehearsal.refine.pitch", "fast profile: a pitch this close to its limit, judged again [deg], [0, 90]",
             real(&SimParams::refinePitch, closed(0, 90))),
-      entry("rehearsal.refine.joint_limit", "fast profile: a joint this close to its stop's margin, judged again [deg], [0, 180]",
+      entry("rehearsal.refine.joint_limit", "fast profile: a joint this close to its stop's margin, judged again [deg; cm for a sliding joint], [0, 180]",
             real(&SimParams::refineJointLimit, closed(0, 180))),
       entry("rehearsal.refine.wheel_liftoff", "fast profile: a wheel off the ground this close to its limit, judged again [s], [0, 60]",
             real(&SimParams::refineLiftoff, closed(0, 60))),
