@@ -271,7 +271,7 @@ int main(int argc, char** argv) {
   std::printf("%zu sequences (%d failing in the full profile): verdicts the same in %d, every margin within 10 %% in %d; "
               "largest margin change %.1f %%; all together %.1f s full, %.1f s fast (%.2fx)\n",
               cases.size(), failedFull, same, within, 100 * largest, fullTotal, fastTotal, fullTotal / fastTotal);
-  std::printf("refined where untrusted (rehearsal.refine_*): %d of %zu run again at full fidelity; verdicts the same in "
+  std::printf("refined where untrusted (rehearsal.refine.*): %d of %zu run again at full fidelity; verdicts the same in "
               "%d, every margin within 10 %% in %d; %.1f s (%.2fx faster than full)\n",
               refinedCount, cases.size(), sameRefined, withinRefined, refinedTotal, fullTotal / refinedTotal);
   std::printf("the fast profile's largest margin error per rule (runs it passed), against its refine band:\n");

@@ -55,7 +55,7 @@ struct RehearsalPlan {
   /// are judged only up to then).
   bool stopAtFirstFailure = false;
   /// With `fast`: where the fast profile is not to be trusted (a rule
-  /// failed, or a margin is within params' rehearsal.refine_* band of its
+  /// failed, or a margin is within params' rehearsal.refine.* band of its
   /// limit, untrusted()), run again at full fidelity and return that
   /// (RehearsalResult::refined says why). Off for a preview that the full
   /// rehearsal follows anyway (the console's first verdicts).
@@ -127,7 +127,7 @@ struct RehearsalResult {
 RehearsalResult rehearse(const RehearsalPlan& plan, const std::function<bool(double)>& progress = {});
 
 /// The margin [the rule's unit] within which the fast profile is not
-/// trusted for `rule` (params' rehearsal.refine_*; 0 for twin health).
+/// trusted for `rule` (params' rehearsal.refine.*; 0 for twin health).
 double refineBand(Rule rule, const SimParams& params);
 /// Why a fast run's verdicts are not to be trusted ("" when they are): a
 /// refused command, a failed rule, or a margin within refineBand().
