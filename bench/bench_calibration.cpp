@@ -17,7 +17,8 @@
 //                 matched twin (the robot's own physics and delay: the floor
 //                 the ghost's coarse profile sets);
 //   fitted        wheel radius against the hidden mean of the four wheels,
-//                 total mass against the hidden total;
+//                 total mass against the hidden total, the centre of mass
+//                 against the hidden one (centreShift over the drive's poses);
 //   rehearsal     a 30 s sequence rehearsed (app/rehearse) with the files' and
 //                 with the calibrated parameters, from rest, against the
 //                 perturbed robot running it: end position errors; and
@@ -136,6 +137,7 @@ struct Case {
   double oraclePos = 0, oracleHead = 0;                  // the hidden values of the fitted parameters
   double filesHead = 0, calHead = 0, matchedHead = 0;   // [rad]
   double radiusFit = 0, radiusTrue = 0, massFit = 0, massTrue = 0;
+  Vec3 comFit, comTrue;  // [m] forward, left of the files' (calibration.com_x, com_y)
   double rehearseFiles = 0, rehearseCal = 0, rehearseGhostValues = 0, rehearseOracle = 0, rehearseOwn = 0;  // [m] end position errors
   double checkMs = 0;
   double fitMsMax = 0, fitMsMedian = 0;
@@ -217,6 +219,12 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
   }
   c.massTrue = perturbed / files;
   c.massFit = values[static_cast<size_t>(CalParam::Mass)];
+  // The robot's centre of mass against the files', as calibration.com_x,
+  // com_y would move it over the poses the robot drove through (comFromLoads'
+  // meaning: bent legs turn their links' parts of a shift).
+  if (const auto truth = centreShift(robot, perturbWorld(world, p).robots[0].model, framesUpTo(30)))
+    c.comTrue = {truth->forward, truth->left, 0};
+  c.comFit = {values[static_cast<size_t>(CalParam::ComX)], values[static_cast<size_t>(CalParam::ComY)], 0};
 
   // The ghost's error over 30-60 s, 2 s ahead.
   std::vector<RobotFrame> judged;
@@ -241,6 +249,8 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
   oracle[static_cast<size_t>(CalParam::MotorGain)] = p.velocityGain;
   oracle[static_cast<size_t>(CalParam::Delay)] = p.delay;
   oracle[static_cast<size_t>(CalParam::Mass)] = c.massTrue;
+  oracle[static_cast<size_t>(CalParam::ComX)] = c.comTrue.x;
+  oracle[static_cast<size_t>(CalParam::ComY)] = c.comTrue.y;
   check(world, oracle, c.oraclePos, c.oracleHead);
   if (std::getenv("SP_BENCH_VALUES")) {  // each parameter: estimate +- sigma [applied] (hidden)
     std::string text;
@@ -352,17 +362,18 @@ int main(int argc, char** argv) {
   std::atomic<size_t> next{0};
   std::mutex print;
   std::printf("world  seed | ghost pos [cm] files  calib  oracle matched | heading [deg] files calib oracle matched | radius fit/true  "
-              "mass fit/true | rehearsal end [m] files calib (ghost's values) oracle own | fits (refused) fit ms med/max, check ms\n");
+              "mass fit/true | com x, y fit/true [mm] | rehearsal end [m] files calib (ghost's values) oracle own | fits (refused) fit ms med/max, check ms\n");
   const auto worker = [&] {
     for (size_t i; (i = next++) < work.size();) {
       const auto& [w, seed] = work[i];
       Case c = run(loaded[w].first, loaded[w].second, seed);
       std::lock_guard lock(print);
-      std::printf("%-6s %4llu | %6.2f %6.2f %6.2f %6.2f | %5.2f %5.2f %5.2f %5.2f | %.4f/%.4f %.3f/%.3f | %6.3f %6.3f (%6.3f) %6.3f %6.3f | %d (%d) %4.0f/%4.0f %5.0f %s\n",
+      std::printf("%-6s %4llu | %6.2f %6.2f %6.2f %6.2f | %5.2f %5.2f %5.2f %5.2f | %.4f/%.4f %.3f/%.3f | %5.1f/%5.1f %5.1f/%5.1f | %6.3f %6.3f (%6.3f) %6.3f %6.3f | %d (%d) %4.0f/%4.0f %5.0f %s\n",
                   c.world.c_str(), static_cast<unsigned long long>(c.seed), c.filesPos * 100, c.calPos * 100,
                   c.oraclePos * 100, c.matchedPos * 100, c.filesHead * 57.2958, c.calHead * 57.2958, c.oracleHead * 57.2958,
                   c.matchedHead * 57.2958, c.radiusFit,
-                  c.radiusTrue, c.massFit, c.massTrue, c.rehearseFiles, c.rehearseCal, c.rehearseGhostValues, c.rehearseOracle, c.rehearseOwn, c.fits, c.refused, c.fitMsMedian,
+                  c.radiusTrue, c.massFit, c.massTrue, c.comFit.x * 1000, c.comTrue.x * 1000, c.comFit.y * 1000, c.comTrue.y * 1000,
+                  c.rehearseFiles, c.rehearseCal, c.rehearseGhostValues, c.rehearseOracle, c.rehearseOwn, c.fits, c.refused, c.fitMsMedian,
                   c.fitMsMax, c.checkMs, c.problem.c_str());
       std::fflush(stdout);
       cases[i] = std::move(c);
@@ -376,9 +387,9 @@ int main(int argc, char** argv) {
   // Summary per world over the perturbed seeds, and the control (seed 0).
   std::printf("\nsummary (perturbed seeds 1..%d):\n", seeds);
   std::printf("world  | ghost pos median of medians: files calib matched, calib/matched | heading calib/matched | "
-              "radius |err| max, median | mass |err| max | rehearsal calib/files median, max; within 25 %%: calib, oracle, own physics | control: calib/files pos\n");
+              "radius |err| max, median | mass |err| max | centre of mass |err| max, median | rehearsal calib/files median, max; within 25 %%: calib, oracle, own physics | control: calib/files pos\n");
   for (const auto& [name, _] : loaded) {
-    std::vector<double> fp, cp, mp, ch, mh, rerr, merr, reh;
+    std::vector<double> fp, cp, mp, ch, mh, rerr, merr, cerr, reh;
     double controlRatio = NAN;
     int failed = 0, within = 0, oracleWithin = 0, ownWithin = 0;
     for (const Case& c : cases) {
@@ -398,6 +409,7 @@ int main(int argc, char** argv) {
       mh.push_back(c.matchedHead);
       rerr.push_back(std::abs(c.radiusFit / c.radiusTrue - 1));
       merr.push_back(std::abs(c.massFit / c.massTrue - 1));
+      cerr.push_back(std::hypot(c.comFit.x - c.comTrue.x, c.comFit.y - c.comTrue.y));
       reh.push_back(c.rehearseCal / c.rehearseFiles);
       within += c.rehearseCal <= 0.25 * c.rehearseFiles;
       oracleWithin += c.rehearseOracle <= 0.25 * c.rehearseFiles;
@@ -405,10 +417,11 @@ int main(int argc, char** argv) {
     }
     if (fp.empty()) continue;
     if (failed) std::printf("%-6s | %d cases not judged (see above)\n", name.c_str(), failed);
-    std::printf("%-6s | %.2f %.2f %.2f cm, %.2f | %.2f | %.2f %%, %.2f %% | %.2f %% | %.2f, %.2f; %d, %d, %d of %zu | %.3f\n", name.c_str(),
+    std::printf("%-6s | %.2f %.2f %.2f cm, %.2f | %.2f | %.2f %%, %.2f %% | %.2f %% | %.1f, %.1f mm | %.2f, %.2f; %d, %d, %d of %zu | %.3f\n", name.c_str(),
                 median(fp) * 100, median(cp) * 100, median(mp) * 100, median(cp) / median(mp), median(ch) / median(mh),
                 *std::max_element(rerr.begin(), rerr.end()) * 100, median(rerr) * 100,
-                *std::max_element(merr.begin(), merr.end()) * 100, median(reh), *std::max_element(reh.begin(), reh.end()),
+                *std::max_element(merr.begin(), merr.end()) * 100, *std::max_element(cerr.begin(), cerr.end()) * 1000,
+                median(cerr) * 1000, median(reh), *std::max_element(reh.begin(), reh.end()),
                 within, oracleWithin, ownWithin, reh.size(), controlRatio);
   }
   return 0;

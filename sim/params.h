@@ -93,10 +93,13 @@ struct SimParams {
   double calMotorGain = 1;         ///< wheel motors reach gain x the commanded speed
   double calDelay = 0;             ///< [s] between a command's arrival and its effect
   double calMass = 1;              ///< every link's mass
+  /// [m] the robot's centre of mass moved forward (x) and left (y) of the
+  /// files', robot frame at zero pose: every link's centre moved by as much.
+  double calComX = 0, calComY = 0;
   /// Whether any calibration.* key differs from the files (identity).
   bool calibrated() const {
     return calWheelRadius != 1 || calWheelRadiusSplit != 0 || calWheelRadiusSide != 0 || calWheelRadiusDiag != 0 || calFriction != 1 || calMotorGain != 1 ||
-           calDelay != 0 || calMass != 1;
+           calDelay != 0 || calMass != 1 || calComX != 0 || calComY != 0;
   }
   // Gaits (sim/gait.h); swings in degrees about the stance pose
   double caterpillarHipSwing = 12;   ///< [deg]

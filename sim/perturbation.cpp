@@ -68,7 +68,8 @@ namespace {
 
 // The calibration as a perturbation of the files' robot: what both the
 // twins (calibratedWorld) and a saved robot file apply.
-Perturbation calibrationPerturbation(const SimParams& params, size_t links) {
+Perturbation calibrationPerturbation(const SimParams& params, const RobotModel& robot) {
+  const size_t links = robot.links.size();
   Perturbation p;
   const double front = params.calWheelRadius * (1 + params.calWheelRadiusSplit / 2);
   const double rear = params.calWheelRadius * (1 - params.calWheelRadiusSplit / 2);
@@ -76,7 +77,11 @@ Perturbation calibrationPerturbation(const SimParams& params, size_t links) {
   const double diag = 1 + params.calWheelRadiusDiag / 2, antiDiag = 1 - params.calWheelRadiusDiag / 2;
   p.wheelRadius = {front * left * diag, front * right * antiDiag, rear * left * antiDiag, rear * right * diag};  // FL FR RL RR
   p.linkMass.assign(links, params.calMass);
-  p.centreOfMass.assign(links, Vec3{});
+  // Every link's centre moved by the same shift in the robot frame: at zero
+  // pose the robot's centre moves by exactly that, whatever the masses.
+  p.centreOfMass.resize(links);
+  for (size_t i = 0; i < links; ++i)
+    p.centreOfMass[i] = rotate(conjugate(robot.links[i].pose.q), Vec3{params.calComX, params.calComY, 0});
   p.friction = params.calFriction;
   p.velocityGain = params.calMotorGain;
   return p;
@@ -86,7 +91,7 @@ Perturbation calibrationPerturbation(const SimParams& params, size_t links) {
 
 WorldModel calibratedWorld(const WorldModel& world, const SimParams& params) {
   if (!params.calibrated() || world.robots.empty()) return world;
-  return perturbWorld(world, calibrationPerturbation(params, world.robots[0].model.links.size()));
+  return perturbWorld(world, calibrationPerturbation(params, world.robots[0].model));
 }
 
 std::optional<std::string> calibratedRobotText(const std::string& text, const RobotModel& robot, const SimParams& params,
@@ -98,7 +103,7 @@ std::optional<std::string> calibratedRobotText(const std::string& text, const Ro
     error = where + ": error: not a robot file: " + (doc.ErrorStr() ? doc.ErrorStr() : "no root element");
     return std::nullopt;
   }
-  const Perturbation p = calibrationPerturbation(params, robot.links.size());
+  const Perturbation p = calibrationPerturbation(params, robot);
   const auto scale = [](XMLElement* e, const char* attr, double factor, double fallback) {
     e->SetAttribute(attr, shortestText(e->DoubleAttribute(attr, fallback) * factor).c_str());
   };
@@ -136,7 +141,11 @@ std::optional<std::string> calibratedRobotText(const std::string& text, const Ro
                            shortestText(params.calMass) + ", tyre radii and wheel motors' velocity_scale written in. " +
                            "Not in a robot file, keep them in the parameters: calibration.friction = " +
                            shortestText(params.calFriction) + " (the ground's contact), calibration.delay = " +
-                           shortestText(params.calDelay) + " s (the link's). ";
+                           shortestText(params.calDelay) + " s (the link's)" +
+                           (params.calComX != 0 || params.calComY != 0
+                                ? ", calibration.com_x = " + shortestText(params.calComX) + ", calibration.com_y = " +
+                                      shortestText(params.calComY) + " m (a robot file places no centre of mass). "
+                                : std::string(". "));
   XMLComment* comment = doc.NewComment(note.c_str());
   if (doc.FirstChild() && doc.FirstChild()->ToDeclaration()) doc.InsertAfterChild(doc.FirstChild(), comment);
   else doc.InsertFirstChild(comment);

@@ -72,7 +72,8 @@ WorldModel perturbWorld(WorldModel world, const Perturbation& p);
 
 /// `world` as a twin calibrated by `params`' calibration.* keys sees it:
 /// the first robot's tyres, link masses, contact friction and wheel motors
-/// scaled (the delay is the caller's: it schedules the commands). `world`
+/// scaled, its links' centres of mass moved (the delay is the caller's: it
+/// schedules the commands). `world`
 /// itself when the keys are the files' (identity).
 WorldModel calibratedWorld(const WorldModel& world, const SimParams& params);
 
@@ -80,8 +81,9 @@ WorldModel calibratedWorld(const WorldModel& world, const SimParams& params);
 /// written in: every link's mass, each wheel's tyre radius and the wheel
 /// motors' `velocity_scale`, so that the file alone builds the calibrated
 /// robot (its comments and everything else kept). Friction is the ground's
-/// (a world's <contact>) and the delay the link's: they stay in the
-/// parameters file, and a comment at the top says so with their values.
+/// (a world's <contact>), the delay the link's, and a robot file places no
+/// centre of mass: they stay in the parameters file, and a comment at the
+/// top says so with their values.
 /// nullopt and `error` when `text` does not parse or does not hold `robot`'s
 /// links.
 std::optional<std::string> calibratedRobotText(const std::string& text, const RobotModel& robot, const SimParams& params,

@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <tuple>
 
 #include "app/console/robot_shapes.h"
 #include "app/ghost/hold_policy.h"
@@ -31,14 +32,18 @@ const std::array<CalParamInfo, kCalParams>& calParams() {
   // means "pinned well inside what a robot may differ by".
   static const std::array<CalParamInfo, kCalParams> table{{
       // Probes of half a scale: a smaller one drowns in the contacts' noise.
-      {"calibration.wheel_radius", "wheel radius", "", 1, 0.8, 1.2, 0.03, 0.015},
-      {"calibration.wheel_radius_split", "radius front - rear", "", 0, -0.1, 0.1, 0.03, 0.015},
-      {"calibration.wheel_radius_side", "radius left - right", "", 0, -0.1, 0.1, 0.03, 0.015},
-      {"calibration.wheel_radius_diag", "radius FL+RR - FR+RL", "", 0, -0.1, 0.1, 0.03, 0.015},
-      {"calibration.friction", "tyre friction", "", 1, 0.3, 3, 0.3, 0.15},
-      {"calibration.motor_gain", "wheel motor gain", "", 1, 0.5, 1.5, 0.2, 0.1},
-      {"calibration.delay", "command delay", "s", 0, 0, 0.5, 0.06, 0.03},
-      {"calibration.mass", "total mass", "", 1, 0.5, 2, 0.15, 0},
+      {"calibration.wheel_radius", "wheel radius", "", 1, 0.8, 1.2, 0.03, 0.015, 0},
+      {"calibration.wheel_radius_split", "radius front - rear", "", 0, -0.1, 0.1, 0.03, 0.015, 0},
+      {"calibration.wheel_radius_side", "radius left - right", "", 0, -0.1, 0.1, 0.03, 0.015, 0},
+      {"calibration.wheel_radius_diag", "radius FL+RR - FR+RL", "", 0, -0.1, 0.1, 0.03, 0.015, 0},
+      {"calibration.friction", "tyre friction", "", 1, 0.3, 3, 0.3, 0.15, 0},
+      {"calibration.motor_gain", "wheel motor gain", "", 1, 0.5, 1.5, 0.2, 0.1, 0},
+      {"calibration.delay", "command delay", "s", 0, 0, 0.5, 0.06, 0.03, 0},
+      {"calibration.mass", "total mass", "", 1, 0.5, 2, 0.15, 0, 0},
+      // Each link's centre may be 2 cm off on each axis (sim/perturbation.h);
+      // the robot's, their mass-weighted mean, rather less.
+      {"calibration.com_x", "centre of mass forward", "m", 0, -0.1, 0.1, 0.02, 0, kComBias},
+      {"calibration.com_y", "centre of mass left", "m", 0, -0.1, 0.1, 0.02, 0, kComBias},
   }};
   return table;
 }
@@ -50,7 +55,7 @@ namespace {
 constexpr std::array<double SimParams::*, kCalParams> kCalFields{
     &SimParams::calWheelRadius, &SimParams::calWheelRadiusSplit, &SimParams::calWheelRadiusSide,
     &SimParams::calWheelRadiusDiag, &SimParams::calFriction, &SimParams::calMotorGain,
-    &SimParams::calDelay, &SimParams::calMass};
+    &SimParams::calDelay, &SimParams::calMass, &SimParams::calComX, &SimParams::calComY};
 
 }  // namespace
 
@@ -97,7 +102,7 @@ CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit, double ove
     const double p = prior.sigma[i] * prior.sigma[i] + drift * drift * dt;
     const double q = sigma * sigma;
     out.value[i] = (prior.value[i] * q + fit.value[i] * p) / (p + q);
-    out.sigma[i] = std::sqrt(p * q / (p + q));
+    out.sigma[i] = std::max(std::sqrt(p * q / (p + q)), calParams()[i].floor);
   }
   return out;
 }
@@ -105,7 +110,7 @@ CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit, double ove
 namespace {
 
 constexpr int kMass = static_cast<int>(CalParam::Mass);
-constexpr int kFitted = kMass;  // the parameters fitted through the twin: all but the mass
+constexpr int kFitted = kMass;  // the parameters fitted through the twin: all before the mass
 // A parameter is unobserved when its deviation is above this share of its
 // scale. The first step of a fit takes only those pinned to kFirstStep:
 // from the start values the residuals are far from linear, and a step in a
@@ -485,6 +490,150 @@ std::optional<std::pair<double, double>> massFromLoads(const WorldModel& files, 
 
 }  // namespace
 
+namespace {
+
+// Each link's mass properties, and the robot's total mass.
+std::vector<MassProperties> linkMasses(const RobotModel& robot, double& total) {
+  std::vector<MassProperties> mass;
+  total = 0;
+  for (const LinkSpec& l : robot.links) total += mass.emplace_back(massProperties(l)).mass;
+  return mass;
+}
+
+// The centre of mass of `robot` at a pose (its links' motions `m`).
+Vec3 centreAt(const std::vector<MassProperties>& mass, double total, const std::vector<LinkMotion>& m) {
+  Vec3 centre{};
+  for (size_t i = 0; i < mass.size(); ++i) centre = centre + (mass[i].mass / total) * transformPoint(m[i].pose, mass[i].centre);
+  return centre;
+}
+
+// Least squares of (com_x, com_y) over frames. The parameter moves each
+// link's centre in its own frame at zero pose, so at a frame's pose the
+// robot's centre moves by A (com_x, com_y), A the mass-weighted mean of the
+// links' turns since zero pose (a bent leg turns its part of a forward shift
+// downward): the twin's own meaning of calibration.com_x. Each row: A (2 x 2,
+// by rows) and the centre's observed move d, in the robot's heading.
+class CentreFit {
+ public:
+  CentreFit(const RobotModel& robot, const std::vector<MassProperties>& mass, double total)
+      : robot_(robot), mass_(mass), total_(total) {}
+  void add(const std::vector<LinkMotion>& m, const Quat& base, Vec3 moved) {
+    Vec3 ux{}, uy{};
+    for (size_t i = 0; i < mass_.size(); ++i) {
+      const double share = mass_[i].mass / total_;
+      const Quat turned = m[i].pose.q * conjugate(robot_.links[i].pose.q);
+      ux = ux + share * rotate(turned, Vec3{1, 0, 0});
+      uy = uy + share * rotate(turned, Vec3{0, 1, 0});
+    }
+    const double c = std::cos(heading(base)), s = std::sin(heading(base));
+    const auto fwd = [&](Vec3 v) { return c * v.x + s * v.y; };
+    const auto lft = [&](Vec3 v) { return -s * v.x + c * v.y; };
+    rows_.push_back({fwd(ux), fwd(uy), lft(ux), lft(uy), fwd(moved), lft(moved)});
+  }
+  std::optional<LoadCentre> solve() const {
+    double n11 = 0, n12 = 0, n22 = 0, b1 = 0, b2 = 0;
+    for (const auto& r : rows_) {
+      n11 += r[0] * r[0] + r[2] * r[2];
+      n12 += r[0] * r[1] + r[2] * r[3];
+      n22 += r[1] * r[1] + r[3] * r[3];
+      b1 += r[0] * r[4] + r[2] * r[5];
+      b2 += r[1] * r[4] + r[3] * r[5];
+    }
+    const double det = n11 * n22 - n12 * n12;
+    if (rows_.size() < 50 || !(det > 0)) return std::nullopt;
+    LoadCentre out;
+    out.forward = (n22 * b1 - n12 * b2) / det;
+    out.left = (n11 * b2 - n12 * b1) / det;
+    double ss = 0;
+    for (const auto& r : rows_) {
+      const double ef = r[4] - r[0] * out.forward - r[1] * out.left, el = r[5] - r[2] * out.forward - r[3] * out.left;
+      ss += ef * ef + el * el;
+    }
+    // Neighbouring frames are not independent (the body rocks over ~0.2 s):
+    // one sample per 10 frames.
+    const double s2 = ss / static_cast<double>(2 * rows_.size() - 2) * 10;
+    out.sigmaForward = std::sqrt(s2 * n22 / det);
+    out.sigmaLeft = std::sqrt(s2 * n11 / det);
+    out.frames = static_cast<int>(rows_.size());
+    return out;
+  }
+
+ private:
+  const RobotModel& robot_;
+  const std::vector<MassProperties>& mass_;
+  double total_;
+  std::vector<std::array<double, 6>> rows_;
+};
+
+}  // namespace
+
+std::optional<LoadCentre> comFromLoads(const WorldModel& files, const std::vector<RobotFrame>& f) {
+  if (files.robots.empty() || !files.robots[0].model.drive) return std::nullopt;
+  const RobotModel& robot = files.robots[0].model;
+  const DriveSpec& drive = *robot.drive;
+  const double g = norm(files.gravity);
+  if (!(g > 0)) return std::nullopt;
+  double total = 0;
+  const std::vector<MassProperties> mass = linkMasses(robot, total);
+  std::array<Vec3, 4> hub{};  // each hub in its wheel link's frame
+  for (size_t w = 0; w < 4; ++w) {
+    if (drive.wheels[w] < 0) return std::nullopt;
+    const JointSpec& j = robot.joints[static_cast<size_t>(drive.wheels[w])];
+    hub[w] = transformPoint(inverse(robot.links[static_cast<size_t>(j.child)].pose), j.anchor);
+  }
+  const TerrainSpec& terrain = files.terrain;
+  const auto groundNormal = [&](Vec3 at) {
+    if (terrain.kind != TerrainSpec::Kind::Heightfield) return Vec3{0, 0, 1};
+    // Over a tyre's half width of ground either way: the contact spreads.
+    const Vec3 l = transformPoint(inverse(terrain.pose), at);
+    const double e = drive.wheelRadius / 2;
+    const double gx = (terrain.grid.heightAt(l.x + e, l.y) - terrain.grid.heightAt(l.x - e, l.y)) / (2 * e);
+    const double gy = (terrain.grid.heightAt(l.x, l.y + e) - terrain.grid.heightAt(l.x, l.y - e)) / (2 * e);
+    return rotate(terrain.pose.q, normalized(Vec3{-gx, -gy, 1}));
+  };
+  CentreFit fit(robot, mass, total);
+  for (size_t k = 1; k + 1 < f.size(); ++k) {
+    const RobotFrame& r = f[k];
+    const double dt = f[k + 1].time - f[k - 1].time;
+    if (!r.hasBaseVelocity || !(dt > 0) || dt > 0.1 || r.jointPositions.size() != robot.joints.size()) continue;
+    const std::vector<LinkMotion> m =
+        linkMotions(robot, r.base, r.baseLinearVelocity, r.baseAngularVelocity, r.jointPositions, r.jointRates);
+    const Vec3 centre = centreAt(mass, total, m);
+    Vec3 balance{};
+    double load = 0, ground = 0;
+    for (size_t w = 0; w < 4; ++w) {
+      const Vec3 at = transformPoint(m[static_cast<size_t>(robot.joints[static_cast<size_t>(drive.wheels[w])].child)].pose, hub[w]);
+      const Vec3 n = groundNormal(at);
+      const double vertical = r.wheelNormal[w] * n.z;
+      const Vec3 contact = at - drive.wheelRadius * n;
+      balance = balance + vertical * contact;
+      load += vertical;
+      ground += contact.z / 4;
+    }
+    if (!(load > 0)) continue;
+    balance = (1 / load) * balance;
+    // Accelerating, the ground's push below the centre loads the rear: the
+    // balance point lies h a / g behind the centre.
+    const Vec3 a = (1 / dt) * (f[k + 1].baseLinearVelocity - f[k - 1].baseLinearVelocity);
+    fit.add(m, r.base.q, balance + ((centre.z - ground) / g) * a - centre);
+  }
+  return fit.solve();
+}
+
+std::optional<LoadCentre> centreShift(const RobotModel& files, const RobotModel& robot, const std::vector<RobotFrame>& f) {
+  if (robot.links.size() != files.links.size()) return std::nullopt;
+  double total = 0, robotTotal = 0;
+  const std::vector<MassProperties> mass = linkMasses(files, total), robotMass = linkMasses(robot, robotTotal);
+  CentreFit fit(files, mass, total);
+  for (const RobotFrame& r : f) {
+    if (r.jointPositions.size() != files.joints.size()) continue;
+    const std::vector<LinkMotion> m =
+        linkMotions(files, r.base, r.baseLinearVelocity, r.baseAngularVelocity, r.jointPositions, r.jointRates);
+    fit.add(m, r.base.q, centreAt(robotMass, robotTotal, m) - centreAt(mass, total, m));
+  }
+  return fit.solve();
+}
+
 RollingRadii radiiFromRolling(const WorldModel& files, const std::vector<RobotFrame>& in) {
   RollingRadii out;
   if (files.robots.empty() || !files.robots[0].model.drive) return out;
@@ -630,6 +779,21 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
       fit.value[kMass] = mass->first;
       fit.sigma[kMass] = mass->second;
       fit.observed[kMass] = true;
+    }
+  // The centre of mass: from the same loads.
+  if (const auto com = comFromLoads(files, frames))
+    for (const auto& [param, value, scatter] : {std::tuple{CalParam::ComX, com->forward, com->sigmaForward},
+                                                std::tuple{CalParam::ComY, com->left, com->sigmaLeft}}) {
+      const size_t i = static_cast<size_t>(param);
+      const CalParamInfo& info = calParams()[i];
+      const double sigma = std::hypot(scatter, info.floor);
+      if (o.fixed[i] || sigma / info.scale > kUnobserved) continue;
+      if (value < info.lower || value > info.upper)
+        return done("the loads say " + std::string(info.key) + " = " + shortestText(value) + " m, outside [" +
+                    shortestText(info.lower) + ", " + shortestText(info.upper) + "]");
+      fit.value[i] = value;
+      fit.sigma[i] = sigma;
+      fit.observed[i] = true;
     }
 
   // The tyres' radii: from rolling without slip, through the kinematics

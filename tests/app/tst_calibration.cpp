@@ -31,6 +31,13 @@
 //     are 50 % larger, beyond calibration.wheel_radius's bounds) is refused
 //     and the previous values kept; the control with 2 % is accepted;
 //   - a window without driving is refused and says what is missing;
+//   - the centre of mass from the wheels' loads: a robot whose every link's
+//     centre lies 15 mm forward and 8 mm right of the files' is found within
+//     2 mm on each axis from 10 s of driving and turning, and the fit
+//     observes it; a robot that is its twin (control) reads within
+//     kComBias, and a fused estimate of it leaves the twins at the files';
+//     calibratedWorld moves the robot's centre by exactly com_x, com_y at
+//     zero pose;
 //   - the arithmetic, worked by hand: fusing weighs by inverse variance; a
 //     parameter held at its start widens the deviation of one fitted with
 //     it by its share of the residuals (none where it shares nothing); a
@@ -481,6 +488,59 @@ class TestCalibration : public QObject {
   // The offline tool on a robot's own log of a straight drive: friction is
   // printed unobserved, the parameters file it writes loads; a log of a
   // robot standing still exits 7 and says what is missing.
+  void centreOfMassFromLoads() {
+    const WorldModel world = loadWorldFile("flat.world.xml");
+    const RobotModel& files = world.robots[0].model;
+    const Vec3 shift{0.015, -0.008, 0};
+    const auto robotCentre = [](const RobotModel& r) {
+      Vec3 sum;
+      double m = 0;
+      for (const LinkSpec& l : r.links) {
+        const MassProperties mp = massProperties(l);
+        sum = sum + mp.mass * transformPoint(l.pose, mp.centre);
+        m += mp.mass;
+      }
+      return (1 / m) * sum;
+    };
+    // The calibration moves the robot's centre as asked, at zero pose.
+    SimParams params;
+    params.calComX = shift.x, params.calComY = shift.y;
+    const Vec3 moved = robotCentre(calibratedWorld(world, params).robots[0].model) - robotCentre(files);
+    QVERIFY2(norm(moved - shift) < 1e-9, qPrintable(QString("%1 %2").arg(moved.x).arg(moved.y)));
+
+    Perturbation p = none(world);
+    for (size_t i = 0; i < files.links.size(); ++i) p.centreOfMass[i] = rotate(conjugate(files.links[i].pose.q), shift);
+    const RecordedDrive d = recordDrive(world, SimParams{}, p, commands(world, kDriveAndTurn), 10.0);
+    QVERIFY2(d.problem.empty(), d.problem.c_str());
+    // The truth as the estimator means it: exactly the shift, whatever the pose.
+    const std::optional<LoadCentre> truth = centreShift(files, perturbWorld(world, p).robots[0].model, d.frames);
+    QVERIFY(truth && std::abs(truth->forward - shift.x) < 1e-9 && std::abs(truth->left - shift.y) < 1e-9);
+    const std::optional<LoadCentre> found = comFromLoads(world, d.frames);
+    QVERIFY(found);
+    qInfo("moved robot: %.2f, %.2f mm +- %.2f, %.2f (hidden 15, -8) from %d frames", found->forward * 1000, found->left * 1000,
+          found->sigmaForward * 1000, found->sigmaLeft * 1000, found->frames);
+    QVERIFY(std::abs(found->forward - shift.x) < 0.002 && std::abs(found->left - shift.y) < 0.002);
+    const CalibrationFit fit = fitCalibration(world, ghostProfile(), d.frames, d.commands, filesCalValues());
+    print(fit);
+    QVERIFY2(fit.refused.empty(), fit.refused.c_str());
+    constexpr size_t kX = static_cast<size_t>(CalParam::ComX), kY = static_cast<size_t>(CalParam::ComY);
+    QVERIFY(fit.observed[kX] && fit.observed[kY]);
+    QVERIFY(std::abs(fit.value[kX] - shift.x) < 0.002 && std::abs(fit.value[kY] - shift.y) < 0.002);
+    QVERIFY(fit.sigma[kX] >= kComBias);  // the estimator's own bias counted
+
+    // The control: a robot that is its twin.
+    const RecordedDrive same = recordDrive(world, SimParams{}, none(world), commands(world, kDriveAndTurn), 10.0);
+    const std::optional<LoadCentre> twin = comFromLoads(world, same.frames);
+    QVERIFY(twin);
+    qInfo("its twin: %.2f, %.2f mm", twin->forward * 1000, twin->left * 1000);
+    QVERIFY(std::abs(twin->forward) < kComBias && std::abs(twin->left) < kComBias);
+    const CalibrationFit still = fitCalibration(world, ghostProfile(), same.frames, same.commands, filesCalValues());
+    QVERIFY2(still.refused.empty(), still.refused.c_str());
+    const CalValues applied = significantValues(fuse(filesEstimate(), still, 2.7));
+    QCOMPARE(applied[kX], 0.0);
+    QCOMPARE(applied[kY], 0.0);
+  }
+
   void calibrationSavedAsARobotFile() {
     const WorldModel world = loadWorldFile("flat.world.xml");
     const RobotModel& files = world.robots[0].model;
@@ -489,6 +549,7 @@ class TestCalibration : public QObject {
     SimParams params;
     params.calWheelRadius = 0.981, params.calWheelRadiusSplit = 0.012, params.calWheelRadiusSide = -0.006, params.calWheelRadiusDiag = 0.008;
     params.calMass = 1.107, params.calMotorGain = 0.913, params.calFriction = 0.8, params.calDelay = 0.031;
+    params.calComX = 0.012, params.calComY = -0.004;
     // The values as the fitter holds them, and back: each in its place.
     const CalValues held = calValues(params);
     QCOMPARE(held[static_cast<size_t>(CalParam::WheelRadiusDiag)], 0.008);
@@ -520,7 +581,8 @@ class TestCalibration : public QObject {
     QVERIFY2(differs(saved, twin) < 1e-6, qPrintable(QString::number(differs(saved, twin))));
     QVERIFY(differs(saved, files) > 0.01);  // it did change the robot
     QVERIFY2(written.find("calibration.friction = 0.8") != std::string::npos &&
-                 written.find("calibration.delay = 0.031") != std::string::npos,
+                 written.find("calibration.delay = 0.031") != std::string::npos &&
+                 written.find("calibration.com_x = 0.012, calibration.com_y = -0.004") != std::string::npos,
              written.c_str());
     QVERIFY(written.rfind("<?xml", 0) == 0);  // the declaration stays first
     QVERIFY(differs(roundTrip(SimParams{}).first, files) < 1e-9);

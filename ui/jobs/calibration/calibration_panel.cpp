@@ -14,15 +14,35 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
+#include <utility>
 
 namespace sp {
 
 namespace {
 
-// A value as shown: factors as such, the delay in milliseconds.
+// A value as shown: factors as such, the delay in milliseconds, the centre
+// of mass in millimetres. What a value is multiplied by, and its unit.
+std::pair<double, QString> display(size_t param) {
+  const std::string_view unit = calParams()[param].unit;
+  if (unit == "s") return {1000, QStringLiteral("ms")};
+  if (unit == "m") return {1000, QStringLiteral("mm")};
+  return {1, QString()};
+}
+
 QString shown(size_t param, double v) {
-  if (calParams()[param].unit[0] == 's') return QString::number(v * 1000, 'f', 1) + " ms";
-  return QString::number(v, 'f', 4);
+  const auto [k, unit] = display(param);
+  if (unit.isEmpty()) return QString::number(v, 'f', 4);
+  return QString::number(v * k, 'f', 1) + " " + unit;
+}
+
+// The fits a log's rows hold: one time each (a log written before the
+// centre of mass was fitted has fewer rows per fit).
+qsizetype fitsIn(const std::vector<LogCalibration>& rows) {
+  std::vector<double> times;
+  for (const LogCalibration& r : rows) times.push_back(r.time);
+  std::sort(times.begin(), times.end());
+  return std::unique(times.begin(), times.end()) - times.begin();
 }
 
 }  // namespace
@@ -185,7 +205,7 @@ void CalibrationPanel::setReplayed(const std::vector<LogCalibration>& rows, cons
   status_->setText(rows.empty() ? tr("The replayed log %1 holds no calibration.").arg(label)
                                 : tr("The calibration the console fitted in %1 (%2 fits).")
                                       .arg(label)
-                                      .arg(rows.size() / kCalParams));
+                                      .arg(fitsIn(rows)));
   replot();
 }
 
@@ -196,7 +216,7 @@ int CalibrationPanel::plottedPoints() const { return static_cast<int>(value_->co
 void CalibrationPanel::replot() {
   const size_t p = static_cast<size_t>(std::max(0, plotted_->currentIndex()));
   const std::vector<Point>& pts = series_[p];
-  const double k = calParams()[p].unit[0] == 's' ? 1000 : 1;  // the delay in ms
+  const auto [k, unit] = display(p);
   QList<QPointF> v, up, down;
   double lo = calParams()[p].files * k, hi = lo;
   for (const Point& x : pts) {
@@ -211,7 +231,7 @@ void CalibrationPanel::replot() {
   lower_->replace(down);
   const double pad = std::max(1e-3, (hi - lo) * 0.1);
   axisY_->setRange(lo - pad, hi + pad);
-  axisY_->setTitleText(calParams()[p].unit[0] == 's' ? tr("ms") : tr("× files"));
+  axisY_->setTitleText(unit.isEmpty() ? tr("× files") : unit);
   if (!pts.empty()) axisX_->setRange(pts.front().time, std::max(pts.back().time, pts.front().time + 1));
 }
 
