@@ -94,6 +94,8 @@ class TestCalibrationDock : public QObject {
     QVERIFY(!s.observed[static_cast<size_t>(CalParam::Friction)]);
     QCOMPARE(panel->table()->item(0, 1)->text(), QString::number(s.applied[0], 'f', 4));
     QCOMPARE(panel->table()->item(static_cast<int>(CalParam::Friction), 2)->text(), QStringLiteral("unobserved"));
+    // The centre of mass in millimetres (the files' column: none moved).
+    QCOMPARE(panel->table()->item(static_cast<int>(CalParam::ComX), 3)->text(), QStringLiteral("0.0 mm"));
     QVERIFY(panel->plottedPoints() >= 2);
     QCOMPARE(w.context().session().twinParams().calWheelRadius, s.applied[0]);
     // The rehearsals get the full-physics values, and the panel shows them.
