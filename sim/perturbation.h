@@ -73,8 +73,8 @@ WorldModel perturbWorld(WorldModel world, const Perturbation& p);
 /// `world` as a twin calibrated by `params`' calibration.* keys sees it:
 /// the first robot's tyres, link masses, contact friction and wheel motors
 /// scaled, its links' centres of mass moved (the delay is the caller's: it
-/// schedules the commands). `world`
-/// itself when the keys are the files' (identity).
+/// schedules the commands). `world` itself when the keys are the files'
+/// (identity).
 WorldModel calibratedWorld(const WorldModel& world, const SimParams& params);
 
 /// The robot file `text` (which loaded as `robot`) with `params`' calibration
