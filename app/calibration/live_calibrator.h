@@ -59,15 +59,16 @@ class LiveCalibrator {
  public:
   struct Options {
     double period = 3;  ///< [s] of new telemetry between fits
-    /// Each fit starts from the last one's values: two Levenberg-Marquardt
+    /// Each fit starts from the last one's values: three Levenberg-Marquardt
     /// steps over the newest 8 s follow the robot (a recursive refinement),
-    /// on both cores at nice 10; the second only when the first left time
-    /// for it within a period, so that a fit lands every period or so even
-    /// on a loaded machine.
+    /// on both cores at nice 10; each after the first only when the last
+    /// left time for it within a period, so that a fit lands every period
+    /// or so even on a loaded machine. (Three, not two, since the centre of
+    /// mass is fitted: docs/performance.md, "A third step again".)
     CalibrationOptions fit = [] {
       CalibrationOptions o;
       o.window = 8;
-      o.iterations = 2;
+      o.iterations = 3;
       o.threads = 2;
       o.budgetMs = 3000;
       return o;
