@@ -8,8 +8,10 @@
 
 #include <QApplication>
 #include <QDockWidget>
+#include <QFontMetrics>
 #include <QLabel>
 #include <QPushButton>
+#include <QStyle>
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTest>
@@ -96,6 +98,16 @@ class TestCalibrationDock : public QObject {
     QCOMPARE(panel->table()->item(static_cast<int>(CalParam::Friction), 2)->text(), QStringLiteral("unobserved"));
     // The centre of mass in millimetres (the files' column: none moved).
     QCOMPARE(panel->table()->item(static_cast<int>(CalParam::ComX), 3)->text(), QStringLiteral("0.0 mm"));
+    // Every parameter's name shows whole in the dock as the console lays it
+    // out (elided names were what an operator met: "radius front - ...").
+    const QTableWidget* table = panel->table();
+    const int width = table->columnWidth(0) - 2 * (table->style()->pixelMetric(QStyle::PM_FocusFrameHMargin, nullptr, table) + 1);
+    for (int row = 0; row < kCalParams; ++row) {
+      const QString name = table->item(row, 0)->text();
+      const QRect need = QFontMetrics(table->font()).boundingRect(QRect(0, 0, width, 1 << 20), Qt::TextWordWrap, name);
+      QVERIFY2(need.width() <= width && need.height() <= table->rowHeight(row),
+               qPrintable(QStringLiteral("%1: %2x%3 px in %4x%5").arg(name).arg(need.width()).arg(need.height()).arg(width).arg(table->rowHeight(row))));
+    }
     QVERIFY(panel->plottedPoints() >= 2);
     QCOMPARE(w.context().session().twinParams().calWheelRadius, s.applied[0]);
     // The rehearsals get the full-physics values, and the panel shows them.
