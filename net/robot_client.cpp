@@ -59,6 +59,24 @@ Clock::duration toDuration(double seconds) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
+/// At most `rate` a second, `burst` at once: what a robot may send beyond
+/// that is shed (a flood must not reach the window or the log).
+struct TokenBucket {
+  double rate = 1, burst = 1, tokens = 1, at = 0;
+  void reset(double r, double b, double t) {
+    rate = r;
+    burst = tokens = b;
+    at = t;
+  }
+  bool take(double t) {
+    tokens = std::min(burst, tokens + (t - at) * rate);
+    at = t;
+    if (tokens < 1) return false;
+    tokens -= 1;
+    return true;
+  }
+};
+
 }  // namespace
 
 // Everything below `// Worker thread only` is touched by the io_context's
@@ -203,6 +221,25 @@ class RobotClient::Impl {
     if (cb_.error) cb_.error(ErrorMsg{text});
   }
 
+  // A message not passed on: said at once when the first of its kind on
+  // this connection, else counted for the next summary (housekeeping).
+  void refuse(const Refusal& r) {
+    updateStats([](RobotClientStats& s) { ++s.refused; });
+    if (tally_.add(r)) notice("client: refused " + r.kind + ": " + r.detail + " (more like it are counted, not shown)");
+  }
+  // Something odd said once per kind, the message used all the same.
+  void remark(const Refusal& r) {
+    if (tally_.add(r)) notice("client: " + r.kind + ": " + r.detail);
+  }
+  void refuseBeforeWelcome(MessageType type) {
+    refuse(Refusal{"before WELCOME", std::string(toString(type)) + " from a robot that has not welcomed this connection"});
+  }
+  // Shed for its rate: counted, said once per kind.
+  void shed(const std::string& kind, const std::string& detail) {
+    updateStats([](RobotClientStats& s) { ++s.shed; });
+    remark(Refusal{kind, detail});
+  }
+
   void setLeaseHeld(bool held) {
     leaseHeld_ = held;
     updateStats([&](RobotClientStats& s) { s.leaseHeld = held; });
@@ -267,6 +304,14 @@ class RobotClient::Impl {
         ++it;
       }
     }
+    if (t - lastReport_ >= kRefusalReport) {
+      lastReport_ = t;
+      for (const std::string& line : tally_.report()) notice("client: refused or shed since the last summary: " + line);
+    }
+    if (state_ == ConnectionState::Authenticating && t - connectedAt_ > config_.helloTimeout)
+      return dropped("no WELCOME within " + std::to_string(static_cast<int>(config_.helloTimeout * 1000)) +
+                         " ms of connecting (link.hello_timeout): the handshake is given up",
+                     false);
     if ((state_ == ConnectionState::Authenticating || state_ == ConnectionState::Ready) &&
         t - lastReceived_ > config_.silenceTimeout)
       dropped("nothing from the robot for " + std::to_string(static_cast<int>(config_.silenceTimeout * 1000)) + " ms",
@@ -299,7 +344,12 @@ class RobotClient::Impl {
     decoder_ = FrameDecoder{};
     errorBeforeWelcome_.clear();
     haveTelemetrySeq_ = false;
-    lastReceived_ = now();
+    challenged_ = false;
+    check_ = TelemetryCheck(config_.bounds);
+    lastReceived_ = connectedAt_ = now();
+    queuedBytes_ = 0;
+    tally_ = RefusalTally{};  // each connection says its problems anew
+    lastReport_ = connectedAt_;
     if (everConnected_) updateStats([](RobotClientStats& s) { ++s.reconnects; });
     everConnected_ = true;
     setState(ConnectionState::Authenticating, config_.host + ":" + std::to_string(config_.port));
@@ -333,6 +383,7 @@ class RobotClient::Impl {
     resolver_.cancel();
     emulatorTimer_.cancel();
     writeQueue_.clear();
+    queuedBytes_ = 0;
     delayed_.clear();
     writing_ = false;
     ready_ = false;
@@ -407,6 +458,14 @@ class RobotClient::Impl {
   }
 
   void enqueue(std::string frame) {
+    if (!socket_.is_open()) return;
+    // A robot that stops reading must not take the console's memory: it is
+    // dropped, as the robot drops a client that does not read.
+    if (queuedBytes_ + frame.size() > config_.maxQueuedBytes && !flushing_)
+      return dropped("the robot does not read what the console sends: " + std::to_string(queuedBytes_ / 1024) +
+                         " KiB unsent (at most " + std::to_string(config_.maxQueuedBytes / 1024) + ")",
+                     false);
+    queuedBytes_ += frame.size();
     writeQueue_.push_back(std::move(frame));
     if (!writing_) writeNext();
   }
@@ -421,6 +480,7 @@ class RobotClient::Impl {
     // The frame lives with the operation, whatever happens to the queue.
     auto frame = std::make_shared<std::string>(std::move(writeQueue_.front()));
     writeQueue_.pop_front();
+    queuedBytes_ -= std::min(queuedBytes_, frame->size());
     asio::async_write(socket_, asio::buffer(*frame),
                       [this, gen = generation_, frame](const asio::error_code& ec, size_t) {
                         if (gen != generation_) return;
@@ -441,33 +501,44 @@ class RobotClient::Impl {
     std::optional<Message> message = decodeMessage(frame, error);
     if (!message) {
       // A sound frame with a bad payload: answered, the connection stays.
-      notice("client: robot sent a bad message: " + error);
-      if (ready_) send(ErrorMsg{error});
+      refuse(Refusal{"bad message", error});
+      // Answered, at most errorReplies_'s rate: a flood of bad frames must
+      // not make the console flood back.
+      if (ready_ && errorReplies_.take(now())) send(ErrorMsg{error});
       return;
     }
     std::visit(
         [this, type = typeOf(*message)](const auto& m) {
           if constexpr (requires { handle(m); }) {
             handle(m);
-          } else if (ready_) {
+          } else {
             // HELLO, COMMAND, ...: only clients send these.
-            send(ErrorMsg{std::string(toString(type)) + " is not sent to clients"});
+            refuse(Refusal{"not sent to clients", std::string(toString(type))});
+            if (ready_ && errorReplies_.take(now())) send(ErrorMsg{std::string(toString(type)) + " is not sent to clients"});
           }
         },
         *message);
   }
 
   void handle(const ChallengeMsg& m) {
-    if (ready_) return;
+    // One CHALLENGE per connection: a robot that repeats it (each answered
+    // with a HELLO) would keep the handshake going and the queue growing.
+    if (challenged_ || ready_)
+      return dropped("the robot sent CHALLENGE again: the handshake is given up", false);
+    challenged_ = true;
     // The token never leaves: the proof covers this connection's nonce only.
     send(HelloMsg{config_.name, {}, config_.role, helloProof(config_.token, m.nonce, config_.name, config_.role)});
   }
 
   void handle(const SequenceStateMsg& m) {
+    if (!ready_) return refuseBeforeWelcome(MessageType::SequenceState);
     if (cb_.sequence) cb_.sequence(m);
   }
 
   void handle(const LimitsMsg& m) {
+    if (!ready_) return refuseBeforeWelcome(MessageType::Limits);
+    if (std::string problem = limitsProblem(m); !problem.empty())
+      return refuse(Refusal{"LIMITS", problem + "; the robot file's limits stay in use"});
     {
       std::lock_guard lock(statsMutex_);
       limits_ = m;
@@ -476,7 +547,10 @@ class RobotClient::Impl {
   }
 
   void handle(const WelcomeMsg& m) {
-    if (ready_) return;
+    if (ready_) return refuse(Refusal{"WELCOME again", "a second WELCOME on this connection is ignored"});
+    if (!challenged_) return dropped("WELCOME before any CHALLENGE: the robot is not following the protocol", false);
+    if (std::string problem = welcomeProblem(m); !problem.empty())
+      return dropped("refused the robot's WELCOME: " + problem, false);
     ready_ = true;
     backoff_ = config_.reconnectMin;
     rateWindowStart_ = now();
@@ -495,8 +569,23 @@ class RobotClient::Impl {
     });
     // Keep-alives at least four per deadman period, so one late or lost
     // keep-alive never trips it.
-    keepaliveInterval_ = m.deadman > 0 ? std::min(config_.keepaliveInterval, m.deadman / 4) : config_.keepaliveInterval;
+    keepaliveInterval_ = std::max(
+        kMinKeepalive, m.deadman > 0 ? std::min(config_.keepaliveInterval, m.deadman / 4) : config_.keepaliveInterval);
+    const double t = now();
+    telemetryBucket_.reset(1.5 * m.telemetryRate + 1, std::max(10.0, m.telemetryRate), t);
+    // Laser scans come at most as fast as telemetry on any robot we know.
+    laserBucket_.reset(1.5 * m.telemetryRate + 1, std::max(10.0, m.telemetryRate), t);
+    eventBucket_.reset(config_.eventRate, std::max(1.0, config_.eventRate), t);
+    errorReplies_.reset(10, 10, t);
+    echoBucket_.reset(50, 50, t);
     setState(ConnectionState::Ready, m.robot);
+    // Plausible, but worth the operator's knowing before taking control.
+    if (m.deadman == 0)
+      notice("client: the robot announces no deadman (WELCOME deadman 0): if this console is lost, nothing says "
+             "the robot stops");
+    else if (m.deadman > 10)
+      notice("client: the robot's deadman is " + std::to_string(static_cast<long long>(m.deadman)) +
+             " s: if this console is lost the robot drives on that long before it stops");
     sendHeartbeat();  // a first round trip at once
     if (estopOnWelcome_) {
       send(EstopMsg{*estopOnWelcome_});
@@ -507,6 +596,7 @@ class RobotClient::Impl {
   }
 
   void handle(const LeaseStateMsg& m) {
+    if (!ready_) return refuseBeforeWelcome(MessageType::LeaseState);
     setLeaseHeld(m.yours);
     if (cb_.lease) cb_.lease(m);
   }
@@ -519,10 +609,36 @@ class RobotClient::Impl {
   }
 
   void handle(const TelemetryMsg& m) {
+    if (!ready_) return refuseBeforeWelcome(MessageType::Telemetry);
+    const double t = now();
+    if (Refusal r = check_.check(m, t); !r.kind.empty()) {
+      if (cb_.refusedTelemetry) cb_.refusedTelemetry(r);
+      return refuse(r);
+    }
+    if (!telemetryBucket_.take(t))
+      return shed("telemetry beyond the announced rate",
+                  "frames beyond " + std::to_string(static_cast<int>(telemetryBucket_.rate)) +
+                      " a second (WELCOME said " + std::to_string(static_cast<int>(stats().telemetryRateAnnounced)) +
+                      " Hz) are shed, the newest kept");
     checkLink(m.time);
     uint64_t lost = 0;
-    if (haveTelemetrySeq_ && m.seq > lastTelemetrySeq_ + 1) lost = m.seq - lastTelemetrySeq_ - 1;
-    if (!haveTelemetrySeq_ || m.seq > lastTelemetrySeq_) lastTelemetrySeq_ = m.seq;
+    if (haveTelemetrySeq_ && m.seq > lastTelemetrySeq_ + 1) {
+      // More missing than the robot could have sent since the last frame
+      // (three times its announced rate, and some) is a renumbering, not loss.
+      const double possible = 3 * stats().telemetryRateAnnounced * (t - lastSeqAt_) + 100;
+      const uint64_t gap = m.seq - lastTelemetrySeq_ - 1;
+      if (static_cast<double>(gap) <= possible) {
+        lost = gap;
+      } else {
+        updateStats([](RobotClientStats& s) { ++s.renumbered; });
+        remark(Refusal{"telemetry seq renumbered", "seq " + std::to_string(lastTelemetrySeq_) + " -> " +
+                                                       std::to_string(m.seq) + ": not counted as lost"});
+      }
+    } else if (haveTelemetrySeq_ && m.seq <= lastTelemetrySeq_) {
+      updateStats([](RobotClientStats& s) { ++s.renumbered; });
+    }
+    lastTelemetrySeq_ = m.seq;
+    lastSeqAt_ = t;
     haveTelemetrySeq_ = true;
     ++rateWindowCount_;
     updateStats([&](RobotClientStats& s) {
@@ -559,16 +675,25 @@ class RobotClient::Impl {
   }
 
   void handle(const LaserMsg& m) {
+    if (!ready_) return refuseBeforeWelcome(MessageType::Laser);
+    if (!laserBucket_.take(now())) return shed("laser beyond the telemetry rate", "scans beyond it are shed");
+    if (m.ranges.size() > 100000 || !std::isfinite(m.time))
+      return refuse(Refusal{"laser", std::to_string(m.ranges.size()) + " ranges at time " + std::to_string(m.time)});
     if (cb_.laser) cb_.laser(m);
   }
 
   void handle(const HeartbeatMsg& m) {
     if (m.seq >= kRobotHeartbeatBase) {
-      send(m);  // the robot's: back unchanged, it measures its round trip
+      // The robot's: back unchanged, it measures its round trip; a robot
+      // that floods them is answered at most echoBucket_'s rate.
+      if (!ready_) return refuseBeforeWelcome(MessageType::Heartbeat);
+      if (echoBucket_.take(now())) send(m);
+      else shed("robot heartbeats beyond 50 a second", "not echoed");
       return;
     }
     if (m.seq == 0 || m.seq > heartbeatSeq_) return;  // not one of ours
     const double rtt = (now() - m.time) * 1000;
+    if (!std::isfinite(rtt) || rtt < 0) return refuse(Refusal{"heartbeat", "an echo that is not ours"});
     updateStats([&](RobotClientStats& s) {
       s.rttMs = rtt;
       s.rttMeanMs = s.rttSamples == 0 ? rtt : s.rttMeanMs + (rtt - s.rttMeanMs) / 8;
@@ -579,12 +704,19 @@ class RobotClient::Impl {
   }
 
   void handle(const EventMsg& m) {
+    if (!ready_) return refuseBeforeWelcome(MessageType::Event);
+    if (!eventBucket_.take(now()))
+      return shed("events beyond " + std::to_string(static_cast<int>(config_.eventRate)) + " a second",
+                  "the robot's EVENTs beyond that are counted, not shown");
     if (cb_.event) cb_.event(m);
   }
 
   void handle(const ErrorMsg& m) {
     // Before WELCOME an ERROR means the HELLO was refused; the robot closes.
     if (!ready_) errorBeforeWelcome_ = m.reason.empty() ? "refused" : m.reason;
+    else if (!eventBucket_.take(now()))
+      return shed("robot ERRORs beyond " + std::to_string(static_cast<int>(config_.eventRate)) + " a second",
+                  "counted, not shown");
     updateStats([&](RobotClientStats& s) { s.lastError = m.reason; });
     if (cb_.error) cb_.error(m);
   }
@@ -680,8 +812,13 @@ class RobotClient::Impl {
   std::map<uint64_t, Pending> pending_;  ///< commands sent, waiting for their REPLY
   uint64_t heartbeatSeq_ = 0;
   double nextKeepalive_ = 0, nextHeartbeat_ = 0, lastReceived_ = 0;
-  bool haveTelemetrySeq_ = false;
+  bool haveTelemetrySeq_ = false, challenged_ = false;
   uint64_t lastTelemetrySeq_ = 0;
+  double lastSeqAt_ = 0, connectedAt_ = 0, lastReport_ = 0;
+  size_t queuedBytes_ = 0;  ///< in writeQueue_
+  TelemetryCheck check_;
+  RefusalTally tally_;
+  TokenBucket telemetryBucket_, laserBucket_, eventBucket_, errorReplies_, echoBucket_;
   double rateWindowStart_ = 0;
   uint64_t rateWindowCount_ = 0;
   double readyAt_ = 0, minOffset_ = INFINITY, maxOffset_ = -INFINITY;  // [s] the link check (checkLink)

@@ -27,6 +27,7 @@
 #include <optional>
 #include <string>
 
+#include "net/link_check.h"
 #include "net/link_emulator.h"
 #include "net/message.h"
 #include "sim/command.h"
@@ -66,6 +67,19 @@ struct RobotClientConfig {
   /// come before the failsafe fires, and the robot carries on; once fired,
   /// the failsafe stays latched until rearm() whatever this says.
   bool reacquireLease = false;
+  /// [s] a connection not welcomed by then (no WELCOME after the CHALLENGE
+  /// was answered, or no CHALLENGE at all) is given up and made again
+  /// (`link.hello_timeout`).
+  double helloTimeout = 5.0;
+  /// What TELEMETRY is checked against before any of it is used (net/
+  /// link_check.h): a console gives its robot file's joints and limits.
+  TelemetryBounds bounds;
+  /// [bytes] frames queued for a robot that does not read them at most;
+  /// beyond it the connection is dropped, as the robot drops a blind client.
+  size_t maxQueuedBytes = size_t{1} << 20;
+  /// [1/s] the robot's EVENTs (and ERRORs) passed on at most this fast, a
+  /// second's worth at once; the rest are counted and said in a summary.
+  double eventRate = 20;
   /// Emulated delay, jitter and loss for the frames this client sends
   /// (inactive by default). Frames still on the emulated link when the
   /// connection drops are lost with it.
@@ -109,6 +123,9 @@ struct RobotClientStats {
   uint64_t emulatorDropped = 0;       ///< outgoing frames the link emulation dropped
   uint64_t commandsSent = 0;          ///< COMMANDs written (or handed to the emulated link)
   uint64_t repliesReceived = 0;       ///< REPLYs from the robot that matched a pending command
+  uint64_t refused = 0;   ///< messages refused by the checks (net/link_check.h) or sent before WELCOME
+  uint64_t shed = 0;      ///< TELEMETRY, LASER and EVENTs beyond their rates, not passed on
+  uint64_t renumbered = 0;  ///< TELEMETRY `seq` jumps too large to be loss (not counted in telemetryLost)
   std::string lastError;              ///< the last connection problem or robot ERROR, for the operator
   /// [ms] the spread of the one-way delay (arrival minus robot time) of
   /// the telemetry over the first kLinkCheckSeconds of this connection: as
@@ -120,6 +137,12 @@ struct RobotClientStats {
   /// (linkAdvice); also sent as a `client: ` notice through `error`.
   std::string linkWarning;
 };
+
+/// [s] the keep-alive period never goes below this, whatever the robot's
+/// deadman asks (WELCOME `deadman` has a floor too: link_check.h).
+constexpr double kMinKeepalive = 0.005;
+/// [s] how often the refusals and what was shed are summed up (`error`).
+constexpr double kRefusalReport = 5.0;
 
 /// [s] telemetry looked at after WELCOME before the link is judged.
 constexpr double kLinkCheckSeconds = 2.0;
@@ -136,6 +159,9 @@ std::string linkAdvice(double deadman, double keepalive, double stretch);
 /// requests the stop).
 struct RobotClientCallbacks {
   std::function<void(const TelemetryMsg&)> telemetry;
+  /// A TELEMETRY refused by the checks (net/link_check.h), with why: a
+  /// guard that cannot judge the robot's state stops what it guards.
+  std::function<void(const Refusal&)> refusedTelemetry;
   std::function<void(const LaserMsg&)> laser;
   /// Exactly one per sendCommand(): the robot's REPLY, or a local one with
   /// status Failed when the command could not be sent, the connection

@@ -48,14 +48,10 @@ void captureOdeMessage(int errnum, const char* msg, va_list ap) {
 // handler instead unwinds out of the step (ODE is C++ built with unwind
 // tables); World::step() catches it, reports the failure and freezes the
 // world, which cannot be trusted again: build a new one and restore into it.
-struct OdeFailure {
-  std::string message;
-};
-
 [[noreturn]] void throwOdeFailure(int errnum, const char* msg, va_list ap) {
   char text[512];
   std::vsnprintf(text, sizeof text, msg, ap);
-  throw OdeFailure{"ODE internal error " + std::to_string(errnum) + ": " + text};
+  throw world_detail::OdeFailure("ODE internal error " + std::to_string(errnum) + ": " + text);
 }
 
 }  // namespace
@@ -114,9 +110,9 @@ bool World::step() {
     try {
       if (params_.solver == Solver::Quick) dWorldQuickStep(m.world, params_.step);
       else dWorldStep(m.world, params_.step);
-    } catch (const OdeFailure& failure) {
+    } catch (const world_detail::OdeFailure& failure) {
       m.broken = true;
-      health_ = {HealthReport::Kind::EngineFailure, failure.message, steps_ + 1, time() + params_.step, 0, 0};
+      health_ = {HealthReport::Kind::EngineFailure, failure.what(), steps_ + 1, time() + params_.step, 0, 0};
     }
     m.randState = tOdeRandState;
   }

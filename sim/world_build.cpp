@@ -160,7 +160,16 @@ std::unique_ptr<World> World::create(const WorldModel& model, const SimParams& p
                                      WorldOptions options) {
   ensureOdeThread();
   std::unique_ptr<World> w(new World(model, params, options));
-  if (!w->build(diag)) return nullptr;
+  // A model the loader passed can still be one ODE refuses (a mass a fit
+  // or a perturbation made not positive definite): an error, not abort().
+  try {
+    if (!w->build(diag)) return nullptr;
+  } catch (const OdeFailure& failure) {
+    w->impl_->broken = true;
+    diag.error(model.robots.empty() ? std::string_view{} : std::string_view(model.robots[0].model.file), 0,
+               std::string("ODE refused the model: ") + failure.what());
+    return nullptr;
+  }
   return w;
 }
 

@@ -20,6 +20,7 @@
 #include <deque>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -29,6 +30,11 @@
 
 namespace sp {
 namespace world_detail {
+
+/// What ODE's error and debug handlers throw in place of abort() (world.cpp).
+struct OdeFailure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 /// Initialises ODE once per process and its per-thread data once per
 /// thread; every World entry point that touches ODE calls it (world.cpp).

@@ -34,12 +34,22 @@ void RobotConnection::open(const net::RobotClientConfig& config) {
   // never waits on the GUI thread.
   callbacks.telemetry = [this](const net::TelemetryMsg& m) {
     // The guard first, here on the worker: its ABORT must not wait for the window.
-    if (std::optional<GuardDeparture> d = guard_->telemetry(m)) {
-      const std::string hash = guard_->status().hash();
-      client_->abortSequence(hash, "guard: " + d->message());
-      post([this, h = QString::fromStdString(hash), d = *d] { emit guardTripped(h, d); });
+    if (std::optional<GuardDeparture> d = guard_->telemetry(m)) guardAbort(*d);
+    // At most kTelemetryQueued frames wait for the window: a window that
+    // falls behind (a modal dialog, a loaded machine) gets the newest frame
+    // when it is back, not a backlog it would show seconds late.
+    if (telemetryQueued_.load() >= kTelemetryQueued) {
+      ++telemetryShed_;
+      return;
     }
-    post([this, m] { emit telemetry(m); });
+    ++telemetryQueued_;
+    post([this, m] {
+      --telemetryQueued_;
+      emit telemetry(m);
+    });
+  };
+  callbacks.refusedTelemetry = [this](const net::Refusal& r) {
+    if (std::optional<GuardDeparture> d = guard_->cannotJudge(r.kind + ": " + r.detail)) guardAbort(*d);
   };
   callbacks.laser = [this](const net::LaserMsg& m) { post([this, m] { emit laser(m); }); };
   callbacks.reply = [this](const net::ReplyMsg& m) { post([this, m] { emit reply(m); }); };
@@ -55,8 +65,15 @@ void RobotConnection::open(const net::RobotClientConfig& config) {
   callbacks.error = [this](const net::ErrorMsg& m) {
     post([this, r = QString::fromStdString(m.reason)] { emit linkError(r); });
   };
+  telemetryQueued_ = 0;
   client_ = std::make_unique<net::RobotClient>(config_, std::move(callbacks));
   client_->start();
+}
+
+void RobotConnection::guardAbort(const GuardDeparture& d) {
+  const std::string hash = guard_->status().hash();
+  client_->abortSequence(hash, "guard: " + d.message());
+  post([this, h = QString::fromStdString(hash), d] { emit guardTripped(h, d); });
 }
 
 void RobotConnection::close() {

@@ -49,6 +49,9 @@ class RobotConnection : public QObject {
   /// Drops the connection as a lost link would (the client reconnects).
   void dropConnection();
   net::RobotClientStats stats() const;
+  /// Telemetry frames not handed to the window because it had
+  /// kTelemetryQueued waiting (the newest goes once it takes them).
+  uint64_t telemetryShed() const { return telemetryShed_.load(); }
 
  signals:
   void telemetry(const sp::net::TelemetryMsg& message);
@@ -66,6 +69,8 @@ class RobotConnection : public QObject {
   void rearmSent();
 
  private:
+  /// The guard tripped (on the worker thread): ABORT now, the window told after.
+  void guardAbort(const GuardDeparture& departure);
   /// Runs `emitIt` on the GUI thread, unless this object is gone by then.
   template <typename F>
   void post(F&& emitIt);
@@ -73,6 +78,9 @@ class RobotConnection : public QObject {
   net::RobotClientConfig config_;
   std::unique_ptr<net::RobotClient> client_;
   std::atomic<uint64_t> generation_{0};  // of the client; post() reads it on the worker
+  static constexpr int kTelemetryQueued = 50;  // a second at 50 Hz
+  std::atomic<int> telemetryQueued_{0};   // telemetry posted to the window, not yet emitted
+  std::atomic<uint64_t> telemetryShed_{0};  // ... not posted: the window was behind
   std::shared_ptr<SequenceGuard> guard_ = std::make_shared<SequenceGuard>();
 };
 

@@ -55,7 +55,11 @@ LiveLinkFeed::LiveLinkFeed(RobotConnection* connection, ConsoleSession* session,
     emit stateChanged(state, d);
   });
   connect(connection, &RobotConnection::linkError, this,
-          [this](const QString& reason) { linkEvent(QStringLiteral("error"), tr("error: %1").arg(reason)); });
+          [this](const QString& reason) {
+            // The robot's ERRORs and the client's own notices, logged whichever the robot is.
+            session_->logEvent("error", reason.toStdString());
+            linkEvent(QStringLiteral("error"), tr("error: %1").arg(reason));
+          });
 }
 
 void LiveLinkFeed::linkEvent(const QString& kind, const QString& text, const char* logKind) {

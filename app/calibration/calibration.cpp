@@ -364,7 +364,13 @@ std::vector<std::optional<std::vector<double>>> runAll(const Problem& pb, const 
           continue;
         }
       }
-      out[i] = residuals(pb, candidates[i].values, whys[i], nullptr, candidates[i].jitter);
+      // On a pool thread a throw would end the process: the candidate fails instead.
+      try {
+        out[i] = residuals(pb, candidates[i].values, whys[i], nullptr, candidates[i].jitter);
+      } catch (const std::exception& e) {
+        out[i].reset();
+        whys[i] = std::string("its twin failed: ") + e.what();
+      }
     }
   };
   std::vector<std::thread> pool;

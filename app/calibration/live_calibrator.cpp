@@ -129,11 +129,23 @@ void LiveCalibrator::run() {
       start = estimate_;
       lastFitAt_ = frames.back().time;
     }
-    const CalibrationFit fit = fitCalibration(files_, profile_, frames, commands, start, options_.fit, [&] {
-      if (options_.duringFit) options_.duringFit();
-      std::lock_guard lock(mutex_);
-      return stop_;
-    });
+    CalibrationFit fit;
+    // A fit builds twins of values the data suggests; whatever a robot's
+    // telemetry makes them (a mass ODE refuses), a throw must not end the
+    // console: the fit is refused and says why.
+    try {
+      fit = fitCalibration(files_, profile_, frames, commands, start, options_.fit, [&] {
+        if (options_.duringFit) options_.duringFit();
+        std::lock_guard lock(mutex_);
+        return stop_;
+      });
+    } catch (const std::exception& e) {
+      fit = CalibrationFit{};
+      fit.value = start.value;
+      fit.from = frames.front().time;
+      fit.to = frames.back().time;
+      fit.refused = std::string("the fit failed: ") + e.what();
+    }
     std::unique_lock lock(mutex_);
     if (stop_) return;
     ++state_.fits;
@@ -203,12 +215,16 @@ void LiveCalibrator::check(const std::vector<RobotFrame>& frames, const std::vec
     applied = state_.applied;
     resets = resets_;
   }
-  const FullPhysicsCheck c =
-      fullPhysicsValues(files_, *options_.full, frames, commands, applied, options_.fit.window, 1, [&] {
-        if (options_.duringFit) options_.duringFit();
-        std::lock_guard lock(mutex_);
-        return stop_;
-      });
+  FullPhysicsCheck c;
+  try {
+    c = fullPhysicsValues(files_, *options_.full, frames, commands, applied, options_.fit.window, 1, [&] {
+      if (options_.duringFit) options_.duringFit();
+      std::lock_guard lock(mutex_);
+      return stop_;
+    });
+  } catch (const std::exception& e) {  // as a fit's (run()): the check is given up, nothing changes
+    c.problem = std::string("the check failed: ") + e.what();
+  }
   std::lock_guard lock(mutex_);
   // Reset or frozen meanwhile: the next fit asks again. The fits that
   // landed meanwhile moved the values a little; the verdict is on whether

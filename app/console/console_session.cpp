@@ -397,13 +397,29 @@ void ConsoleSession::note(const std::string& text) {
   if (recorder_) recorder_->event("note", text);
 }
 
+// What a robot sent is stored escaped: a terminal escape in an EVENT or an
+// ERROR must not reach a terminal that prints the log.
 void ConsoleSession::logEvent(const std::string& kind, const std::string& text) {
-  if (standIn_) standIn_->logEvent(kind, text);
-  if (recorder_) recorder_->event(kind, text);
+  const std::string safe = net::escapeText(text);
+  if (standIn_) standIn_->logEvent(kind, safe);
+  if (recorder_) recorder_->event(kind, safe);
 }
 
 void ConsoleSession::event(const std::string& kind, const std::string& text) {
-  if (recorder_) recorder_->event(kind, text);
+  if (recorder_) recorder_->event(kind, net::escapeText(text));
+}
+
+net::RobotClientConfig ConsoleSession::clientConfig(const std::string& name) const {
+  net::RobotClientConfig config;
+  config.host = endpoint_.host;
+  config.port = endpoint_.port;
+  config.token = endpoint_.token;
+  config.name = name;
+  config.keepaliveInterval = params_.linkKeepalive;
+  config.commandExpiryMs = static_cast<uint64_t>(std::llround(params_.linkCommandExpiry * 1000));
+  config.helloTimeout = params_.linkHelloTimeout;
+  if (const RobotModel* model = robot()) config.bounds = net::telemetryBounds(*model);
+  return config;
 }
 
 }  // namespace sp

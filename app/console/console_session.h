@@ -26,6 +26,7 @@
 #include "app/log/resimulation.h"
 #include "app/console/robot_frame.h"
 #include "net/message.h"
+#include "net/robot_client.h"
 #include "sim/params.h"
 #include "sim/robot_model.h"
 
@@ -129,6 +130,11 @@ class ConsoleSession {
   /// Counts world changes: views rebuild when it moves on.
   int worldVersion() const { return worldVersion_; }
   const RobotEndpoint& endpoint() const { return endpoint_; }
+  /// How the console's client of endpoint() behaves, named `name` (HELLO):
+  /// the parameters' keep-alive period, command expiry and handshake
+  /// timeout (link.hello_timeout), and the robot file's joints and limits
+  /// that every TELEMETRY is checked against (net/link_check.h).
+  net::RobotClientConfig clientConfig(const std::string& name) const;
   /// The parameters (file, then overrides) as loaded by start(): the
   /// client's keep-alive period and command expiry come from them.
   const SimParams& params() const { return params_; }

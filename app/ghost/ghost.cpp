@@ -46,10 +46,29 @@ std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& p
       g->makeTwin(std::vector<double>(robot.joints.size(), 0.0), !g->held_.empty(), error);
   if (!twin) return nullptr;
   if (!g->buildWorld(*twin, &error)) return nullptr;
-  g->anchorThread_ = std::thread([raw = g.get()] { raw->anchorLoop(); });
-  g->presentThread_ = std::thread([raw = g.get()] { raw->presentLoop(); });
-  g->trailThread_ = std::thread([raw = g.get()] { raw->trailLoop(); });
+  g->anchorThread_ = std::thread([raw = g.get()] { raw->guarded("anchor", &Ghost::anchorLoop); });
+  g->presentThread_ = std::thread([raw = g.get()] { raw->guarded("present", &Ghost::presentLoop); });
+  g->trailThread_ = std::thread([raw = g.get()] { raw->guarded("trail", &Ghost::trailLoop); });
   return g;
+}
+
+void Ghost::guarded(const char* name, void (Ghost::*loop)()) {
+  // What a thread throws (ODE's errors are thrown: sim/world.h) must not
+  // reach std::terminate and end the console: the view says so and the
+  // loop starts over with worlds built anew, a second later.
+  for (;;) {
+    try {
+      (this->*loop)();
+      return;
+    } catch (const std::exception& e) {
+      setProblem(std::string("the ghost's ") + name + " thread failed: " + e.what() + "; it starts again");
+    } catch (...) {
+      setProblem(std::string("the ghost's ") + name + " thread failed; it starts again");
+    }
+    std::unique_lock lock(mutex_);
+    anchorWake_.wait_for(lock, std::chrono::seconds(1), [this] { return stop_; });
+    if (stop_) return;
+  }
 }
 
 Ghost::~Ghost() {

@@ -114,6 +114,10 @@ class Ghost {
     bool inFlight = true;        ///< false: ignore commands not yet in effect at the robot (a control)
     double frameInterval = 0.016;  ///< [s] present thread's period
     double trailSpacing = 0.1;   ///< [s] robot time between trail points
+    /// [s] the ghost runs at most this far ahead of the newest telemetry,
+    /// whatever the clock estimate says (a robot whose time leaps, a round
+    /// trip of hours): beyond it the view says so instead of predicting.
+    double maxAhead = 10;
   };
 
   /// The ghost's physics profile of `params`: ghost.step and
@@ -191,6 +195,8 @@ class Ghost {
   /// ones as `reported` has them (the newest telemetry), when it has them.
   std::vector<double> fullPositions(const Twin& twin, const std::vector<double>& joints,
                                     const std::vector<double>* reported) const;
+  /// Runs `loop` on the calling thread until it returns; restarts it when it throws.
+  void guarded(const char* name, void (Ghost::*loop)());
   void anchorLoop();
   void presentLoop();
   void trailLoop();
@@ -201,6 +207,11 @@ class Ghost {
   bool advance(World& world, double& t, double target, const std::vector<SentCommand>& commands, size_t& next,
                const std::function<bool()>& abort = {}) const;
   void setProblem(const std::string& problem);
+  /// The destructor asked the threads to end (a long run ahead gives up).
+  bool stopping() const {
+    std::lock_guard lock(mutex_);
+    return stop_;
+  }
 
   WorldModel model_;  // the full world, as calibrated: the anchor thread's once it runs
   SimParams params_;  // the ghost profile

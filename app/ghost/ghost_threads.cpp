@@ -30,6 +30,13 @@ std::chrono::steady_clock::duration steady(double seconds) {
 // the trail are best effort, and must not take the cores the robot's twin
 // and the window's frames need (Linux: a thread's nice value is its own).
 void yieldToOthers() { setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10); }
+// What the view says when the clock puts the robot `ahead` [s] past its
+// newest telemetry, beyond Options::maxAhead.
+std::string aheadProblem(double ahead) {
+  return "the link's delay puts the robot " + (std::isfinite(ahead) ? std::to_string(static_cast<long long>(ahead)) + " s" : std::string("an unknown time")) +
+         " past its newest telemetry: the ghost predicts no further than its limit";
+}
+
 // Names the calling thread (top -H, gdb): at most 15 characters.
 void nameThread(const char* name) { pthread_setname_np(pthread_self(), name); }
 
@@ -73,6 +80,10 @@ void Ghost::anchorLoop() {
       }
       for (SentCommand& c : commands_.from(applied)) (c.time <= frame.time ? effective : pending).push_back(std::move(c));
       target = options_.runAhead ? clock_.ghostTime(now()) : frame.time;
+    }
+    if (!(target <= frame.time + options_.maxAhead)) {  // NaN too
+      setProblem(aheadProblem(target - frame.time));
+      target = frame.time + options_.maxAhead;
     }
     lastStart = now();
     const size_t joints = robot.joints.size();
@@ -136,7 +147,8 @@ void Ghost::anchorLoop() {
     anchored = w.snapshot();
     double t = frame.time;
     size_t next = 0;
-    const bool ok = advance(w, t, target, pending, next);
+    const bool ok = advance(w, t, target, pending, next, [this] { return stopping(); });
+    if (stopping()) return;
     auto base = std::make_shared<Base>();
     base->twin = twin;
     base->time = t;
@@ -173,8 +185,8 @@ void Ghost::presentLoop() {
   const auto period = steady(options_.frameInterval);
   for (;;) {
     std::vector<SentCommand> commands;
-    double target = 0;
-    bool newBase = false, newCommands = false;
+    double target = 0, ahead = 0;
+    bool newBase = false, newCommands = false, capped = false;
     {
       std::unique_lock lock(mutex_);
       presentWake_.wait_for(lock, period,
@@ -191,6 +203,15 @@ void Ghost::presentLoop() {
       if (!base) continue;
       if (!base->latched && options_.inFlight) commands = commands_.from(next);
       target = options_.runAhead ? clock_.ghostTime(now()) : clock_.newest();
+      // From the newest telemetry, or from the base it runs on when that
+      // is older: a base the anchor thread has not yet replaced after a
+      // leap in the robot's time is not run up to it.
+      const double from = std::min(base->time, clock_.newest());
+      capped = !(target <= from + options_.maxAhead);
+      if (capped) {
+        ahead = target - from;
+        target = from + options_.maxAhead;
+      }
     }
     if (newBase && base->twin != twin) {
       twin = base->twin;
@@ -203,7 +224,8 @@ void Ghost::presentLoop() {
     }
     World& w = *world;
     size_t applied = 0;
-    if (!advance(w, t, target, commands, applied)) {
+    if (!advance(w, t, target, commands, applied, [this] { return stopping(); })) {
+      if (stopping()) return;
       const std::string health = w.health().message();
       w.restore(base->snapshot);
       t = base->time;
@@ -229,7 +251,8 @@ void Ghost::presentLoop() {
       v.base = r.base;
       v.jointPositions = fullPositions(*twin, r.jointPositions, frame_ ? &frame_->jointPositions : nullptr);
       v.objects = r.objects;
-      v.problem.clear();
+      if (capped) v.problem = aheadProblem(ahead);
+      else v.problem.clear();
       v.commands = next;
       ++stats_.views;
       record_.shown(t, base->made, r.base);

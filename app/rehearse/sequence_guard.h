@@ -32,6 +32,11 @@ class SequenceGuard {
     std::lock_guard lock(mutex_);
     return relay_.guard(telemetry);
   }
+  /// Telemetry refused by the link's checks (SequenceRelay::cannotJudge).
+  std::optional<GuardDeparture> cannotJudge(const std::string& why) {
+    std::lock_guard lock(mutex_);
+    return relay_.cannotJudge(why);
+  }
   /// Where the relay stands, without the rehearsal it carries (the GUI
   /// asks on every key and state; the rehearsal's path is large).
   class Status {

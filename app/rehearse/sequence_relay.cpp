@@ -74,6 +74,7 @@ std::optional<RehearsalStart> startFromTelemetry(const net::TelemetryMsg& t, con
 }
 
 std::string GuardDeparture::message() const {
+  if (!unjudged.empty()) return "telemetry the guard cannot judge: " + unjudged;
   char buf[200];
   const bool metres = what == "position";
   std::snprintf(buf, sizeof buf, "%s %.3g %s from the rehearsal at t = %.2f s (guard %.3g %s)", what.c_str(), value,
@@ -129,6 +130,17 @@ void SequenceRelay::state(const net::SequenceStateMsg& s) {
       reason_ = s.reason;
       break;
   }
+}
+
+std::optional<GuardDeparture> SequenceRelay::cannotJudge(const std::string& why) {
+  // A sequence sent or running is stopped: the robot's own word on where it
+  // is cannot be compared with the rehearsal, so the guard cannot vouch for it.
+  if (tripped_ || (phase_ != Phase::Sent && phase_ != Phase::Running)) return std::nullopt;
+  tripped_ = true;
+  GuardDeparture d;
+  d.what = "telemetry";
+  d.unjudged = why;
+  return d;
 }
 
 std::optional<GuardDeparture> SequenceRelay::guard(const net::TelemetryMsg& t) {

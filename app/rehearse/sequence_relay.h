@@ -41,6 +41,9 @@ struct GuardDeparture {
   double value = 0;     ///< [m] or [deg]
   double limit = 0;
   Pose reported, rehearsed;  ///< the base, both
+  /// Not "" when the guard tripped on telemetry it could not judge (refused
+  /// by the link's checks: net/link_check.h): why.
+  std::string unjudged;
   /// e.g. "position 0.41 m from the rehearsal at t = 3.20 s (guard 0.3 m)".
   std::string message() const;
 };
@@ -58,6 +61,9 @@ class SequenceRelay {
   /// (and while the rehearsal's settling time lasts after it is done); the
   /// first departure beyond a guard threshold is returned, once.
   std::optional<GuardDeparture> guard(const net::TelemetryMsg& telemetry);
+  /// A telemetry frame was refused as unbelievable (`why`): while a
+  /// sequence is sent or running, the guard trips on it, once.
+  std::optional<GuardDeparture> cannotJudge(const std::string& why);
 
   Phase phase() const { return phase_; }
   const std::string& hash() const { return hash_; }

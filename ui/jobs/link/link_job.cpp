@@ -6,8 +6,6 @@
 #include <QMessageBox>
 #include <QPushButton>
 
-#include <cmath>
-
 #include "app/console/console_session.h"
 #include "ui/connect_dialog.h"
 #include "ui/link_panel.h"
@@ -88,14 +86,8 @@ void LinkJob::connectToRobot() {
   const ConsoleSession& session = context_->session();
   const RobotEndpoint& e = session.endpoint();
   if (e.port == 0) return;
-  net::RobotClientConfig config;
-  config.host = e.host;
-  config.port = e.port;
-  config.token = e.token;
-  config.name = QStringLiteral("console@%1").arg(QCoreApplication::applicationPid()).toStdString();
-  config.keepaliveInterval = session.params().linkKeepalive;
-  config.commandExpiryMs = static_cast<uint64_t>(std::llround(session.params().linkCommandExpiry * 1000));
-  context_->connection().open(config);
+  context_->connection().open(
+      session.clientConfig(QStringLiteral("console@%1").arg(QCoreApplication::applicationPid()).toStdString()));
   if (takeControl_) context_->connection().acquireLease();
 }
 
