@@ -17,6 +17,7 @@
 
 #include "net/auth.h"
 #include "net/frame.h"
+#include "net/thread_priority.h"
 
 namespace sp::net {
 
@@ -99,6 +100,7 @@ class RobotClient::Impl {
     asio::post(io_, [this] { begin(); });
     thread_ = std::thread([this] {
       workerId_ = std::this_thread::get_id();
+      raiseLinkThreadPriority();
       io_.run();
     });
   }
@@ -265,6 +267,9 @@ class RobotClient::Impl {
     keepaliveTimer_.expires_at(epoch_ + toDuration(nextKeepalive_));
     keepaliveTimer_.async_wait([this](const asio::error_code& ec) {
       if (ec || !running_) return;
+      // How late this thread woke: a loaded machine delays what it reads
+      // as much as what it sends, and that is not the link's jitter.
+      ownLate_ = std::max(ownLate_, now() - nextKeepalive_);
       if (ready_ && leaseHeld_) send(LeaseKeepaliveMsg{});
       // Fixed deadlines, no drift; after a stall, resync instead of a burst.
       nextKeepalive_ = std::max(nextKeepalive_ + keepaliveInterval_, now());
@@ -558,6 +563,7 @@ class RobotClient::Impl {
     readyAt_ = now();
     minOffset_ = INFINITY;
     maxOffset_ = -INFINITY;
+    ownLate_ = 0;
     linkChecked_ = false;
     updateStats([&](RobotClientStats& s) {
       s.robot = m.robot;
@@ -664,8 +670,9 @@ class RobotClient::Impl {
     if (t - readyAt_ < kLinkCheckSeconds) return;
     linkChecked_ = true;
     const RobotClientStats s = stats();
-    // Our own emulated link's jitter stretches what we send, not what we get.
-    const double stretch = std::max(maxOffset_ - minOffset_, 2 * config_.emulation.jitter);
+    // Our own emulated link's jitter stretches what we send, not what we
+    // get; our own thread's lateness (a loaded machine) is not the link's.
+    const double stretch = std::max(maxOffset_ - minOffset_ - ownLate_, 2 * config_.emulation.jitter);
     const std::string advice = linkAdvice(s.robotDeadman, keepaliveInterval_, std::max(0.0, stretch));
     updateStats([&](RobotClientStats& st) {
       st.delaySpreadMs = std::max(0.0, stretch) * 1000;
@@ -822,6 +829,7 @@ class RobotClient::Impl {
   double rateWindowStart_ = 0;
   uint64_t rateWindowCount_ = 0;
   double readyAt_ = 0, minOffset_ = INFINITY, maxOffset_ = -INFINITY;  // [s] the link check (checkLink)
+  double ownLate_ = 0;  // [s] the keep-alive timer's worst lateness over the check
   bool linkChecked_ = false;
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <limits>
 
@@ -207,8 +208,17 @@ std::string RuleVerdict::message() const {
   char buf[256];
   const std::string at = where.empty() ? "" : " (" + where + ")";
   if (!passed) {
-    std::snprintf(buf, sizeof buf, "%s: %.3g %s against limit %.3g at t = %.2f s%s", toString(rule), value,
-                  unitOf(rule), limit, time, at.c_str());
+    // With as many digits as it takes for the value and the limit to read
+    // differently: "1.94 against 1.94" would read as a pass.
+    int digits = 3;
+    char v[40], l[40];
+    for (;; ++digits) {
+      std::snprintf(v, sizeof v, "%.*g", digits, value);
+      std::snprintf(l, sizeof l, "%.*g", digits, limit);
+      if (std::strcmp(v, l) != 0 || digits >= 12) break;
+    }
+    std::snprintf(buf, sizeof buf, "%s: %s %s %s its limit %s at t = %.2f s%s", toString(rule), v, unitOf(rule),
+                  value > limit ? "exceeded" : "fell below", l, time, at.c_str());
   } else {
     const std::string w = worstWhere.empty() ? "" : ", " + worstWhere;
     std::snprintf(buf, sizeof buf, "%s: ok (closest %.3g %s at t = %.2f s%s; limit %.3g)", toString(rule), worst,

@@ -27,8 +27,11 @@ void ConsoleContext::event(const QString& kind, const QString& text, bool log) {
 }
 
 void ConsoleContext::emergencyStop() {
+  // Said as it is: sent only when the link is up (a client still trying
+  // to reconnect sends it once the robot welcomes it again).
+  const bool queued = connection().isOpen();
+  const QString text = QString::fromStdString(state().estopPressedText(queued));
   connection().estop(tr("operator e-stop"));
-  const QString text = state().replaying() ? tr("E-STOP sent to the live robot") : tr("E-STOP sent");
   event(QStringLiteral("estop"), text);
   status(text, 5000);
 }

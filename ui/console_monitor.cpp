@@ -35,20 +35,23 @@ ConsoleMonitor::ConsoleMonitor(RobotConnection* connection, LiveLinkFeed* live, 
   });
   // An e-stop or re-arm in flight: shown at once, the ghost stops where the
   // robot will, the controls go back to a stopped robot (they wait for it).
+  // Half the round trip; -1 before one was measured (the banner says so
+  // rather than "lands in ~0.0 s").
   const auto landsIn = [this] {
     const net::RobotClientStats s = connection_->stats();
+    if (s.rttSamples == 0) return -1.0;
     return (s.rttMeanMs > 0 ? s.rttMeanMs : s.rttMs) / 2000;
   };
   connect(connection, &RobotConnection::estopSent, this, [this, landsIn] {
     if (!state_.connected()) return;
-    state_.estopSent(landsIn());
+    state_.estopSent(landsIn(), wallSeconds());
     session_->estopSent();
     emit robotStopped();
     notify();
   });
   connect(connection, &RobotConnection::rearmSent, this, [this, landsIn] {
     if (!state_.connected()) return;
-    state_.rearmSent(landsIn());
+    state_.rearmSent(landsIn(), wallSeconds());
     notify();
   });
   connect(live, &RobotFeed::frame, this, [this](const RobotFrame& f) {

@@ -124,6 +124,9 @@ void LinkPanel::showStats(const net::RobotClientStats& s) {
   if (!s.connected) {
     rtt_->setFullText(QStringLiteral("–"));
     rate_->setFullText(QStringLiteral("–"));
+  } else if (s.rttSamples == 0) {
+    rtt_->setFullText(tr("measuring…"));
+    rate_->setFullText(tr("%1 Hz of %2").arg(s.telemetryRateHz, 0, 'f', 1).arg(s.telemetryRateAnnounced, 0, 'f', 0));
   } else {
     rtt_->setFullText(tr("%1 ms (mean %2, max %3)")
                       .arg(s.rttMs, 0, 'f', 1)
@@ -135,11 +138,15 @@ void LinkPanel::showStats(const net::RobotClientStats& s) {
                                        : tr("not announced"));
   const uint64_t total = s.telemetryFrames + s.telemetryLost;
   const double percent = total ? 100.0 * static_cast<double>(s.telemetryLost) / static_cast<double>(total) : 0.0;
-  loss_->setFullText(tr("%1 frames (%2 %), robot dropped %3, %4 reconnects")
+  // What the checks refused or shed is the robot's doing, not the link's:
+  // said beside the loss when there is any (protocol.md, "What a client refuses").
+  QString text = tr("%1 frames (%2 %), robot dropped %3, %4 reconnects")
                      .arg(s.telemetryLost)
                      .arg(percent, 0, 'f', 2)
                      .arg(s.robotDropped)
-                     .arg(s.reconnects));
+                     .arg(s.reconnects);
+  if (s.refused + s.shed > 0) text += tr("; refused %1, shed %2").arg(s.refused).arg(s.shed);
+  loss_->setFullText(text);
 }
 
 void LinkPanel::showConnection(net::ConnectionState state, const QString& detail) {
@@ -154,7 +161,8 @@ void LinkPanel::showConnection(net::ConnectionState state, const QString& detail
   connect_->setText(open_ ? tr("Disconnect") : tr("Connect"));
   connect_->setIcon(actionIcon(open_ ? QStringLiteral("disconnect") : QStringLiteral("connect")));
   control_->setEnabled(state == net::ConnectionState::Ready);
-  rearm_->setEnabled(state == net::ConnectionState::Ready);
+  ready_ = state == net::ConnectionState::Ready;
+  rearm_->setEnabled(ready_ && latched_);
   if (state != net::ConnectionState::Ready) showLease({});
 }
 
@@ -167,6 +175,8 @@ void LinkPanel::showLease(const net::LeaseStateMsg& lease) {
 }
 
 void LinkPanel::showLatches(bool failsafe, bool estop) {
+  latched_ = failsafe || estop;
+  rearm_->setEnabled(ready_ && latched_);
   if (!failsafe && !estop) {
     latches_->setFullText(tr("clear"), "#2e7d32");
     return;

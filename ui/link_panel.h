@@ -66,6 +66,7 @@ class LinkPanel : public QWidget {
   QPlainTextEdit* events_ = nullptr;
   bool open_ = false;
   bool leaseHeld_ = false;
+  bool ready_ = false, latched_ = false;  // Re-arm is offered only when both
 };
 
 }  // namespace sp

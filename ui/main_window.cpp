@@ -24,6 +24,8 @@
 #include <QHBoxLayout>
 #include <QVBoxLayout>
 
+#include <cmath>
+
 #include "app/console/console_session.h"
 #include "app/data/data_files.h"
 #include "app/log/log_player.h"
@@ -374,7 +376,7 @@ void MainWindow::buildMenus() {
       QMessageBox::information(this, tr("Log folder"), tr("The session logs are in\n%1").arg(dir));
   });
   file->addSeparator();
-  file->addAction(tr("&Quit"), QKeySequence::Quit, this, &QWidget::close);
+  file->addAction(tr("&Quit"), QKeySequence::Quit, this, &MainWindow::requestQuit);
 
   menu(tr("&Robot"));  // the link job's items
 
@@ -596,6 +598,32 @@ bool MainWindow::eventFilter(QObject* watched, QEvent* event) {
     return true;
   }
   return QMainWindow::eventFilter(watched, event);
+}
+
+double MainWindow::robotSpeed() const {
+  const std::optional<net::TelemetryMsg>& t = liveFeed_->lastTelemetry();
+  if (!t || t->baseVelocity.size() < 2) return 0;
+  return std::hypot(t->baseVelocity[0], t->baseVelocity[1]);
+}
+
+void MainWindow::requestQuit() {
+  // Holding control of a moving robot, a quit would leave it to the
+  // deadman: the operator chooses (issue 59: Ctrl+Q quit at once).
+  if (state().leaseHeld() && !state().latched() && robotSpeed() > 0.05) {
+    QMessageBox box(QMessageBox::Warning, tr("Quit"),
+                    tr("You hold control of a robot moving at %1 m/s.\n\nQuitting now leaves it to its deadman, "
+                       "which stops it once the keep-alives stop.")
+                        .arg(robotSpeed(), 0, 'f', 2),
+                    QMessageBox::NoButton, this);
+    box.setObjectName(QStringLiteral("quitConfirm"));
+    QPushButton* stopAndQuit = box.addButton(tr("Stop the robot and quit"), QMessageBox::AcceptRole);
+    QPushButton* cancel = box.addButton(tr("Cancel"), QMessageBox::RejectRole);
+    box.setDefaultButton(cancel);
+    box.exec();
+    if (box.clickedButton() != stopAndQuit) return;
+    context_->sendCommand(StopCmd{});
+  }
+  close();
 }
 
 void MainWindow::closeEvent(QCloseEvent* event) {

@@ -176,6 +176,11 @@ class MainWindow : public QMainWindow, public ConsoleHost {
  public slots:
   /// Sends the e-stop to the live robot (whatever the views show).
   void emergencyStop();
+  /// File ▸ Quit (Ctrl+Q): quits, after asking when this console holds
+  /// control of a robot that moves (stop it first, or cancel).
+  void requestQuit();
+  /// The live robot's ground speed [m/s] by its newest telemetry (0 without one).
+  double robotSpeed() const;
   /// Asks the operator to confirm, then re-arms (clears a latched failsafe
   /// or e-stop) and zeroes the controls.
   void rearm();

@@ -28,6 +28,7 @@ void RobotConnection::post(F&& emitIt) {
 
 void RobotConnection::open(const net::RobotClientConfig& config) {
   close();
+  guard_->reset();  // before the new client's worker can feed it
   config_ = config;
   net::RobotClientCallbacks callbacks;
   // Each callback copies its message into a queued call: the worker thread

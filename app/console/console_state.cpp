@@ -59,7 +59,7 @@ void ConsoleState::terrain(bool heightfield, double width, double depth) {
 
 FrameChanges ConsoleState::frame(const RobotFrame& f, double wall, std::optional<double> edge) {
   FrameChanges changes;
-  lastFrameWall_ = wall;
+  lastFrameWall_ = now_ = wall;
   haveFrame_ = true;
   if (stale_) {
     stale_ = false;
@@ -83,6 +83,7 @@ FrameChanges ConsoleState::frame(const RobotFrame& f, double wall, std::optional
   }
   if (f.failsafe != failsafe_ || f.estop != estop_ || f.health != health_) {
     changes.latchedNow = (f.failsafe && !failsafe_) || (f.estop && !estop_);
+    if (!f.failsafe) failsafeReason_.clear();  // the next failsafe has its own
     failsafe_ = f.failsafe;
     estop_ = f.estop;
     health_ = f.health;
@@ -93,21 +94,51 @@ FrameChanges ConsoleState::frame(const RobotFrame& f, double wall, std::optional
   return changes;
 }
 
-void ConsoleState::estopSent(double landsIn) {
+void ConsoleState::estopSent(double landsIn, double wall) {
   estopInFlight_ = true;
   rearmInFlight_ = false;
   estopLandsIn_ = landsIn;
+  estopSentAt_ = now_ = wall;
   ++revision_;
 }
 
-void ConsoleState::rearmSent(double landsIn) {
+void ConsoleState::rearmSent(double landsIn, double wall) {
   if (!latched()) return;
   rearmInFlight_ = true;
   rearmLandsIn_ = landsIn;
+  rearmSentAt_ = now_ = wall;
   ++revision_;
 }
 
+std::string ConsoleState::estopPressedText(bool queued) const {
+  const std::string live = replaying() ? " to the live robot" : "";
+  if (connected()) return "E-STOP sent" + live;
+  if (queued)
+    return "E-STOP NOT sent" + live + ": the link is down; it goes out when the robot answers again. The robot's "
+           "own deadman stops it meanwhile.";
+  return "E-STOP NOT sent" + live + ": not connected to the robot";
+}
+
+std::string ConsoleState::inFlightText(const char* what, double landsIn, double sentAt) const {
+  if (landsIn < 0) return std::string(what) + " in flight: the round trip is not measured yet";
+  const double left = landsIn - (now_ - sentAt);
+  if (left > 0) return std::string(what) + " in flight: lands in ~" + fixed(left, 1) + " s";
+  return std::string(what) + " should have landed (sent " + fixed(now_ - sentAt, 1) +
+         " s ago); waiting for the robot's report";
+}
+
 bool ConsoleState::tick(double wall) {
+  now_ = wall;
+  // The countdown of what is in flight moves in tenths of a second.
+  if (estopInFlight_ || rearmInFlight_) {
+    const double sentAt = estopInFlight_ ? estopSentAt_ : rearmSentAt_;
+    const double landsIn = estopInFlight_ ? estopLandsIn_ : rearmLandsIn_;
+    const auto shown = static_cast<int64_t>(std::floor(std::max(0.0, landsIn - (wall - sentAt)) * 10));
+    if (shown != shownCountdown_) {
+      shownCountdown_ = shown;
+      ++revision_;
+    }
+  }
   const bool stale = connected() && haveFrame_ && wall - lastFrameWall_ > config_.staleAfter;
   if (stale == stale_) return false;
   stale_ = stale;
@@ -146,17 +177,19 @@ std::vector<std::string> ConsoleState::bannerLines() const {
   // In flight first: the operator must see at once that the stop is on
   // its way, not two seconds later when the robot reports it.
   if (estopInFlight_)
-    lines.push_back(live + "E-STOP in flight: lands in ~" + fixed(estopLandsIn_, 1) +
-                    " s; the robot drives on until then (the ghost shows where it stops).");
-  if (estop_)
-    lines.push_back(live + (rearmInFlight_ ? "E-STOP latched, re-arm pending: lands in ~" + fixed(rearmLandsIn_, 1) + " s."
-                                           : std::string("E-STOP latched: the robot is stopped. Re-arm to continue.")));
-  if (failsafe_ && rearmInFlight_)
-    lines.push_back(live + "FAILSAFE latched, re-arm pending: lands in ~" + fixed(rearmLandsIn_, 1) + " s.");
-  else if (failsafe_)
-    lines.push_back(live + (failsafeReason_.empty()
-                                ? "FAILSAFE latched: the robot stopped itself. Re-arm to continue."
-                                : "FAILSAFE latched: " + failsafeReason_ + "; the robot stopped. Re-arm to continue."));
+    lines.push_back(live + inFlightText("E-STOP", estopLandsIn_, estopSentAt_) +
+                    "; the robot drives on until then (the ghost shows where it stops).");
+  // One line for the latches, whichever are on: what latched, why, and
+  // what to do, each said once.
+  if (latched()) {
+    const std::string what = estop_ && failsafe_ ? "E-STOP and FAILSAFE latched" : estop_ ? "E-STOP latched" : "FAILSAFE latched";
+    const std::string why = !failsafe_               ? "the robot is stopped"
+                            : failsafeReason_.empty() ? "the robot stopped itself (its reason did not reach this console: see the robot's log)"
+                                                      : failsafeReason_ + "; the robot stopped";
+    const std::string next = rearmInFlight_ ? inFlightText("Re-arm", rearmLandsIn_, rearmSentAt_) + "."
+                                            : std::string("Re-arm to continue.");
+    lines.push_back(live + what + ": " + why + ". " + next);
+  }
   if (nearEdge() && !replaying()) {
     lines.push_back(*edge_ < 0 ? "The robot is off the terrain (" + fixed(-*edge_, 1) +
                                      " m beyond its edge): Robot ▸ Reset puts it back."
@@ -179,8 +212,8 @@ std::string ConsoleState::controlsRefusal() const {
   if (replaying()) return "A replay is shown: close it (File ▸ Close replay) to drive the live robot";
   if (!connected()) return "Not connected to the robot";
   if (!lease_) return "Take control first (Robot ▸ Take control)";
-  if (estopInFlight_) return "E-STOP in flight: the robot stops in ~" + fixed(estopLandsIn_, 1) + " s";
-  if (latched() && rearmInFlight_) return "Re-arm pending: it lands in ~" + fixed(rearmLandsIn_, 1) + " s";
+  if (estopInFlight_) return inFlightText("E-STOP", estopLandsIn_, estopSentAt_);
+  if (latched() && rearmInFlight_) return inFlightText("Re-arm", rearmLandsIn_, rearmSentAt_);
   if (latched()) return "The robot is stopped and latched: re-arm first";
   return {};
 }

@@ -82,12 +82,18 @@ class ConsoleState {
   void clearFrames();
   /// A replay (named `label`) is shown instead of the live robot, or ("") not.
   void replay(std::string label);
-  /// This console sent an e-stop (a re-arm) that lands on the robot in
-  /// about `landsIn` [s] (half the round trip): until a frame shows the
-  /// latch on (off), or the link drops, the banner says it is in flight
-  /// and the controls wait for it.
-  void estopSent(double landsIn);
-  void rearmSent(double landsIn);
+  /// This console sent an e-stop (a re-arm) at wall time `wall` [s] that
+  /// lands on the robot in about `landsIn` [s] (half the round trip; < 0:
+  /// not known yet): until a frame shows the latch on (off), or the link
+  /// drops, the banner says it is in flight, counting down at tick(), then
+  /// that it should have landed and the robot's report is awaited; the
+  /// controls wait for it.
+  void estopSent(double landsIn, double wall);
+  void rearmSent(double landsIn, double wall);
+  /// What the operator is told of an e-stop pressed now: "E-STOP sent"
+  /// when connected, else that it is not sent and when it will be
+  /// (`queued`: the client sends it once the robot welcomes it again).
+  std::string estopPressedText(bool queued) const;
   bool estopInFlight() const { return estopInFlight_; }
   bool rearmInFlight() const { return rearmInFlight_; }
 
@@ -145,7 +151,11 @@ class ConsoleState {
   bool lease_ = false;
   bool failsafe_ = false, estop_ = false;
   bool estopInFlight_ = false, rearmInFlight_ = false;
-  double estopLandsIn_ = 0, rearmLandsIn_ = 0;  // [s] as said when sent
+  double estopLandsIn_ = 0, rearmLandsIn_ = 0;  // [s] as said when sent (< 0: not known)
+  double estopSentAt_ = 0, rearmSentAt_ = 0;    // [s] wall time sent
+  double now_ = 0;                              // [s] wall time of the last frame or tick
+  std::string inFlightText(const char* what, double landsIn, double sentAt) const;
+  int64_t shownCountdown_ = -1;  // tenths of a second the banner shows (moves the revision)
   std::string health_;
   std::string failsafeReason_;
   std::string filesMismatch_;

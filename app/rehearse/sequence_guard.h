@@ -32,6 +32,14 @@ class SequenceGuard {
     std::lock_guard lock(mutex_);
     return relay_.guard(telemetry);
   }
+  /// Forgets the sequence relayed: a new connection is another robot, or
+  /// the same one restarted, which runs nothing the console relayed before
+  /// (issue 59: a branch's stand-in was "aborted by the guard" against the
+  /// old robot's sequence).
+  void reset() {
+    std::lock_guard lock(mutex_);
+    relay_ = SequenceRelay{};
+  }
   /// Telemetry refused by the link's checks (SequenceRelay::cannotJudge).
   std::optional<GuardDeparture> cannotJudge(const std::string& why) {
     std::lock_guard lock(mutex_);

@@ -11,6 +11,7 @@
 #include "app/robot/twin_host.h"
 #include "net/auth.h"
 #include "net/robot_server.h"
+#include "net/thread_priority.h"
 #include "sim/model_loader.h"
 #include "sim/perturbation.h"
 
@@ -155,7 +156,10 @@ std::string StandInRobot::start() {
   port_ = server->server->port();
   host.start();
   Server& s = *server;
-  s.thread = std::thread([&s] { s.io.run(); });
+  s.thread = std::thread([&s] {
+    net::raiseLinkThreadPriority();  // the robot's deadman, above the console's other work
+    s.io.run();
+  });
   server_ = std::move(server);
   return {};
 }

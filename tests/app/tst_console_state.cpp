@@ -104,31 +104,43 @@ class TestConsoleState : public QObject {
   }
 
   // An e-stop sent is in flight until a frame shows the latch (issue 31):
-  // the banner says so at once and the controls wait; a re-arm sent is
-  // pending until a frame shows the latch off. A dropped link ends both
-  // (they may never land; the banner says the link is down).
+  // the banner says so at once, counting down (issue 59: it said "lands in
+  // ~1.0 s" 1.5 s after the press), then that it should have landed; the
+  // controls wait. A re-arm sent is pending until a frame shows the latch
+  // off. A dropped link ends both (they may never land; the banner says
+  // the link is down).
   void inFlight() {
     ConsoleState s = driving();
-    s.estopSent(1.04);
+    s.estopSent(1.04, 10.0);
     QVERIFY(s.estopInFlight());
     QVERIFY(anyLineHas(s.bannerLines(), "E-STOP in flight: lands in ~1.0 s"));
-    QCOMPARE(s.controlsRefusal(), std::string("E-STOP in flight: the robot stops in ~1.0 s"));
-    QVERIFY(!s.frame(frameWith(false, false), 0.5, std::nullopt).latchedNow);  // not landed yet
+    QCOMPARE(s.controlsRefusal(), std::string("E-STOP in flight: lands in ~1.0 s"));
+    QVERIFY(!s.frame(frameWith(false, false), 10.5, std::nullopt).latchedNow);  // not landed yet
     QVERIFY(s.estopInFlight());
-    QVERIFY(s.frame(frameWith(false, true), 2.1, std::nullopt).latchedNow);
+    QVERIFY(anyLineHas(s.bannerLines(), "E-STOP in flight: lands in ~0.5 s"));
+    const uint64_t before = s.revision();
+    s.tick(10.8);
+    QVERIFY(s.revision() != before);  // the countdown redraws
+    QVERIFY(anyLineHas(s.bannerLines(), "E-STOP in flight: lands in ~0.2 s"));
+    s.tick(11.5);
+    QVERIFY2(anyLineHas(s.bannerLines(), "E-STOP should have landed (sent 1.5 s ago); waiting for the robot's report"),
+             s.bannerLines().front().c_str());
+    QVERIFY(!anyLineHas(s.bannerLines(), "lands in"));  // the old text's claim, 1.5 s after the press
+    QVERIFY(s.frame(frameWith(false, true), 12.1, std::nullopt).latchedNow);
     QVERIFY(!s.estopInFlight());
     QVERIFY(!anyLineHas(s.bannerLines(), "in flight"));
     QVERIFY(anyLineHas(s.bannerLines(), "E-STOP latched: the robot is stopped"));
-    s.rearmSent(1.0);
-    QVERIFY(anyLineHas(s.bannerLines(), "E-STOP latched, re-arm pending: lands in ~1.0 s."));
-    QCOMPARE(s.controlsRefusal(), std::string("Re-arm pending: it lands in ~1.0 s"));
-    s.frame(frameWith(false, false), 4.2, std::nullopt);
+    s.rearmSent(1.0, 12.2);
+    QVERIFY(anyLineHas(s.bannerLines(), "E-STOP latched: the robot is stopped. Re-arm in flight: lands in ~1.0 s."));
+    QCOMPARE(s.controlsRefusal(), std::string("Re-arm in flight: lands in ~1.0 s"));
+    s.frame(frameWith(false, false), 14.2, std::nullopt);
     QVERIFY(!s.rearmInFlight());
     QVERIFY(s.bannerLines().empty());
     QCOMPARE(s.controlsRefusal(), std::string());
-    s.rearmSent(1.0);  // nothing latched: nothing pending
+    s.rearmSent(1.0, 14.3);  // nothing latched: nothing pending
     QVERIFY(!s.rearmInFlight());
-    s.estopSent(1.0);
+    s.estopSent(-1, 14.4);  // before a round trip was measured: not "~0.0 s"
+    QVERIFY(anyLineHas(s.bannerLines(), "E-STOP in flight: the round trip is not measured yet"));
     s.connection(ConnectionState::Waiting, "timeout");
     QVERIFY(!s.estopInFlight());
   }
@@ -175,6 +187,45 @@ class TestConsoleState : public QObject {
     QVERIFY(s.bannerAlarm());  // off the terrain: an alarm
     s.clearFrames();
     QVERIFY(s.bannerLines().empty());
+  }
+
+  // Both latches on after a reconnect, the failsafe's reason lost with the
+  // old connection (issue 59: the banner said "failsafe latched" twice and
+  // "re-arm" three times, and no reason): one line says what latched, that
+  // the reason did not arrive, and to re-arm, once each.
+  void bothLatchesOneLine() {
+    ConsoleState s = driving();
+    s.failsafeReason("deadman: no keep-alive for 0.2 s");
+    s.frame(frameWith(true, false), 0.05, std::nullopt);
+    s.frame(frameWith(false, false), 0.1, std::nullopt);  // re-armed: that failsafe's reason goes with it
+    s.connection(ConnectionState::Waiting, "timeout");
+    s.connection(ConnectionState::Ready, "robot");
+    s.frame(frameWith(true, true), 0.3, std::nullopt);
+    const std::vector<std::string> lines = s.bannerLines();
+    QCOMPARE(lines.size(), size_t{1});
+    const std::string& line = lines[0];
+    const auto count = [&](const std::string& what) {
+      size_t n = 0;
+      for (size_t at = line.find(what); at != std::string::npos; at = line.find(what, at + 1)) ++n;
+      return n;
+    };
+    QCOMPARE(line, std::string("E-STOP and FAILSAFE latched: the robot stopped itself (its reason did not reach this "
+                               "console: see the robot's log). Re-arm to continue."));
+    QCOMPARE(count("latched"), size_t{1});
+    QCOMPARE(count("Re-arm"), size_t{1});
+    QVERIFY(line.find("deadman") == std::string::npos);  // not the old failsafe's reason
+  }
+
+  // An e-stop pressed says what became of it (issue 59: "E-STOP sent" while
+  // disconnected, right under the error that said it was not).
+  void estopPressedSaysTheTruth() {
+    ConsoleState s = driving();
+    QCOMPARE(s.estopPressedText(true), std::string("E-STOP sent"));
+    s.connection(ConnectionState::Waiting, "timeout");
+    QVERIFY(s.estopPressedText(true).starts_with("E-STOP NOT sent: the link is down; it goes out when"));
+    s.connection(ConnectionState::Stopped, "disconnected");
+    QCOMPARE(s.estopPressedText(false), std::string("E-STOP NOT sent: not connected to the robot"));
+    QVERIFY(s.estopPressedText(false).find("E-STOP sent") == std::string::npos);
   }
 
   // While a replay is shown the banner says which robot its alarms are

@@ -17,6 +17,7 @@
 #include <deque>
 
 #include "app/log/resimulation.h"
+#include "app/rehearse/sequence_guard.h"
 #include "app/rehearse/sequence_relay.h"
 #include "app/log/session_log.h"
 #include "app/robot/stand_in.h"
@@ -133,6 +134,28 @@ class TestSequenceRelay : public QObject {
   Q_OBJECT
 
  private slots:
+  // Telemetry the link refused cannot be judged: a sequence sent or running
+  // is aborted on it, once; nothing relayed (the control), nothing to abort.
+  // A new connection forgets the sequence (issue 59: Simulate from here was
+  // "aborted by the guard" against the old robot's sequence).
+  void guardOnUnjudgeableTelemetryAndANewRobot() {
+    const WorldModel world = loadOrFail(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml");
+    SequenceMsg msg;
+    msg.hash = "0123456789abcdef";
+    msg.commands = "0 drive 0.5 0;5 stop";
+    SequenceGuard guard;
+    QVERIFY(!guard.cannotJudge("telemetry: not finite: pose[0] = inf"));  // nothing relayed
+    guard.relayed(msg, RehearsalResult{}, FlightRules{}, world.robots[0].model);
+    const std::optional<GuardDeparture> d = guard.cannotJudge("telemetry: not finite: pose[0] = inf");
+    QVERIFY(d);
+    QCOMPARE(d->message(), std::string("telemetry the guard cannot judge: telemetry: not finite: pose[0] = inf"));
+    QVERIFY(!guard.cannotJudge("again"));  // once
+    guard.relayed(msg, RehearsalResult{}, FlightRules{}, world.robots[0].model);
+    guard.reset();  // the connection is opened anew
+    QCOMPARE(guard.status().phase(), SequenceRelay::Phase::Idle);
+    QVERIFY(!guard.cannotJudge("telemetry: not finite"));
+  }
+
   // Criterion: the robot runs the rehearsed sequence whole and reports done
   // under the hash the console computed; the guard, comparing every frame,
   // never trips (the robot's world is the rehearsal's), and the largest
