@@ -17,6 +17,8 @@ ConsoleMonitor::ConsoleMonitor(RobotConnection* connection, LiveLinkFeed* live, 
   });
   connect(connection, &RobotConnection::connectionChanged, this, [this](net::ConnectionState s, const QString& d) {
     if (state_.connection(s, d.toStdString())) emit robotStopped();
+    if (s == net::ConnectionState::Waiting || s == net::ConnectionState::Stopped || s == net::ConnectionState::Refused)
+      session_->linkDown(d.toStdString());
     if (s == net::ConnectionState::Ready) {
       // The ghost is only as good as the files it is built from.
       const net::RobotClientStats stats = connection_->stats();

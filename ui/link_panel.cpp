@@ -58,6 +58,12 @@ LinkPanel::LinkPanel(QWidget* parent) : QWidget(parent) {
   lease_ = new ElidedLabel;
   latches_ = new ElidedLabel;
   deadman_ = new ElidedLabel;
+  pose_ = new ElidedLabel;
+  pose_->setObjectName(QStringLiteral("poseLabel"));
+  pose_->setToolTip(tr("The robot's base by its newest telemetry: position on the ground and heading"));
+  motion_ = new ElidedLabel;
+  motion_->setObjectName(QStringLiteral("motionLabel"));
+  motion_->setToolTip(tr("Ground speed as the robot reports it, and the distance driven since the session began"));
   deadman_->setToolTip(tr("The robot's deadman: it stops (failsafe) when the controller's keep-alives stop arriving for this long"));
   form->addRow(tr("robot"), endpoint_);
   form->addRow(tr("link"), state_);
@@ -67,6 +73,8 @@ LinkPanel::LinkPanel(QWidget* parent) : QWidget(parent) {
   form->addRow(tr("control"), lease_);
   form->addRow(tr("latches"), latches_);
   form->addRow(tr("deadman"), deadman_);
+  form->addRow(tr("pose"), pose_);
+  form->addRow(tr("moving"), motion_);
   layout->addLayout(form);
 
   auto* row = new QHBoxLayout;
@@ -148,6 +156,13 @@ void LinkPanel::showStats(const net::RobotClientStats& s) {
   if (s.refused + s.shed > 0) text += tr("; refused %1, shed %2").arg(s.refused).arg(s.shed);
   loss_->setFullText(text);
 }
+
+void LinkPanel::showOdometry(const QString& pose, const QString& motion) {
+  pose_->setFullText(pose.isEmpty() ? QStringLiteral("–") : pose);
+  motion_->setFullText(motion.isEmpty() ? QStringLiteral("–") : motion);
+}
+
+QString LinkPanel::poseText() const { return pose_->fullText(); }
 
 void LinkPanel::showConnection(net::ConnectionState state, const QString& detail) {
   open_ = state != net::ConnectionState::Stopped;

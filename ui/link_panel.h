@@ -30,6 +30,10 @@ class LinkPanel : public QWidget {
   void showConnection(net::ConnectionState state, const QString& detail);
   void showLease(const net::LeaseStateMsg& lease);
   void showLatches(bool failsafe, bool estop);
+  /// The robot's pose and motion read-outs (ConsoleState::poseText(),
+  /// motionText(); "" shows a dash).
+  void showOdometry(const QString& pose, const QString& motion);
+  QString poseText() const;
   /// Where the console connects, e.g. "127.0.0.1:47800 (stand-in)".
   void setEndpoint(const QString& endpoint);
   /// Adds a line to the link's event list (replies refused, robot events,
@@ -59,6 +63,8 @@ class LinkPanel : public QWidget {
   ElidedLabel* lease_ = nullptr;
   ElidedLabel* latches_ = nullptr;
   ElidedLabel* deadman_ = nullptr;  // the robot's, from WELCOME
+  ElidedLabel* pose_ = nullptr;
+  ElidedLabel* motion_ = nullptr;
   QPushButton* connect_ = nullptr;
   QPushButton* control_ = nullptr;
   QPushButton* estop_ = nullptr;

@@ -175,10 +175,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   parts.laserPlot = laserPlot_;
   parts.errorPlot = errorPlot_;
   parts.background = background_;
-  parts.status = [this](const QString& text, int ms) {
-    if (text.isEmpty()) statusBar()->clearMessage();
-    else statusBar()->showMessage(text, ms);
-  };
+  parts.status = [this](const QString& text, int ms) { showStatus(text, ms); };
   context_ = new ConsoleContext(std::move(parts), this);
   connect(monitor_, &ConsoleMonitor::robotStopped, context_, &ConsoleContext::robotStopped);
   // The right docks run the window's full height; the plots sit under the
@@ -203,7 +200,12 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
     if (panelTicks_ % 5 == 0) errorPlot_->tick();
     emit context_->panelTick();
     updateStale();
-    if (++panelTicks_ % 3 == 0) refreshStatus();
+    if (++panelTicks_ % 3 == 0) {
+      if (session_->standIn())
+        monitor_->state().realTime(session_->realTimeFactor(), session_->targetRealTimeFactor(), monitor_->wallSeconds());
+      refreshStatus();
+      linkPanel()->showOdometry(qs(state().poseText()), qs(state().motionText()));
+    }
     scene_->update();
   });
   panelTimer->start(100);
@@ -224,7 +226,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
     // must not come back squeezed: the 3D view is what the console is for.
     if (viewShare() < kMinViewShare) {
       defaultLayout();
-      statusBar()->showMessage(tr("The saved layout left the 3D view too small: the default layout is back."), 8000);
+      showStatus(tr("The saved layout left the 3D view too small: the default layout is back."), 8000);
     }
   });
   refreshStatus();
@@ -425,7 +427,7 @@ QString MainWindow::start() {
 void MainWindow::sessionChanged() {
   if (session_->worldVersion() != shownWorld_) showWorld(*session_->world(), true);
   const std::string error = session_->logError();
-  if (!error.empty()) statusBar()->showMessage(tr("session log: %1").arg(qs(error)));
+  if (!error.empty()) showStatus(tr("session log: %1").arg(qs(error)), 0);
   emit context_->sessionChanged();
 }
 
@@ -478,7 +480,7 @@ QString MainWindow::openWorld(const QString& path, bool quiet) {
   }
   if (remote) showWorld(*session_->world(), true);  // the remote robot runs in its own world: only the drawing changes
   else sessionChanged();
-  statusBar()->showMessage(tr("opened %1").arg(path), 5000);
+  showStatus(tr("opened %1").arg(path), 5000);
   return {};
 }
 
@@ -490,7 +492,7 @@ QString MainWindow::openRobot(const QString& path, bool quiet) {
   }
   if (remote) showWorld(*session_->world(), true);
   else sessionChanged();
-  statusBar()->showMessage(tr("opened %1").arg(path), 5000);
+  showStatus(tr("opened %1").arg(path), 5000);
   return {};
 }
 
@@ -514,7 +516,7 @@ QString MainWindow::startBranch(const QString& logPath, const BranchPoint& point
 void MainWindow::addNote(const QString& text) {
   session_->note(text.toStdString());
   emit context_->eventShown(tr("note: %1").arg(text));
-  statusBar()->showMessage(tr("note logged"), 3000);
+  showStatus(tr("note logged"), 3000);
 }
 
 void MainWindow::onShownFrame(const RobotFrame& f) {
@@ -598,6 +600,25 @@ bool MainWindow::eventFilter(QObject* watched, QEvent* event) {
     return true;
   }
   return QMainWindow::eventFilter(watched, event);
+}
+
+void MainWindow::showStatus(const QString& text, int ms) {
+  QStatusBar* bar = statusBar();
+  bar->setToolTip(text);
+  if (text.isEmpty()) {
+    bar->clearMessage();
+    return;
+  }
+  // A message wider than the room left of the fields runs under them
+  // (issue 59): elided to that room, the whole text in the tooltip and,
+  // when it does not fit, in the event list too.
+  int fields = 0;
+  for (QWidget* w : bar->findChildren<QWidget*>(QString(), Qt::FindDirectChildrenOnly))
+    if (w->isVisible() && w->property("permanentField").toBool()) fields += w->width() + 6;
+  const int room = std::max(80, bar->width() - fields - 24);
+  const QString shown = bar->fontMetrics().elidedText(text, Qt::ElideRight, room);
+  if (shown != text) context_->event(QStringLiteral("status"), text, false);
+  bar->showMessage(shown, ms);
 }
 
 double MainWindow::robotSpeed() const {

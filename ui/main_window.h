@@ -179,6 +179,10 @@ class MainWindow : public QMainWindow, public ConsoleHost {
   /// File ▸ Quit (Ctrl+Q): quits, after asking when this console holds
   /// control of a robot that moves (stop it first, or cancel).
   void requestQuit();
+  /// Shows `text` in the status bar for `ms` (0: until replaced), elided
+  /// to the room the fields leave, whole in the tooltip (and the event list
+  /// when elided).
+  void showStatus(const QString& text, int ms);
   /// The live robot's ground speed [m/s] by its newest telemetry (0 without one).
   double robotSpeed() const;
   /// Asks the operator to confirm, then re-arms (clears a latched failsafe

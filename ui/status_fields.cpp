@@ -30,7 +30,10 @@ StatusFields::StatusFields(QStatusBar* bar) : QObject(bar) {
   log_ = new QLabel;
   log_->setTextInteractionFlags(Qt::TextSelectableByMouse);
   for (QLabel* l : {time_, rtf_, health_}) l->setMinimumWidth(l->fontMetrics().horizontalAdvance(QStringLiteral("t = 00000.00 s")));
-  for (QLabel* l : {terrain_, ghost_, time_, rtf_, health_, log_}) bar->addPermanentWidget(l);
+  for (QLabel* l : {terrain_, ghost_, time_, rtf_, health_, log_}) {
+    l->setProperty("permanentField", true);  // MainWindow::showStatus leaves them their room
+    bar->addPermanentWidget(l);
+  }
 }
 
 void StatusFields::refresh(const ConsoleState& state, const ConsoleSession& session, const LiveLinkFeed& live) {

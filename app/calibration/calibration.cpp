@@ -722,6 +722,16 @@ std::string makeProblem(const WorldModel& files, const SimParams& profile, const
 
 }  // namespace
 
+std::string boundsRefusal(const CalParamInfo& info, double value) {
+  // In words and the parameter's unit, three digits: what the operator
+  // reads in the Calibration panel (issue 59: a raw key with 16 digits).
+  const std::string unit = *info.unit ? std::string(" ") + info.unit : std::string(" ×");
+  char text[200];
+  std::snprintf(text, sizeof text, "the %s came out at %.3g%s, outside what the robot can have (%.3g to %.3g%s; %s)",
+                info.label, value, unit.c_str(), info.lower, info.upper, unit.c_str(), info.key);
+  return text;
+}
+
 CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& frames,
                               const std::vector<TimedCommand>& commands, const CalEstimate& from, CalibrationOptions options,
                               const std::function<bool()>& abort) {
@@ -1030,8 +1040,7 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
     const CalParamInfo& info = calParams()[i];
     const double bounded = std::clamp(v[i], info.lower, info.upper);
     if (!std::isfinite(v[i]) || std::abs(v[i] - bounded) > std::max(3 * fit.sigma[i], kUnobserved * info.scale))
-      return done(std::string(info.key) + " = " + shortestText(v[i]) + " is outside its physical bounds [" +
-                  shortestText(info.lower) + ", " + shortestText(info.upper) + "]");
+      return done(boundsRefusal(info, v[i]));
     v[i] = bounded;
   }
   for (int p = 0; p < kFitted; ++p) fit.value[static_cast<size_t>(p)] = v[static_cast<size_t>(p)];

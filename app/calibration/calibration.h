@@ -87,6 +87,10 @@ CalValues calValues(const SimParams& params);
 SimParams withCalValues(SimParams params, const CalValues& values);
 /// The files' values (identity).
 CalValues filesCalValues();
+/// Why a fit whose `value` of `info` lies beyond its physical bounds is
+/// refused, in words and units ("the command delay came out at -0.297 s,
+/// outside what the robot can have (0 to 0.5 s; calibration.delay)").
+std::string boundsRefusal(const CalParamInfo& info, double value);
 
 struct CalibrationOptions {
   double window = 10;        ///< [s] of the newest telemetry fitted; <= 0: all of it

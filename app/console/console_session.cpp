@@ -289,6 +289,11 @@ void ConsoleSession::commandSent(const Command& command) {
   }
 }
 
+void ConsoleSession::linkDown(const std::string& why) {
+  if (ghost_) ghost_->halt("the robot link is down (" + why + "): no prediction until it is back");
+  lastPrediction_.reset();
+}
+
 void ConsoleSession::estopSent() {
   // The robot's e-stop stops every motor as `stop` does, when it lands: the
   // ghost and the fit see it arrive then, as any command (not logged as

@@ -172,6 +172,9 @@ class ConsoleSession {
   const std::optional<GhostError>& lastPrediction() const { return lastPrediction_; }
   /// A laser scan arrived: the frame to draw, logged when remote.
   LaserFrame laser(const net::LaserMsg& message);
+  /// The real-time factor the stand-in is asked to run at (`--rtf`, else
+  /// the parameters').
+  double targetRealTimeFactor() const { return options_.rtf >= 0 ? options_.rtf : params_.realTimeFactor; }
   /// The achieved real-time factor over the last second of telemetry.
   double realTimeFactor() const { return rate_.factor(); }
 
@@ -181,6 +184,10 @@ class ConsoleSession {
   /// A command went out: logged when the robot is remote (the stand-in logs
   /// what it applies itself), and handed to the ghost.
   void commandSent(const Command& command);
+  /// The link went down (`why`): the ghost stops predicting from the last
+  /// telemetry (it would run on from it as if the robot drove on) until
+  /// the next frame.
+  void linkDown(const std::string& why);
   /// An e-stop went out: the ghost (and the calibration) stop the robot
   /// where it lands, as a `stop` sent now.
   void estopSent();

@@ -59,6 +59,16 @@ void ConsoleState::terrain(bool heightfield, double width, double depth) {
 
 FrameChanges ConsoleState::frame(const RobotFrame& f, double wall, std::optional<double> edge) {
   FrameChanges changes;
+  // Odometry before haveFrame_ changes: the first frame only sets the start.
+  const double dx = f.base.p.x - odometry_.x, dy = f.base.p.y - odometry_.y;
+  const double step = std::hypot(dx, dy), dt = f.time - odometryTime_;
+  if (haveFrame_ && step < 1.0) odometry_.distance += step;
+  if (f.hasBaseVelocity) odometry_.speed = std::hypot(f.baseLinearVelocity.x, f.baseLinearVelocity.y);
+  else if (haveFrame_ && dt > 0 && step < 1.0) odometry_.speed = step / dt;
+  odometry_.x = f.base.p.x;
+  odometry_.y = f.base.p.y;
+  odometry_.heading = heading(f.base.q);
+  odometryTime_ = f.time;
   lastFrameWall_ = now_ = wall;
   haveFrame_ = true;
   if (stale_) {
@@ -148,6 +158,7 @@ bool ConsoleState::tick(double wall) {
 
 void ConsoleState::clearFrames() {
   haveFrame_ = false;
+  odometry_ = {};
   stale_ = false;
   edge_.reset();
   shownEdge_ = 0;
@@ -159,9 +170,55 @@ void ConsoleState::replay(std::string label) {
   ++revision_;
 }
 
+void ConsoleState::realTime(double factor, double target, double wall) {
+  if (!(factor > 0) || !(target > 0) || !connected()) {
+    slowSince_ = -1;
+    if (slowTwin_) {
+      slowTwin_ = false;
+      ++revision_;
+    }
+    return;
+  }
+  targetFactor_ = target;
+  if (factor < 0.8 * target) {
+    if (slowSince_ < 0) slowSince_ = wall;
+  } else {
+    slowSince_ = -1;
+  }
+  const bool slow = slowTwin_ ? factor < 0.9 * target : slowSince_ >= 0 && wall - slowSince_ >= 3;
+  // The figure shown moves in steps of 0.05: the banner is not rewritten every tick.
+  const double shown = std::round(factor * 20) / 20;
+  if (slow != slowTwin_ || (slow && shown != shownFactor_)) {
+    slowTwin_ = slow;
+    shownFactor_ = shown;
+    ++revision_;
+  }
+}
+
+std::string ConsoleState::poseText() const {
+  if (!haveFrame_) return {};
+  constexpr double kDegrees = 180 / 3.14159265358979323846;
+  // Rounded first, so that a hair below zero reads 0.00, not -0.00.
+  const auto shown = [](double v, int decimals) {
+    const double scale = std::pow(10.0, decimals);
+    return fixed(std::round(v * scale) / scale + 0.0, decimals);
+  };
+  return "x " + shown(odometry_.x, 2) + " m  y " + shown(odometry_.y, 2) + " m  heading " +
+         shown(odometry_.heading * kDegrees, 1) + "°";
+}
+
+std::string ConsoleState::motionText() const {
+  if (!haveFrame_) return {};
+  return fixed(odometry_.speed, 2) + " m/s, " + fixed(odometry_.distance, 1) + " m driven";
+}
+
 std::string ConsoleState::staleText(double wall) const {
-  if (!stale_ || replaying()) return {};
+  if (replaying() || !haveFrame_) return {};
   const std::string age = fixed(dataAge(wall), 1);
+  // A robot last seen before the link went down is as old as a quiet one
+  // (issue 59: it stayed drawn in full colour, as if live).
+  if (!connected()) return "not connected: the robot drawn is where it was " + age + " s ago";
+  if (!stale_) return {};
   return "no data " + age + " s: the robot drawn is where it was " + age + " s ago";
 }
 
@@ -198,6 +255,10 @@ std::vector<std::string> ConsoleState::bannerLines() const {
                                      " m heightfield; beyond it the robot falls.");
   }
   if (!filesMismatch_.empty()) lines.push_back(live + filesMismatch_);
+  if (slowTwin_ && !replaying())
+    lines.push_back("The stand-in's twin runs at " + fixed(shownFactor_, 2) + " × real time (asked " +
+                    fixed(targetFactor_, 2) + "): this machine cannot keep up, and the robot, its deadman and the "
+                    "ghost run slow with it.");
   if (connection_ == net::ConnectionState::Waiting || connection_ == net::ConnectionState::Refused)
     lines.push_back(live + "Robot link down (" + connectionDetail_ + "): the robot's own deadman stops it; reconnecting.");
   return lines;

@@ -77,6 +77,12 @@ class ConsoleState {
   FrameChanges frame(const RobotFrame& frame, double wall, std::optional<double> edge);
   /// At wall time `wall` [s]: true when staleness began or ended.
   bool tick(double wall);
+  /// The stand-in's twin runs at `factor` times real time, asked to run at
+  /// `target` (0: not measured yet), at wall time `wall` [s]: below 0.8 ×
+  /// the target for 3 s the banner says the twin cannot keep real time
+  /// (the robot and its deadman run slow), until it is back above 0.9 ×.
+  void realTime(double factor, double target, double wall);
+  bool slowTwin() const { return slowTwin_; }
   /// A new session or world: no frame yet, no edge, nothing latched from
   /// the old robot's frames.
   void clearFrames();
@@ -108,12 +114,25 @@ class ConsoleState {
   /// The twin's divergence report, "" while healthy.
   const std::string& healthReport() const { return health_; }
   bool haveFrame() const { return haveFrame_; }
+  /// Where the robot is by its newest live frame: base x, y [m] and
+  /// heading [rad]; its ground speed [m/s] (the reported twist, else from
+  /// the last two frames) and the distance driven on the ground [m] since
+  /// this session's first frame (clearFrames() starts it over; a leap of
+  /// more than 1 m between two frames, a reset, is not driving).
+  struct Odometry {
+    double x = 0, y = 0, heading = 0, speed = 0, distance = 0;
+  };
+  const Odometry& odometry() const { return odometry_; }
+  /// "x 1.23 m  y -0.40 m  heading 12.3°" and "0.48 m/s, 12.6 m driven", or "" before a frame.
+  std::string poseText() const;
+  std::string motionText() const;
   /// No live telemetry for config().staleAfter while connected.
   bool stale() const { return stale_; }
   /// [s] since the last live frame (0 before the first).
   double dataAge(double wall) const { return haveFrame_ ? wall - lastFrameWall_ : 0; }
-  /// The line over the 3D view while the data is stale, "" when not shown
-  /// (fresh data, or a replay shown).
+  /// The line over the 3D view while the data is stale or the link is down
+  /// with a robot drawn, "" when not shown (fresh data, nothing drawn yet,
+  /// or a replay shown).
   std::string staleText(double wall) const;
   const std::optional<double>& edgeDistance() const { return edge_; }
   bool replaying() const { return !replay_.empty(); }
@@ -163,6 +182,10 @@ class ConsoleState {
   double terrainWidth_ = 0, terrainDepth_ = 0;
   std::optional<double> edge_;
   double shownEdge_ = 0;  // the distance the banner shows (moves in 0.1 m steps)
+  Odometry odometry_;
+  bool slowTwin_ = false;
+  double slowSince_ = -1, shownFactor_ = 0, targetFactor_ = 1;
+  double odometryTime_ = 0;  // [s] robot time of the frame odometry_ is from
   bool haveFrame_ = false, stale_ = false;
   double lastFrameWall_ = 0;
   std::string replay_;

@@ -40,6 +40,7 @@ void TerrainEditor::endStroke() {
   Stroke done{rectangle(s.start, s.i0, s.j0, s.i1, s.j1), rectangle(grid_, s.i0, s.j0, s.i1, s.j1)};
   stroke_.reset();
   if (done.before == done.after) return;
+  ++changes_;
   done_.push_back(std::move(done));
   if (done_.size() > maxLevels_) done_.erase(done_.begin());
   undone_.clear();
@@ -50,6 +51,7 @@ std::optional<TerrainPatchCmd> TerrainEditor::undo() {
   if (done_.empty()) return std::nullopt;
   Stroke s = std::move(done_.back());
   done_.pop_back();
+  ++changes_;
   applyPatch(grid_, s.before);
   TerrainPatchCmd patch = s.before;
   undone_.push_back(std::move(s));
@@ -61,6 +63,7 @@ std::optional<TerrainPatchCmd> TerrainEditor::redo() {
   if (undone_.empty()) return std::nullopt;
   Stroke s = std::move(undone_.back());
   undone_.pop_back();
+  ++changes_;
   applyPatch(grid_, s.after);
   TerrainPatchCmd patch = s.after;
   done_.push_back(std::move(s));

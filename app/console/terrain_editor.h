@@ -52,6 +52,12 @@ class TerrainEditor {
   std::optional<TerrainPatchCmd> redo();
   size_t undoLevels() const { return done_.size(); }
   size_t redoLevels() const { return undone_.size(); }
+  /// The heights were saved as they are now.
+  void markSaved() { saved_ = changes_; }
+  /// Strokes, undos or redos since the last markSaved() (or since the
+  /// start): what a restart from the world file would lose. Conservative:
+  /// undoing back to the saved heights still counts.
+  size_t unsavedChanges() const { return changes_ - saved_; }
 
  private:
   struct Stroke {
@@ -65,6 +71,7 @@ class TerrainEditor {
   size_t maxLevels_;
   std::optional<Open> stroke_;
   std::vector<Stroke> done_, undone_;
+  size_t changes_ = 0, saved_ = 0;  // counts strokes, undos and redos
 };
 
 /// `patch` cut into row bands (and, for very wide patches, column blocks)

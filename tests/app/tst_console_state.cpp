@@ -165,11 +165,15 @@ class TestConsoleState : public QObject {
     }
     QVERIFY(!s.stale());
     QCOMPARE(s.health().text, std::string("replay"));
-    // Not connected: not stale, however old the data.
+    // Not connected: not stale, however old the data, but the robot drawn
+    // is said to be as old as it is (issue 59: drawn in full colour, as if
+    // live, after a disconnect).
     ConsoleState d = driving();
+    QCOMPARE(d.staleText(0.1), std::string());  // the control: connected and fresh
     d.connection(ConnectionState::Waiting, {});
     QVERIFY(!d.tick(10));
     QVERIFY(!d.stale());
+    QCOMPARE(d.staleText(10), std::string("not connected: the robot drawn is where it was 10.0 s ago"));
   }
 
   // The edge warning appears within edgeWarning of a heightfield's edge,
@@ -214,6 +218,48 @@ class TestConsoleState : public QObject {
     QCOMPARE(count("latched"), size_t{1});
     QCOMPARE(count("Re-arm"), size_t{1});
     QVERIFY(line.find("deadman") == std::string::npos);  // not the old failsafe's reason
+  }
+
+  // A twin that cannot keep real time says so after 3 s below 0.8 x the
+  // target, and stops saying so above 0.9 x; a twin on time (the control)
+  // says nothing.
+  void slowTwinSaysSo() {
+    ConsoleState s = driving();
+    for (double t = 0; t < 5; t += 0.3) s.realTime(0.98, 1.0, t);
+    QVERIFY(!s.slowTwin());
+    for (double t = 5; t < 7.9; t += 0.3) s.realTime(0.54, 1.0, t);
+    QVERIFY(!s.slowTwin());  // not yet 3 s
+    s.realTime(0.54, 1.0, 8.1);
+    QVERIFY(s.slowTwin());
+    QVERIFY(anyLineHas(s.bannerLines(), "The stand-in's twin runs at 0.55 × real time (asked 1.00)"));
+    s.realTime(0.85, 1.0, 8.4);
+    QVERIFY(s.slowTwin());  // hysteresis
+    s.realTime(0.95, 1.0, 8.7);
+    QVERIFY(!s.slowTwin());
+  }
+
+  // The pose and motion read-outs: position, heading, ground speed and the
+  // distance driven, a reset's leap not counted.
+  void odometry() {
+    ConsoleState s;
+    s.connection(ConnectionState::Ready, {});
+    QCOMPARE(s.poseText(), std::string());
+    RobotFrame f;
+    for (int i = 0; i <= 10; ++i) {
+      f.time = 0.1 * i;
+      f.base.p = {0.05 * i, 0, 0.5};
+      s.frame(f, f.time, std::nullopt);
+    }
+    QCOMPARE(s.poseText(), std::string("x 0.50 m  y 0.00 m  heading 0.0°"));
+    QCOMPARE(s.motionText(), std::string("0.50 m/s, 0.5 m driven"));
+    f.time = 1.1;
+    f.base.p = {20, 0, 0.5};  // a reset puts it elsewhere: not driven
+    s.frame(f, f.time, std::nullopt);
+    QCOMPARE(s.odometry().distance, 0.5);
+    f.base.p = {0.5, -0.0001, 0.5};  // a hair below zero reads 0.00, not -0.00
+    f.time = 1.2;
+    s.frame(f, f.time, std::nullopt);
+    QCOMPARE(s.poseText(), std::string("x 0.50 m  y 0.00 m  heading 0.0°"));
   }
 
   // An e-stop pressed says what became of it (issue 59: "E-STOP sent" while

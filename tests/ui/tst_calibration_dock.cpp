@@ -33,8 +33,10 @@ class TestCalibrationDock : public QObject {
 
  private slots:
   // A robot standing still has every fit refused for want of driving: the
-  // event list says once that calibration waits (not that a fit was
-  // refused: nothing is wrong), not every 3 s (three refusals, one line).
+  // Calibration panel says it waits (not that a fit was refused: nothing
+  // is wrong), and the link's event list says nothing of calibration at
+  // all (issue 59: it was flooded with "waits for driving" after every
+  // start and re-arm; the old code said it there once, and fails this).
   void standingStillSaysItOnce() {
     QTemporaryDir dir;
     QVERIFY(dir.isValid());
@@ -43,19 +45,16 @@ class TestCalibrationDock : public QObject {
     const QString error = test::startConsole(dir, QStringLiteral("terrains/flat.world.xml"), options, window);
     QVERIFY2(error.isEmpty(), qPrintable(error));
     MainWindow& w = *window;
-    int said = 0, refusedSaid = 0;
-    connect(&w.context(), &ConsoleContext::eventShown, this, [&](const QString& text) {
-      said += text.startsWith(QLatin1String("Calibration waits for driving"));
-      refusedSaid += text.startsWith(QLatin1String("Calibration fit refused"));
-    });
+    int said = 0;
+    connect(&w.context(), &ConsoleContext::eventShown, this,
+            [&](const QString& text) { said += text.startsWith(QLatin1String("Calibration")); });
     LiveCalibrator* calibrator = w.context().session().calibrator();
     QVERIFY(calibrator);
     QTRY_VERIFY_WITH_TIMEOUT(calibrator->state().refusals >= 3, 30000);
     QTest::qWait(300);  // a panel tick
     qInfo("%d refusals standing still, %d said", calibrator->state().refusals, said);
     QVERIFY2(calibrator->state().lastRefusal.rfind("not enough driving", 0) == 0, calibrator->state().lastRefusal.c_str());
-    QCOMPARE(said, 1);
-    QCOMPARE(refusedSaid, 0);
+    QCOMPARE(said, 0);
     QVERIFY(calibrator->state().lastRefusalWantsDriving);
     auto* job = w.job<CalibrationJob>();
     QVERIFY(job);

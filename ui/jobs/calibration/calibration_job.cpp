@@ -101,7 +101,6 @@ void CalibrationJob::refresh() {
   if (c != calibrator_) {
     calibrator_ = c;
     seen_ = -1;
-    refusalsSeen_ = 0;
   }
   if (!c) {
     if (seen_ != 0)
@@ -115,19 +114,9 @@ void CalibrationJob::refresh() {
   const CalibrationState s = c->state();
   seen_ = s.version;
   panel_->setLive(&s);
-  if (s.refusals > refusalsSeen_) {
-    const std::string kind = s.lastRefusal.substr(0, s.lastRefusal.find(':'));
-    const int accepted = s.fits - s.refusals;
-    if (kind != refusalSaid_ || accepted != acceptedWhenSaid_)
-      context_->event(QStringLiteral("calibration"),
-                      (s.lastRefusalWantsDriving ? tr("Calibration waits for driving (the values kept): %1")
-                                                 : tr("Calibration fit refused, the values kept: %1"))
-                          .arg(QString::fromStdString(s.lastRefusal)),
-                      false);  // the session logs the fit itself
-    refusalSaid_ = kind;
-    acceptedWhenSaid_ = accepted;
-    refusalsSeen_ = s.refusals;
-  }
+  // Refused fits are said in the panel (its status line) and logged by
+  // the session with every fit: the link's event list keeps the link and
+  // the safety chain in view (issue 59: it was flooded by calibration).
 }
 
 }  // namespace sp

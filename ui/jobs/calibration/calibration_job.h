@@ -33,12 +33,6 @@ class CalibrationJob : public ConsoleJob {
   ConsoleContext* context_ = nullptr;
   CalibrationPanel* panel_ = nullptr;
   int64_t seen_ = -1;       // the calibrator's version shown
-  int refusalsSeen_ = 0;    // refused fits already said in the event list
-  // The last refusal said (its reason's first clause) and the fits accepted
-  // then: a robot standing still has every fit refused for want of driving,
-  // said once, not every period.
-  std::string refusalSaid_;
-  int acceptedWhenSaid_ = -1;
   const void* calibrator_ = nullptr;  // the one seen_ counts (a new world makes another)
   QString replayed_;        // the log shown, "" when live
 };

@@ -7,6 +7,7 @@
 #include <QPushButton>
 
 #include "app/console/console_session.h"
+#include "app/console/terrain_editor.h"
 #include "ui/connect_dialog.h"
 #include "ui/link_panel.h"
 #include "ui/robot_connection.h"
@@ -112,6 +113,21 @@ void LinkJob::openConnectDialog() {
 }
 
 void LinkJob::resetRobot() {
+  // The stand-in restarts on the world file's terrain: edits not saved
+  // would go without a word (issue 59). Asked first, Cancel the default.
+  if (const TerrainEditor* t = context_->session().terrainEditor(); t && t->unsavedChanges() > 0) {
+    QMessageBox box(QMessageBox::Warning, tr("Reset to the start"),
+                    tr("The terrain has %n edit(s) not saved. Reset restarts the robot on the world file's terrain: "
+                       "they would be lost.\n\nSave them first with Terrain ▸ Save as…, or reset without them.",
+                       nullptr, static_cast<int>(t->unsavedChanges())),
+                    QMessageBox::NoButton, context_->window());
+    box.setObjectName(QStringLiteral("resetConfirm"));
+    QPushButton* discard = box.addButton(tr("Reset, losing the edits"), QMessageBox::DestructiveRole);
+    QPushButton* cancel = box.addButton(tr("Cancel"), QMessageBox::RejectRole);
+    box.setDefaultButton(cancel);
+    box.exec();
+    if (box.clickedButton() != discard) return;
+  }
   context_->connection().close();
   if (const std::string error = context_->session().resetRobot(); !error.empty()) {
     context_->status(qs(error), 6000);

@@ -288,7 +288,9 @@ void TerrainPanel::updateState() {
 
 QString TerrainPanel::save(const QString& terrainFile, const QString& worldFile) {
   if (!editor_ || !world_) return tr("no heightfield to save");
-  return writeTerrain(editor_->grid(), world_->file, terrainFile, worldFile);
+  QString error = writeTerrain(editor_->grid(), world_->file, terrainFile, worldFile);
+  if (error.isEmpty()) editor_->markSaved();
+  return error;
 }
 
 QString TerrainPanel::createNew(double width, double depth, double resolution, double baseHeight,
