@@ -4,9 +4,12 @@
 // --quit-after S`, under a display: run it under xvfb-run) is started
 // against it, and its peak memory (wait4's ru_maxrss) and its quit latency
 // (from the line it prints when --quit-after fires to its exit) are printed
-// as a table for docs/performance.md. Asserts nothing.
+// as a table for docs/performance.md. With --check it also judges each row
+// by the criterion fixed in docs/performance.md (exit 0, quit within 1 s,
+// peak under 300 MB) and exits 1 when one misses it: ctest runs a few
+// cases so (`hostile_console`).
 //
-//   xvfb-run -a -s "-screen 0 1280x800x24" build/bench/bench_hostile [--seconds 20] [--only NAME]
+//   xvfb-run -a -s "-screen 0 1280x800x24" build/bench/bench_hostile [--seconds 20] [--only NAME[|NAME...]] [--check]
 
 #include <fcntl.h>
 #include <poll.h>
@@ -246,13 +249,15 @@ Outcome runConsole(const std::string& exe, uint16_t port, double seconds, const 
 int main(int argc, char** argv) {
   std::string exe = SP_BINARY_DIR "/app/simpartner", only;
   double seconds = 20;
+  bool check = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--seconds" && i + 1 < argc) seconds = std::stod(argv[++i]);
     else if (a == "--only" && i + 1 < argc) only = argv[++i];
     else if (a == "--console" && i + 1 < argc) exe = argv[++i];
+    else if (a == "--check") check = true;
     else {
-      std::fprintf(stderr, "usage: bench_hostile [--seconds S] [--only NAME] [--console PATH]\n");
+      std::fprintf(stderr, "usage: bench_hostile [--seconds S] [--only NAME[|NAME...]] [--console PATH] [--check]\n");
       return 2;
     }
   }
@@ -260,8 +265,11 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(logDir);
   standing();
   std::printf("| misbehaviour | peak memory | quit latency | exit |\n|---|---|---|---|\n");
+  int missed = 0, ran = 0;
+  const std::string names = "|" + only + "|";  // names hold commas: '|' separates them
   for (Case& c : cases()) {
-    if (!only.empty() && only != c.name) continue;
+    if (!only.empty() && names.find("|" + std::string(c.name) + "|") == std::string::npos) continue;
+    ++ran;
     HostileRobot robot(c.handshake, c.behaviour, seconds + 20);
     const Outcome o = runConsole(exe, robot.port(), seconds, logDir, c.drive);
     robot.stop();
@@ -271,8 +279,18 @@ int main(int argc, char** argv) {
     else std::snprintf(quit, sizeof quit, "%.0f ms", o.quitMs);
     const std::string exit = WIFSIGNALED(o.status) ? std::string("signal ") + strsignal(WTERMSIG(o.status))
                                                    : std::to_string(WEXITSTATUS(o.status));
-    std::printf("| %s | %.0f MB | %s | %s |\n", c.name, o.peakMiB, quit, exit.c_str());
+    const bool ok = WIFEXITED(o.status) && WEXITSTATUS(o.status) == 0 && o.quitMs >= 0 && o.quitMs < 1000 &&
+                    o.peakMiB < 300;
+    missed += !ok;
+    std::printf("| %s | %.0f MB | %s | %s |%s\n", c.name, o.peakMiB, quit, exit.c_str(),
+                check && !ok ? "  <- misses the criterion" : "");
     std::fflush(stdout);
   }
-  return 0;
+  if (!check) return 0;
+  if (ran == 0) {
+    std::fprintf(stderr, "bench_hostile: error: no case named in --only '%s'\n", only.c_str());
+    return 2;
+  }
+  std::printf("%d of %d cases meet the criterion (exit 0, quit within 1 s, peak under 300 MB)\n", ran - missed, ran);
+  return missed == 0 ? 0 : 1;
 }
