@@ -56,8 +56,9 @@ QString seconds(double t) { return QString::number(t, 'f', 2) + " s"; }
 
 // A word-wrapped label that does not ask for height for its width: one
 // that does makes the dock's scroll area size the whole panel by its
-// preferred heights (593 px where 317 are enough). It wraps in the height
-// the layout gives it, a line at least.
+// preferred heights (593 px where 317 are enough). Its minimum is the
+// height its text takes at its present width: squeezed to one line, a
+// two-line reason was cut in half (issue 59).
 class WrappedLabel : public QLabel {
  public:
   explicit WrappedLabel(QWidget* parent) : QLabel(parent) {
@@ -69,6 +70,11 @@ class WrappedLabel : public QLabel {
   QSize sizeHint() const override {
     const QSize hint = QLabel::sizeHint();
     return {hint.width(), QLabel::heightForWidth(width() > 50 ? width() : hint.width())};
+  }
+  QSize minimumSizeHint() const override {
+    const QSize least = QLabel::minimumSizeHint();
+    if (width() <= 50 || text().isEmpty()) return {least.width(), fontMetrics().lineSpacing()};
+    return {least.width(), std::max(fontMetrics().lineSpacing(), QLabel::heightForWidth(width()))};
   }
 
  protected:
@@ -84,6 +90,7 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   setBackground(new BackgroundJobs(this));  // until given the console's
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(4, 4, 4, 4);
+  layout->setSpacing(3);  // at 1280x800 every row must fit the tab's ~340 px
 
   auto* fileRow = new QHBoxLayout;
   auto* open = new QPushButton(tr("Open…"), this);
@@ -186,6 +193,11 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   verdicts_->setHeaderLabels({tr("Rule"), tr("Verdict")});
   verdicts_->setRootIsDecorated(false);
   verdicts_->setMinimumHeight(60);
+  // A failed rule's explanation wraps in its row rather than being elided
+  // (issue 59: clipped top and bottom); failed rules come first.
+  verdicts_->setWordWrap(true);
+  verdicts_->setUniformRowHeights(false);
+  verdicts_->setTextElideMode(Qt::ElideNone);
   // The verdicts and the margins' plot share one place, as tabs: stacked,
   // they pushed Watch and Send below the fold of a 1280x800 window.
   results_ = new QTabWidget(this);
@@ -205,6 +217,8 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   scrubRow->addWidget(scrubber_, 1);
   scrubRow->addWidget(scrubLabel_);
   layout->addLayout(scrubRow);
+  // Send and Abort on the Watch row: on a row of their own they fell below
+  // the fold of a 1280x800 window (issue 59).
   connect(scrubber_, &QSlider::valueChanged, this, &SequencePanel::showScrub);
 
   auto* chart = new QChart;
@@ -224,15 +238,12 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   chart_->setMinimumHeight(60);
   results_->addTab(chart_, tr("Margins"));
 
-  auto* relayRow = new QHBoxLayout;
   sendButton_ = new QPushButton(tr("Send to robot"), this);
   sendButton_->setToolTip(tr("Only a sequence that passed its rehearsal, unchanged since"));
   abortButton_ = new QPushButton(tr("Abort"), this);
   abortButton_->setToolTip(tr("Stop the sequence on the robot (the robot stops)"));
-  relayRow->addWidget(sendButton_);
-  relayRow->addWidget(abortButton_);
-  relayRow->addStretch();
-  layout->addLayout(relayRow);
+  scrubRow->addWidget(sendButton_);
+  scrubRow->addWidget(abortButton_);
   connect(sendButton_, &QPushButton::clicked, this, &SequencePanel::send);
   connect(abortButton_, &QPushButton::clicked, this, [this] { abort(tr("the operator pressed Abort")); });
 
@@ -356,6 +367,11 @@ void SequencePanel::checkNow() {
   }
   editor_->setExtraSelections(marks);
   errorList_->setVisible(!errors_.isEmpty());
+  // As tall as its lines, three at most: 70 px for one error squeezed the
+  // editor to two lines (issue 59).
+  if (errorList_->count() > 0)
+    errorList_->setFixedHeight(std::min(3, errorList_->count()) * errorList_->sizeHintForRow(0) +
+                               2 * errorList_->frameWidth());
   updateButtons();
 }
 
@@ -586,7 +602,11 @@ void SequencePanel::showVerdicts() {
     return;
   }
   if (!result_->error.empty()) new QTreeWidgetItem(verdicts_, {tr("rehearsal"), QString::fromStdString(result_->error)});
-  for (const RuleVerdict& v : result_->verdicts) {
+  std::vector<const RuleVerdict*> ordered;
+  for (const RuleVerdict& v : result_->verdicts) ordered.push_back(&v);
+  std::stable_partition(ordered.begin(), ordered.end(), [](const RuleVerdict* v) { return !v->passed; });
+  for (const RuleVerdict* p : ordered) {
+    const RuleVerdict& v = *p;
     // The message without its leading "rule: ", which the first column shows.
     QString text = QString::fromStdString(v.message());
     const QString prefix = QString::fromUtf8(toString(v.rule)) + QStringLiteral(": ");
@@ -597,6 +617,14 @@ void SequencePanel::showVerdicts() {
     item->setData(0, Qt::UserRole, v.passed ? v.worstTime : v.time);
   }
   verdicts_->resizeColumnToContents(0);
+  // Each row as tall as its explanation wraps to in the verdict column
+  // (the view does not measure wrapped rows against the column's width).
+  const int textWidth = std::max(80, verdicts_->viewport()->width() - verdicts_->columnWidth(0) - 10);
+  for (int i = 0; i < verdicts_->topLevelItemCount(); ++i) {
+    QTreeWidgetItem* item = verdicts_->topLevelItem(i);
+    const int h = verdicts_->fontMetrics().boundingRect(QRect(0, 0, textWidth, 10000), Qt::TextWordWrap, item->text(1)).height();
+    item->setSizeHint(1, QSize(textWidth, h + 4));
+  }
   double top = 0, bottom = 0;
   for (const RehearsalSample& s : result_->path) {
     const double margin = std::isfinite(s.margin) ? std::clamp(s.margin * 100, -100.0, 100.0) : -100.0;
