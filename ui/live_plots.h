@@ -60,6 +60,8 @@ class LivePlot : public QWidget {
   /// Times the chart's contents were updated since construction; each update
   /// is one data pass plus one repaint of the view.
   int64_t replots() const { return replots_; }
+  /// Data changed since the last replot: the next tick redraws.
+  bool replotPending() const { return dirty_; }
 
   /// The chart, owned by this widget: to restyle it (title, fonts, legend;
   /// setTheme() would recolour the series) or read its plotArea().

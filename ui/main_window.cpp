@@ -1,5 +1,6 @@
 #include "ui/main_window.h"
 
+#include <QActionGroup>
 #include <QApplication>
 #include <QCloseEvent>
 #include <QDesktopServices>
@@ -390,6 +391,28 @@ void MainWindow::buildMenus() {
   follow->setShortcutContext(Qt::WidgetWithChildrenShortcut);
   scene_->addAction(follow);
   connect(follow, &QAction::toggled, scene_, &SceneView::setFollow);
+  // Camera presets beside follow (issue 59): chase behind the robot, top
+  // down, free; the follow action shows whether the camera follows.
+  QMenu* cameras = view->addMenu(tr("&Camera"));
+  auto* group = new QActionGroup(this);
+  const std::pair<QString, SceneView::Camera> presets[] = {{tr("&Follow"), SceneView::Camera::Follow},
+                                                           {tr("&Chase (behind the robot)"), SceneView::Camera::Chase},
+                                                           {tr("&Top (from above)"), SceneView::Camera::Top},
+                                                           {tr("F&ree"), SceneView::Camera::Free}};
+  for (const auto& [name, preset] : presets) {
+    QAction* a = cameras->addAction(name);
+    a->setCheckable(true);
+    a->setChecked(preset == scene_->camera());
+    a->setObjectName(QStringLiteral("camera%1").arg(static_cast<int>(preset)));
+    group->addAction(a);
+    connect(a, &QAction::triggered, scene_, [this, p = preset] { scene_->setCamera(p); });
+  }
+  connect(scene_, &SceneView::cameraChanged, this, [follow, cameras](SceneView::Camera c) {
+    const QSignalBlocker block(follow);
+    follow->setChecked(c != SceneView::Camera::Free);
+    for (QAction* a : cameras->actions())
+      a->setChecked(a->objectName() == QStringLiteral("camera%1").arg(static_cast<int>(c)));
+  });
   QAction* reset = view->addAction(tr("&Reset view"), scene_, &SceneView::resetView);
   reset->setShortcut(QKeySequence(Qt::Key_Home));
   QAction* beams = view->addAction(tr("Laser &beams"));

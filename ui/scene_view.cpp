@@ -484,6 +484,8 @@ struct SceneView::Impl {
   osg::Vec3d centre;
   double azimuth = kDefaultAzimuth, elevation = kDefaultElevation, distance = kDefaultDistance;
   bool follow = true;
+  SceneView::Camera preset = SceneView::Camera::Follow;
+  osg::Vec3d eye;  // of the last frame
   Qt::MouseButton dragButton = Qt::NoButton;
   QPointF lastMouse;  // device pixels
   double dpr = 1.0;
@@ -808,10 +810,13 @@ void SceneView::Impl::sync() {
   }
   laserNode->setNodeMask(laserVisible ? ~0u : 0u);
   if (follow && hasRobot) centre = toOsgD(base.p);
-  const osg::Vec3d eye =
-      centre + osg::Vec3d(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
-                          std::sin(elevation)) *
-                   distance;
+  // Chase and top turn with the robot: the eye behind it (azimuth is where
+  // the eye is seen from the centre).
+  if (hasRobot && (preset == SceneView::Camera::Chase || preset == SceneView::Camera::Top))
+    azimuth = heading(base.q) + kPi;
+  eye = centre + osg::Vec3d(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                            std::sin(elevation)) *
+                     distance;
   viewer->getCamera()->setViewMatrixAsLookAt(eye, centre, osg::Vec3d(0, 0, 1));
   // Fog starts behind what the camera looks at, whatever the zoom.
   fog->setStart(f(distance + 15));
@@ -819,8 +824,8 @@ void SceneView::Impl::sync() {
 }
 
 void SceneView::Impl::updateHud() {
-  hud->setText(QStringLiteral("%1 fps · %2").arg(fps, 0, 'f', 0).arg(follow ? QStringLiteral("follow")
-                                                                          : QStringLiteral("free camera")));
+  const char* names[] = {"follow", "chase", "top", "free camera"};
+  hud->setText(QStringLiteral("%1 fps · %2").arg(fps, 0, 'f', 0).arg(QLatin1String(names[static_cast<int>(preset)])));
   hud->adjustSize();
 }
 
@@ -1024,11 +1029,32 @@ bool SceneView::stale() const { return m_->stale; }
 bool SceneView::laserVisible() const { return m_->laserVisible; }
 
 void SceneView::setFollow(bool on) {
-  m_->follow = on;
-  m_->updateHud();
+  if (on == m_->follow && (on || m_->preset == Camera::Free)) return;
+  setCamera(on ? Camera::Follow : Camera::Free);
 }
 
 bool SceneView::follow() const { return m_->follow; }
+
+void SceneView::setCamera(Camera camera) {
+  Impl& m = *m_;
+  const Camera was = m.preset;
+  m.preset = camera;
+  m.follow = camera != Camera::Free;
+  if (camera == Camera::Chase) {
+    m.elevation = degToRad(15);
+    m.distance = 6;
+  } else if (camera == Camera::Top) {
+    m.elevation = kMaxElevation;
+    m.distance = 18;
+  }
+  m.updateHud();
+  update();
+  if (was != camera) emit cameraChanged(camera);
+}
+
+SceneView::Camera SceneView::camera() const { return m_->preset; }
+
+Vec3 SceneView::cameraEye() const { return {m_->eye.x(), m_->eye.y(), m_->eye.z()}; }
 
 void SceneView::resetView() {
   m_->azimuth = kDefaultAzimuth;
@@ -1119,6 +1145,7 @@ void SceneView::mouseMoveEvent(QMouseEvent* event) {
   const QPointF d = p - m.lastMouse;
   m.lastMouse = p;
   if (m.dragButton == Qt::LeftButton) {
+    if (m.preset == Camera::Chase || m.preset == Camera::Top) setCamera(Camera::Follow);
     m.azimuth -= d.x() * kOrbitRadPerPixel;
     m.elevation = std::clamp(m.elevation + d.y() * kOrbitRadPerPixel, kMinElevation, kMaxElevation);
   } else if (m.dragButton == Qt::RightButton || m.dragButton == Qt::MiddleButton) {

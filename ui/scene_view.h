@@ -127,6 +127,16 @@ class SceneView : public QOpenGLWidget {
   /// Follow mode keeps the orbit centre on the robot base (default on).
   void setFollow(bool on);
   bool follow() const;
+  /// Where the camera goes. Follow: the orbit centre on the base, the angles
+  /// the operator's. Chase: behind the robot, turning as it turns, 6 m off
+  /// and 15° up. Top: straight down from 18 m, the robot's forward up the
+  /// screen. Free: the camera stays where it is put. Orbiting (left drag)
+  /// a chase or top camera makes it a follow one; panning, a free one.
+  enum class Camera { Follow, Chase, Top, Free };
+  void setCamera(Camera camera);
+  Camera camera() const;
+  /// The eye of the last frame drawn (world frame).
+  Vec3 cameraEye() const;
   /// Default camera angles and distance, centred on the robot base (the
   /// origin without a robot). Follow mode is left as it is.
   void resetView();
@@ -184,6 +194,8 @@ class SceneView : public QOpenGLWidget {
   void terrainHover(const sp::Vec3& ground);
   void terrainStrokeEnded();
   void groundPicked(const sp::Vec3& ground);
+  /// The camera changed preset (the operator dragged, or setCamera()).
+  void cameraChanged(sp::SceneView::Camera camera);
 
  private:
   struct Impl;

@@ -93,7 +93,9 @@ class TestCalibrationDock : public QObject {
     QVERIFY(std::abs(s.applied[0] - 1.012) < 0.015);  // the hidden mean is 1.012
     QVERIFY(std::abs(s.applied[static_cast<size_t>(CalParam::MotorGain)] - 1.0605) < 0.02);  // hidden 1.0605
     QVERIFY(!s.observed[static_cast<size_t>(CalParam::Friction)]);
-    QCOMPARE(panel->table()->item(0, 1)->text(), QString::number(s.applied[0], 'f', 4));
+    // Factors say they are (issue 59: bare numbers), splits as percentages.
+    QCOMPARE(panel->table()->item(0, 1)->text(), QString::number(s.applied[0], 'f', 4) + QStringLiteral(" ×"));
+    QVERIFY(panel->table()->item(static_cast<int>(CalParam::WheelRadiusSplit), 1)->text().endsWith(QLatin1String(" %")));
     QCOMPARE(panel->table()->item(static_cast<int>(CalParam::Friction), 2)->text(), QStringLiteral("unobserved"));
     // The centre of mass in millimetres (the files' column: none moved).
     QCOMPARE(panel->table()->item(static_cast<int>(CalParam::ComX), 3)->text(), QStringLiteral("0.0 mm"));
@@ -111,7 +113,15 @@ class TestCalibrationDock : public QObject {
     QCOMPARE(w.context().session().twinParams().calWheelRadius, s.applied[0]);
     // The rehearsals get the full-physics values, and the panel shows them.
     QTRY_VERIFY(calValues(w.context().session().twinParams()) == calibrator->fullPhysics());  // two calls: a fit may land between
-    QCOMPARE(panel->table()->item(0, 4)->text(), QString::number(s.fullPhysics[0], 'f', 4));
+    QCOMPARE(panel->table()->item(0, 4)->text(), QString::number(s.fullPhysics[0], 'f', 4) + QStringLiteral(" ×"));
+    // Every value shows whole in its column, units and all.
+    for (int row = 0; row < kCalParams; ++row)
+      for (int column = 1; column < table->columnCount(); ++column)
+        if (const QTableWidgetItem* item = table->item(row, column)) {
+          const int room = table->columnWidth(column) - 6;
+          QVERIFY2(QFontMetrics(table->font()).horizontalAdvance(item->text()) <= room,
+                   qPrintable(QStringLiteral("row %1, column %2: '%3' in %4 px").arg(row).arg(column).arg(item->text()).arg(room)));
+        }
     for (CalParam q : kFullPhysicsChecked) {
       const size_t i = static_cast<size_t>(q);
       qInfo("%s: applied %.4f, rehearsals %.4f (%s)", calParams()[i].key, s.applied[i], s.fullPhysics[i],

@@ -412,6 +412,40 @@ class TstSceneView : public QObject {
     QVERIFY(fixedChanged > 2 * followChanged + 1000);
   }
 
+  // Camera presets (issue 59): chase puts the eye behind the robot and
+  // turns with it; top looks straight down from above it; free stays put
+  // when the robot moves (the control: follow would have moved with it).
+  void cameraPresets() {
+    auto view = shownView(flat_);
+    QVERIFY(view);
+    const sp::Pose base = flat_.robots[0].pose * flat_.robots[0].model.links[0].pose;
+    const std::vector<double> joints(flat_.robots[0].model.joints.size(), 0.0);
+    sp::Pose turned = base;
+    turned.q = sp::quatFromAxisAngle({0, 0, 1}, sp::kPi / 2) * base.q;  // facing +y
+    view->setRobotState(turned, joints);
+    view->setCamera(sp::SceneView::Camera::Chase);
+    QVERIFY(waitFrames(*view, 2));
+    sp::Vec3 eye = view->cameraEye();
+    QVERIFY2(eye.y < turned.p.y - 4 && std::abs(eye.x - turned.p.x) < 0.5,
+             qPrintable(QStringLiteral("chase eye %1, %2").arg(eye.x).arg(eye.y)));
+    view->setCamera(sp::SceneView::Camera::Top);
+    QVERIFY(waitFrames(*view, 2));
+    eye = view->cameraEye();
+    QVERIFY(eye.z > turned.p.z + 15 && std::hypot(eye.x - turned.p.x, eye.y - turned.p.y) < 1);
+    view->setCamera(sp::SceneView::Camera::Free);
+    QVERIFY(!view->follow());
+    const sp::Vec3 before = view->cameraEye();
+    sp::Pose moved = turned;
+    moved.p.x += 5;
+    view->setRobotState(moved, joints);
+    QVERIFY(waitFrames(*view, 2));
+    QCOMPARE(view->cameraEye().x, before.x);
+    view->setCamera(sp::SceneView::Camera::Follow);
+    QVERIFY(waitFrames(*view, 2));
+    QVERIFY(std::abs(view->cameraEye().x - before.x - 5) < 1e-6);
+    view->resetView();
+  }
+
   // A scan draws beams and hit points; hiding the laser restores the image,
   // and so does an empty scan.
   void laserChangesImage() {

@@ -33,7 +33,14 @@ std::pair<double, QString> display(size_t param) {
 
 QString shown(size_t param, double v) {
   const auto [k, unit] = display(param);
-  if (unit.isEmpty()) return QString::number(v, 'f', 4);
+  // A factor says it is one (issue 59: bare numbers read as metres); a
+  // split is the front (left, diagonal) wheels' factor over the others'.
+  if (unit.isEmpty()) {
+    const bool split = param == static_cast<size_t>(CalParam::WheelRadiusSplit) ||
+                       param == static_cast<size_t>(CalParam::WheelRadiusSide) ||
+                       param == static_cast<size_t>(CalParam::WheelRadiusDiag);
+    return split ? QString::asprintf("%+.2f %%", v * 100) : QString::number(v, 'f', 4) + QStringLiteral(" ×");
+  }
   return QString::number(v * k, 'f', 1) + " " + unit;
 }
 
@@ -138,6 +145,9 @@ CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(k
   status_ = new QLabel(this);
   status_->setWordWrap(true);
   layout->addWidget(status_);
+  // The button says what it is in (issue 59: a pressed Freeze looked as any other).
+  connect(freeze_, &QPushButton::toggled, this,
+          [this](bool on) { freeze_->setText(on ? tr("Frozen: unfreeze") : tr("Freeze")); });
   connect(freeze_, &QPushButton::toggled, this, &CalibrationPanel::freezeToggled);
   connect(reset_, &QPushButton::clicked, this, &CalibrationPanel::resetRequested);
   connect(save_, &QPushButton::clicked, this, &CalibrationPanel::saveRequested);
@@ -146,7 +156,9 @@ CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(k
 void CalibrationPanel::showRow(int row, double value, double sigma, bool observed, const QString& status) {
   const size_t p = static_cast<size_t>(row);
   auto* v = new QTableWidgetItem(shown(p, value));
-  auto* s = new QTableWidgetItem(observed ? shown(p, sigma) : status);
+  QString deviation = shown(p, sigma);
+  if (deviation.startsWith(QLatin1Char('+'))) deviation.remove(0, 1);  // a deviation has no sign
+  auto* s = new QTableWidgetItem(observed ? deviation : status);
   if (!observed) {
     v->setForeground(palette().color(QPalette::Disabled, QPalette::Text));
     s->setForeground(palette().color(QPalette::Disabled, QPalette::Text));
