@@ -442,6 +442,7 @@ struct SceneView::Impl {
   TerrainSpec terrain;
   TerrainMesh mesh;
   osg::ref_ptr<osg::Node> gridLines;
+  osg::ref_ptr<osg::MatrixTransform> planeFollow;  // a plane's ground and grid, following the robot (null on a heightfield)
   // Terrain editing: the mode, a stroke under way, a pick asked for, the
   // brush's footprint (a ring draped on the ground under the cursor).
   bool editing = false, painting = false, picking = false;
@@ -810,6 +811,10 @@ void SceneView::Impl::sync() {
   }
   laserNode->setNodeMask(laserVisible ? ~0u : 0u);
   if (follow && hasRobot) centre = toOsgD(base.p);
+  if (planeFollow && hasRobot) {
+    const double x = 5 * std::round(base.p.x / 5), y = 5 * std::round(base.p.y / 5);
+    planeFollow->setMatrix(osg::Matrix::translate(x, y, 0));
+  }
   // Chase and top turn with the robot: the eye behind it (azimuth is where
   // the eye is seen from the centre).
   if (hasRobot && (preset == SceneView::Camera::Chase || preset == SceneView::Camera::Top))
@@ -881,9 +886,21 @@ void SceneView::setWorld(const WorldModel& world) {
   matte->setSpecular(osg::Material::FRONT_AND_BACK, {0, 0, 0, 1});
   terrain->getOrCreateStateSet()->setAttributeAndModes(matte);
   terrain->getOrCreateStateSet()->setAttributeAndModes(new osg::PolygonOffset(1.0f, 1.0f));
-  m.worldNode->addChild(terrain);
   m.gridLines = gridNode(t);
-  m.worldNode->addChild(m.gridLines);
+  if (t.kind == TerrainSpec::Kind::Plane) {
+    // An endless plane is drawn (ground and grid) around the robot, moved
+    // with it in whole 5 m steps so the lines stay on the world's metres:
+    // 200 m around the origin ended where a long drive went (issue 59).
+    m.planeFollow = new osg::MatrixTransform;
+    m.planeFollow->setDataVariance(osg::Object::DYNAMIC);
+    m.planeFollow->addChild(terrain);
+    m.planeFollow->addChild(m.gridLines);
+    m.worldNode->addChild(m.planeFollow);
+  } else {
+    m.planeFollow = nullptr;
+    m.worldNode->addChild(terrain);
+    m.worldNode->addChild(m.gridLines);
+  }
   m.footprintDirty = true;
   m.worldNode->addChild(axesNode(groundHeight(t, 0, 0)));
   // Objects start where the file puts them; dynamic ones move with setObjectPoses.

@@ -412,6 +412,30 @@ class TstSceneView : public QObject {
     QVERIFY(fixedChanged > 2 * followChanged + 1000);
   }
 
+  // The ground and its grid go wherever the robot goes on an endless plane
+  // (issue 59: drawn 200 m around the origin only): 1 km out, the view
+  // following the robot looks as it does at the start (the world axes at
+  // the origin are out of sight).
+  void groundEverywhere() {
+    auto view = shownView(flat_);
+    QVERIFY(view);
+    QVERIFY(view->follow());
+    const sp::Pose base = flat_.robots[0].pose * flat_.robots[0].model.links[0].pose;
+    const std::vector<double> joints(flat_.robots[0].model.joints.size(), 0.0);
+    sp::Pose away = base;
+    away.p.x += 20;  // past the axes, so that both images lack them
+    view->setRobotState(away, joints);
+    QVERIFY(waitFrames(*view, 2));
+    const QImage near = frame(*view);
+    away.p.x += 1000;
+    view->setRobotState(away, joints);
+    QVERIFY(waitFrames(*view, 2));
+    const int changed = countDiffering(near, frame(*view), near.rect());
+    qInfo("pixels changed between 20 m and 1020 m out: %d of %lld", changed,
+          static_cast<long long>(near.width()) * near.height());
+    QVERIFY(changed < near.width() * near.height() / 50);
+  }
+
   // Camera presets (issue 59): chase puts the eye behind the robot and
   // turns with it; top looks straight down from above it; free stays put
   // when the robot moves (the control: follow would have moved with it).
