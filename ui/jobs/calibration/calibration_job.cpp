@@ -35,7 +35,14 @@ void CalibrationJob::install(ConsoleContext& context) {
                                                       tr("Parameters (*.params);;Robot file (*.xml)"), &filter);
     if (path.isEmpty()) return;
     const QString error = save(path);
-    if (error.isEmpty()) context_->status(tr("Calibration saved to %1").arg(path));
+    // After a reset the file holds the files' own values: said so, not as
+    // if it held a calibration (issue 59).
+    const LiveCalibrator* c = context_->session().calibrator();
+    const bool filesOnly = c && c->fullPhysics() == filesCalValues();
+    if (error.isEmpty() && filesOnly)
+      context_->status(tr("Saved to %1: it holds the robot files' own values (nothing is calibrated since the reset)").arg(path));
+    else if (error.isEmpty())
+      context_->status(tr("Calibration saved to %1").arg(path));
     else context_->showError(tr("Save the calibration"), error);
   });
   connect(&context, &ConsoleContext::panelTick, this, &CalibrationJob::refresh);
