@@ -94,8 +94,8 @@ class TestCalibrationDock : public QObject {
     QVERIFY(std::abs(s.applied[static_cast<size_t>(CalParam::MotorGain)] - 1.0605) < 0.02);  // hidden 1.0605
     QVERIFY(!s.observed[static_cast<size_t>(CalParam::Friction)]);
     // Factors say they are (issue 59: bare numbers), splits as percentages.
-    QCOMPARE(panel->table()->item(0, 1)->text(), QString::number(s.applied[0], 'f', 4) + QStringLiteral(" ×"));
-    QVERIFY(panel->table()->item(static_cast<int>(CalParam::WheelRadiusSplit), 1)->text().endsWith(QLatin1String(" %")));
+    QCOMPARE(panel->table()->item(0, 1)->text(), QString::number(s.applied[0], 'f', 4) + QStringLiteral("×"));
+    QVERIFY(panel->table()->item(static_cast<int>(CalParam::WheelRadiusSplit), 1)->text().endsWith(QLatin1String("%")));
     QCOMPARE(panel->table()->item(static_cast<int>(CalParam::Friction), 2)->text(), QStringLiteral("unobserved"));
     // The centre of mass in millimetres (the files' column: none moved).
     QCOMPARE(panel->table()->item(static_cast<int>(CalParam::ComX), 3)->text(), QStringLiteral("0.0 mm"));
@@ -113,7 +113,7 @@ class TestCalibrationDock : public QObject {
     QCOMPARE(w.context().session().twinParams().calWheelRadius, s.applied[0]);
     // The rehearsals get the full-physics values, and the panel shows them.
     QTRY_VERIFY(calValues(w.context().session().twinParams()) == calibrator->fullPhysics());  // two calls: a fit may land between
-    QCOMPARE(panel->table()->item(0, 4)->text(), QString::number(s.fullPhysics[0], 'f', 4) + QStringLiteral(" ×"));
+    QCOMPARE(panel->table()->item(0, 4)->text(), QString::number(s.fullPhysics[0], 'f', 4) + QStringLiteral("×"));
     // Every value shows whole in its column, units and all.
     for (int row = 0; row < kCalParams; ++row)
       for (int column = 1; column < table->columnCount(); ++column)
@@ -160,10 +160,15 @@ class TestCalibrationDock : public QObject {
     panel->freezeButton()->click();
     QVERIFY(!calibrator->state().frozen);
 
-    // Reset: the files' values, at once.
+    // Reset: the files' values, at once; saved now, the file is said to
+    // hold the files' own values (issue 59), a calibration before (the control).
+    QString saveError;
+    QVERIFY(job->saveAndSay(saved, saveError).startsWith(QLatin1String("Calibration saved to")));
     panel->resetButton()->click();
     QVERIFY(calibrator->state().applied == filesCalValues());
     QCOMPARE(w.context().session().twinParams().calWheelRadius, 1.0);
+    const QString said = job->saveAndSay(saved, saveError);
+    QVERIFY2(saveError.isEmpty() && said.contains(QLatin1String("the robot files' own values")), qPrintable(said + saveError));
 
     // The session log holds the fits: one row per parameter per fit. The
     // session takes them on telemetry frames (50 a second): let a few come

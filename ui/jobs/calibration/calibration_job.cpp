@@ -34,19 +34,24 @@ void CalibrationJob::install(ConsoleContext& context) {
     const QString path = QFileDialog::getSaveFileName(panel_, tr("Save the calibration"), QStringLiteral("calibrated.params"),
                                                       tr("Parameters (*.params);;Robot file (*.xml)"), &filter);
     if (path.isEmpty()) return;
-    const QString error = save(path);
-    // After a reset the file holds the files' own values: said so, not as
-    // if it held a calibration (issue 59).
-    const LiveCalibrator* c = context_->session().calibrator();
-    const bool filesOnly = c && c->fullPhysics() == filesCalValues();
-    if (error.isEmpty() && filesOnly)
-      context_->status(tr("Saved to %1: it holds the robot files' own values (nothing is calibrated since the reset)").arg(path));
-    else if (error.isEmpty())
-      context_->status(tr("Calibration saved to %1").arg(path));
+    QString error;
+    const QString said = saveAndSay(path, error);
+    if (error.isEmpty()) context_->status(said);
     else context_->showError(tr("Save the calibration"), error);
   });
   connect(&context, &ConsoleContext::panelTick, this, &CalibrationJob::refresh);
   connect(&context, &ConsoleContext::stateChanged, this, &CalibrationJob::refresh);
+}
+
+QString CalibrationJob::saveAndSay(const QString& path, QString& error) const {
+  error = save(path);
+  if (!error.isEmpty()) return {};
+  // After a reset the file holds the files' own values: said so, not as if
+  // it held a calibration (issue 59).
+  const LiveCalibrator* c = context_->session().calibrator();
+  if (c && c->fullPhysics() == filesCalValues())
+    return tr("Saved to %1: it holds the robot files' own values (nothing is calibrated since the reset)").arg(path);
+  return tr("Calibration saved to %1").arg(path);
 }
 
 QString CalibrationJob::save(const QString& path) const {

@@ -26,6 +26,10 @@ class CalibrationJob : public ConsoleJob {
   CalibrationPanel* panel() const { return panel_; }
   /// Writes the values the twins use now as a parameters file: "" or why not.
   QString save(const QString& path) const;
+  /// save(), then what the status bar says of it: where, and whether the
+  /// file holds a calibration or (after a reset) the files' own values.
+  /// Empty `error` on success; else it is why not.
+  QString saveAndSay(const QString& path, QString& error) const;
 
  private:
   void refresh();

@@ -31,15 +31,18 @@ std::pair<double, QString> display(size_t param) {
   return {1, QString()};
 }
 
-QString shown(size_t param, double v) {
+// A value as a cell shows it. A factor says it is one (issue 59: bare
+// numbers read as metres), a split (the front, left or diagonal wheels'
+// radius over the others') in per cent. `compact` for the files' column,
+// whose factors are 1 and splits 0: the parameters' names keep the room.
+QString shown(size_t param, double v, bool compact = false) {
   const auto [k, unit] = display(param);
-  // A factor says it is one (issue 59: bare numbers read as metres); a
-  // split is the front (left, diagonal) wheels' factor over the others'.
   if (unit.isEmpty()) {
     const bool split = param == static_cast<size_t>(CalParam::WheelRadiusSplit) ||
                        param == static_cast<size_t>(CalParam::WheelRadiusSide) ||
                        param == static_cast<size_t>(CalParam::WheelRadiusDiag);
-    return split ? QString::asprintf("%+.2f %%", v * 100) : QString::number(v, 'f', 4) + QStringLiteral(" ×");
+    if (split) return compact ? QString::number(v * 100, 'g', 3) + QStringLiteral("%") : QString::asprintf("%+.2f%%", v * 100);
+    return (compact ? QString::number(v, 'g', 4) : QString::number(v, 'f', 4)) + QStringLiteral("×");
   }
   return QString::number(v * k, 'f', 1) + " " + unit;
 }
@@ -92,7 +95,7 @@ CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(k
     auto* name = new QTableWidgetItem(brief(static_cast<CalParam>(i)));
     name->setToolTip(tr("%1 (%2)").arg(tr(p.label), QString::fromUtf8(p.key)));
     table_->setItem(i, 0, name);
-    table_->setItem(i, 3, new QTableWidgetItem(shown(static_cast<size_t>(i), p.files)));
+    table_->setItem(i, 3, new QTableWidgetItem(shown(static_cast<size_t>(i), p.files, true)));
     showRow(i, p.files, 0, false, tr("files"));
     table_->setItem(i, 4, new QTableWidgetItem(shown(static_cast<size_t>(i), p.files)));
   }
@@ -156,8 +159,10 @@ CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(k
 void CalibrationPanel::showRow(int row, double value, double sigma, bool observed, const QString& status) {
   const size_t p = static_cast<size_t>(row);
   auto* v = new QTableWidgetItem(shown(p, value));
+  // A deviation has no sign, and is in the value's unit (the header says ±).
   QString deviation = shown(p, sigma);
-  if (deviation.startsWith(QLatin1Char('+'))) deviation.remove(0, 1);  // a deviation has no sign
+  if (deviation.startsWith(QLatin1Char('+'))) deviation.remove(0, 1);
+  if (deviation.endsWith(QStringLiteral("×"))) deviation.chop(1);
   auto* s = new QTableWidgetItem(observed ? deviation : status);
   if (!observed) {
     v->setForeground(palette().color(QPalette::Disabled, QPalette::Text));
