@@ -579,6 +579,11 @@ class RobotClient::Impl {
         kMinKeepalive, m.deadman > 0 ? std::min(config_.keepaliveInterval, m.deadman / 4) : config_.keepaliveInterval);
     const double t = now();
     telemetryBucket_.reset(1.5 * m.telemetryRate + 1, std::max(10.0, m.telemetryRate), t);
+    // Per connection, not per frame: a flood sheds thousands a second.
+    announcedRate_ = m.telemetryRate;
+    telemetryShedDetail_ = "frames beyond " + std::to_string(static_cast<int>(telemetryBucket_.rate)) +
+                           " a second (WELCOME said " + std::to_string(static_cast<int>(m.telemetryRate)) +
+                           " Hz) are shed, the newest kept";
     // Laser scans come at most as fast as telemetry on any robot we know.
     laserBucket_.reset(1.5 * m.telemetryRate + 1, std::max(10.0, m.telemetryRate), t);
     eventBucket_.reset(config_.eventRate, std::max(1.0, config_.eventRate), t);
@@ -621,17 +626,13 @@ class RobotClient::Impl {
       if (cb_.refusedTelemetry) cb_.refusedTelemetry(r);
       return refuse(r);
     }
-    if (!telemetryBucket_.take(t))
-      return shed("telemetry beyond the announced rate",
-                  "frames beyond " + std::to_string(static_cast<int>(telemetryBucket_.rate)) +
-                      " a second (WELCOME said " + std::to_string(static_cast<int>(stats().telemetryRateAnnounced)) +
-                      " Hz) are shed, the newest kept");
+    if (!telemetryBucket_.take(t)) return shed("telemetry beyond the announced rate", telemetryShedDetail_);
     checkLink(m.time);
     uint64_t lost = 0;
     if (haveTelemetrySeq_ && m.seq > lastTelemetrySeq_ + 1) {
       // More missing than the robot could have sent since the last frame
       // (three times its announced rate, and some) is a renumbering, not loss.
-      const double possible = 3 * stats().telemetryRateAnnounced * (t - lastSeqAt_) + 100;
+      const double possible = 3 * announcedRate_ * (t - lastSeqAt_) + 100;
       const uint64_t gap = m.seq - lastTelemetrySeq_ - 1;
       if (static_cast<double>(gap) <= possible) {
         lost = gap;
@@ -713,8 +714,7 @@ class RobotClient::Impl {
   void handle(const EventMsg& m) {
     if (!ready_) return refuseBeforeWelcome(MessageType::Event);
     if (!eventBucket_.take(now()))
-      return shed("events beyond " + std::to_string(static_cast<int>(config_.eventRate)) + " a second",
-                  "the robot's EVENTs beyond that are counted, not shown");
+      return shed(eventShedKind_, "the robot's EVENTs beyond that are counted, not shown");
     if (cb_.event) cb_.event(m);
   }
 
@@ -722,8 +722,7 @@ class RobotClient::Impl {
     // Before WELCOME an ERROR means the HELLO was refused; the robot closes.
     if (!ready_) errorBeforeWelcome_ = m.reason.empty() ? "refused" : m.reason;
     else if (!eventBucket_.take(now()))
-      return shed("robot ERRORs beyond " + std::to_string(static_cast<int>(config_.eventRate)) + " a second",
-                  "counted, not shown");
+      return shed(errorShedKind_, "counted, not shown");
     updateStats([&](RobotClientStats& s) { s.lastError = m.reason; });
     if (cb_.error) cb_.error(m);
   }
@@ -826,6 +825,11 @@ class RobotClient::Impl {
   TelemetryCheck check_;
   RefusalTally tally_;
   TokenBucket telemetryBucket_, laserBucket_, eventBucket_, errorReplies_, echoBucket_;
+  double announcedRate_ = 50;        // [Hz] this connection's WELCOME telemetry_rate
+  std::string telemetryShedDetail_;  // what a shed frame is said to be (made at WELCOME)
+  // The kinds the event and ERROR floods are counted under, made once.
+  const std::string eventShedKind_ = "events beyond " + std::to_string(static_cast<int>(config_.eventRate)) + " a second";
+  const std::string errorShedKind_ = "robot ERRORs beyond " + std::to_string(static_cast<int>(config_.eventRate)) + " a second";
   double rateWindowStart_ = 0;
   uint64_t rateWindowCount_ = 0;
   double readyAt_ = 0, minOffset_ = INFINITY, maxOffset_ = -INFINITY;  // [s] the link check (checkLink)

@@ -2,6 +2,7 @@
 
 #include <QMainWindow>
 #include <QMessageBox>
+#include <QPushButton>
 
 #include "app/console/console_session.h"
 #include "ui/robot_connection.h"
@@ -38,6 +39,16 @@ void ConsoleContext::emergencyStop() {
 
 void ConsoleContext::logEvent(const QString& kind, const QString& text) const {
   session().logEvent(kind.toStdString(), text.toStdString());
+}
+
+bool ConsoleContext::confirm(QMessageBox::Icon icon, const QString& title, const QString& text,
+                             const QString& objectName, const QString& yes, QMessageBox::ButtonRole role) const {
+  QMessageBox box(icon, title, text, QMessageBox::NoButton, parts_.window);
+  box.setObjectName(objectName);
+  QPushButton* accept = box.addButton(yes, role);
+  box.setDefaultButton(box.addButton(tr("Cancel"), QMessageBox::RejectRole));
+  box.exec();
+  return box.clickedButton() == accept;
 }
 
 void ConsoleContext::showError(const QString& title, const QString& text) const {

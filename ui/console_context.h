@@ -15,6 +15,7 @@
 // Thread: GUI thread only, as every job.
 
 #include <QMainWindow>
+#include <QMessageBox>
 #include <QObject>
 #include <QString>
 
@@ -132,6 +133,11 @@ class ConsoleContext : public QObject {
   void logEvent(const QString& kind, const QString& text) const;
   /// Shows `text` (errors with file:line) under `title` in a dialog.
   void showError(const QString& title, const QString& text) const;
+  /// Asks the operator before something that cannot be taken back: a modal
+  /// box named `objectName` (tests find it) whose default is Cancel, so no
+  /// stray Enter or Space says yes. True when `yes` was clicked.
+  bool confirm(QMessageBox::Icon icon, const QString& title, const QString& text, const QString& objectName,
+               const QString& yes, QMessageBox::ButtonRole role = QMessageBox::AcceptRole) const;
 
  public slots:
   /// Sends the e-stop to the live robot (whatever the views show) before

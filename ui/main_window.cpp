@@ -654,17 +654,12 @@ void MainWindow::requestQuit() {
   // Holding control of a moving robot, a quit would leave it to the
   // deadman: the operator chooses (issue 59: Ctrl+Q quit at once).
   if (state().leaseHeld() && !state().latched() && robotSpeed() > 0.05) {
-    QMessageBox box(QMessageBox::Warning, tr("Quit"),
-                    tr("You hold control of a robot moving at %1 m/s.\n\nQuitting now leaves it to its deadman, "
-                       "which stops it once the keep-alives stop.")
-                        .arg(robotSpeed(), 0, 'f', 2),
-                    QMessageBox::NoButton, this);
-    box.setObjectName(QStringLiteral("quitConfirm"));
-    QPushButton* stopAndQuit = box.addButton(tr("Stop the robot and quit"), QMessageBox::AcceptRole);
-    QPushButton* cancel = box.addButton(tr("Cancel"), QMessageBox::RejectRole);
-    box.setDefaultButton(cancel);
-    box.exec();
-    if (box.clickedButton() != stopAndQuit) return;
+    if (!context_->confirm(QMessageBox::Warning, tr("Quit"),
+                           tr("You hold control of a robot moving at %1 m/s.\n\nQuitting now leaves it to its "
+                              "deadman, which stops it once the keep-alives stop.")
+                               .arg(robotSpeed(), 0, 'f', 2),
+                           QStringLiteral("quitConfirm"), tr("Stop the robot and quit")))
+      return;
     context_->sendCommand(StopCmd{});
   }
   close();

@@ -116,17 +116,13 @@ void LinkJob::resetRobot() {
   // The stand-in restarts on the world file's terrain: edits not saved
   // would go without a word (issue 59). Asked first, Cancel the default.
   if (const TerrainEditor* t = context_->session().terrainEditor(); t && t->unsavedChanges() > 0) {
-    QMessageBox box(QMessageBox::Warning, tr("Reset to the start"),
-                    tr("The terrain has %n edit(s) not saved. Reset restarts the robot on the world file's terrain: "
-                       "they would be lost.\n\nSave them first with Terrain ▸ Save as…, or reset without them.",
-                       nullptr, static_cast<int>(t->unsavedChanges())),
-                    QMessageBox::NoButton, context_->window());
-    box.setObjectName(QStringLiteral("resetConfirm"));
-    QPushButton* discard = box.addButton(tr("Reset, losing the edits"), QMessageBox::DestructiveRole);
-    QPushButton* cancel = box.addButton(tr("Cancel"), QMessageBox::RejectRole);
-    box.setDefaultButton(cancel);
-    box.exec();
-    if (box.clickedButton() != discard) return;
+    if (!context_->confirm(QMessageBox::Warning, tr("Reset to the start"),
+                           tr("The terrain has %n edit(s) not saved. Reset restarts the robot on the world file's "
+                              "terrain: they would be lost.\n\nSave them first with Terrain ▸ Save as…, or reset "
+                              "without them.",
+                              nullptr, static_cast<int>(t->unsavedChanges())),
+                           QStringLiteral("resetConfirm"), tr("Reset, losing the edits"), QMessageBox::DestructiveRole))
+      return;
   }
   context_->connection().close();
   if (const std::string error = context_->session().resetRobot(); !error.empty()) {
@@ -139,18 +135,13 @@ void LinkJob::resetRobot() {
 }
 
 void LinkJob::rearm() {
-  // Deliberate: a confirmation whose default is No, so that no stray Enter
-  // or Space re-arms a stopped robot.
-  QMessageBox box(QMessageBox::Question, tr("Re-arm"),
-                  tr("Re-arm the robot?\n\nThe latch clears; the robot stays stopped until the next command, "
-                     "and the deadman counts from now."),
-                  QMessageBox::NoButton, context_->window());
-  box.setObjectName(QStringLiteral("rearmConfirm"));
-  QPushButton* yes = box.addButton(tr("Re-arm"), QMessageBox::AcceptRole);
-  QPushButton* no = box.addButton(tr("Cancel"), QMessageBox::RejectRole);
-  box.setDefaultButton(no);
-  box.exec();
-  if (box.clickedButton() != yes) return;
+  // Deliberate: a confirmation whose default is Cancel, so that no stray
+  // Enter or Space re-arms a stopped robot.
+  if (!context_->confirm(QMessageBox::Question, tr("Re-arm"),
+                         tr("Re-arm the robot?\n\nThe latch clears; the robot stays stopped until the next command, "
+                            "and the deadman counts from now."),
+                         QStringLiteral("rearmConfirm"), tr("Re-arm")))
+    return;
   emit context_->robotStopped();
   context_->event(QStringLiteral("rearm"), tr("re-arm sent"));
   context_->connection().rearm();
