@@ -148,7 +148,8 @@ void LinkPanel::showStats(const net::RobotClientStats& s) {
   const double percent = total ? 100.0 * static_cast<double>(s.telemetryLost) / static_cast<double>(total) : 0.0;
   // What the checks refused or shed is the robot's doing, not the link's:
   // said beside the loss when there is any (protocol.md, "What a client refuses").
-  QString text = tr("%1 frames (%2 %), robot dropped %3, %4 reconnects")
+  // Short enough for the dock's width at 1280x800 (issue 59).
+  QString text = tr("%1 (%2 %), robot dropped %3, %4 reconnects")
                      .arg(s.telemetryLost)
                      .arg(percent, 0, 'f', 2)
                      .arg(s.robotDropped)

@@ -68,6 +68,7 @@ struct RunResult {
   GhostStats stats;
   size_t trail = 0;     // points of the last trail
   size_t maxTrail = 0;  // of the longest trail seen during the drive
+  double stopAt = 0;    // [s] robot time the ghost took the stop to arrive at
 };
 
 }  // namespace
@@ -78,8 +79,9 @@ class TestGhost : public QObject {
   // Drives the stand-in (world, `delay` each way) for three phases of
   // `phase` seconds: straight, left, right; every frame goes
   // through the session (which anchors the ghost) on this thread.
+  // `tail` [s]: how long it goes on after the stop has come back.
   RunResult drive(const std::string& world, double delay, bool inFlight, const QString& logDir = {}, double jitter = 0,
-                  bool arm = false) {
+                  bool arm = false, double tail = 0.5) {
     RunResult result;
     ConsoleSessionOptions o;
     o.world = std::string(SP_SOURCE_DIR) + "/" + world;
@@ -136,10 +138,11 @@ class TestGhost : public QObject {
     while (session.ghost()->viewVersion() == 0 && elapsed() < 10) takeTelemetry([](const TelemetryMsg&) {});
     size_t sent = 0;
     // Until the stop has come back in telemetry: a round trip after the last phase.
-    const double t0 = elapsed(), end = t0 + phase * 3 + 2 * delay + 0.5;
+    const double t0 = elapsed(), end = t0 + phase * 3 + 2 * delay + tail;
     while (elapsed() < end) {
       if (sent < phases.size() && elapsed() - t0 >= phase * static_cast<double>(sent)) {
         client.sendCommand(phases[sent], 0, session.robot());
+        if (std::holds_alternative<StopCmd>(phases[sent])) result.stopAt = session.ghost()->ghostTime(Ghost::now());
         session.commandSent(phases[sent]);
         if (arm && sent == 1) {
           client.sendCommand(armForward, 0, session.robot());
@@ -363,6 +366,43 @@ class TestGhost : public QObject {
     QCOMPARE(QString::fromStdString(why), error);
     params.ghostHold = "none";
     QVERIFY(Ghost::create(*world, params, why));
+  }
+
+  // Issue 59: "the ghost error spikes to ~25 cm at every stop with no delay
+  // at all". Criterion, stated before the runs: from the stop's arrival on,
+  // for 2 s, every frame is within 2 cm of what the ghost showed for its
+  // time. Control: a ghost that ignores the commands in flight over a 1 s
+  // each-way link drives on past the stop for a round trip and fails it.
+  void stopIsPredicted_data() {
+    QTest::addColumn<double>("delay");   // each way [s]
+    QTest::addColumn<bool>("inFlight");  // the ghost applies commands still in flight
+    QTest::addColumn<bool>("pass");
+    QTest::newRow("no delay") << 0.0 << true << true;
+    QTest::newRow("0.25 s each way") << 0.25 << true << true;
+    QTest::newRow("control: 1 s each way, commands in flight ignored") << 1.0 << false << false;
+  }
+
+  void stopIsPredicted() {
+    QFETCH(double, delay);
+    QFETCH(bool, inFlight);
+    QFETCH(bool, pass);
+    const RunResult r = drive("terrains/flat.world.xml", delay, inFlight, {}, 0, false, 2.0);
+    QVERIFY(r.stopAt > 0);
+    double worst = 0;
+    int frames = 0;
+    for (const GhostError& e : r.all)
+      if (e.time >= r.stopAt && e.time <= r.stopAt + 2) {
+        worst = std::max(worst, e.position);
+        ++frames;
+      }
+    qInfo("over the 2 s from the stop's arrival (robot time %.2f s): %d frames, the largest error %.1f mm", r.stopAt,
+          frames, worst * 1000);
+    // With no delay the ghost shows the robot's present, rarely a frame's
+    // future: about one frame in four has a shown state after it to be
+    // compared with (PredictionRecord::compare interpolates, it does not
+    // extrapolate).
+    QVERIFY2(frames >= (delay > 0 ? 80 : 10), qPrintable(QString::number(frames)));
+    QCOMPARE(worst <= 0.02, pass);
   }
 
   // The predictions go into the session's log, as the session saw them.

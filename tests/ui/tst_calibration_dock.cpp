@@ -22,6 +22,7 @@
 #include "app/log/session_log.h"
 #include "sim/model_loader.h"
 #include "tests/ui/console_fixture.h"
+#include "tests/ui/readable.h"
 #include "ui/jobs/calibration/calibration_job.h"
 #include "ui/jobs/calibration/calibration_panel.h"
 #include "ui/jobs/drive/control_panel.h"
@@ -60,6 +61,33 @@ class TestCalibrationDock : public QObject {
     QVERIFY(job);
     QVERIFY2(job->panel()->statusLabel()->text().startsWith(QLatin1String("Waiting for driving")),
              qPrintable(job->panel()->statusLabel()->text()));
+
+    // At 1280x800 the dock reads whole with the wait said, and with a fit
+    // refused for a value out of bounds (issue 59: the refusal was a raw key
+    // and a 16-digit number; the buttons fell out of view). The refusal is
+    // shown as the job shows a state, between two of its ticks.
+    CalibrationPanel* panel = job->panel();
+    auto* dock = w.findChild<QDockWidget*>(QStringLiteral("calibrationDock"));
+    QVERIFY(dock);
+    dock->show();
+    dock->raise();
+    QTest::qWait(300);  // laid out, a panel tick
+    QStringList bad = test::unreadable(panel);
+    QVERIFY2(bad.isEmpty(), qPrintable("waiting for driving:\n" + bad.join('\n')));
+    CalibrationState refused = calibrator->state();
+    CalibrationFit fit;
+    fit.refused = boundsRefusal(calParam(CalParam::Delay), -0.2965728459650404);
+    refused.history.push_back(fit);
+    panel->setLive(&refused);
+    QCoreApplication::sendPostedEvents(nullptr, QEvent::LayoutRequest);
+    QVERIFY2(panel->statusLabel()->text().contains(QLatin1String("-0.297 s")), qPrintable(panel->statusLabel()->text()));
+    bad = test::unreadable(panel);
+    QVERIFY2(bad.isEmpty(), qPrintable("a fit refused:\n" + bad.join('\n')));
+    // Control: the same label one line high cannot hold the refusal.
+    panel->statusLabel()->setFixedHeight(panel->statusLabel()->fontMetrics().height());
+    QVERIFY2(!test::unreadable(panel).isEmpty(), "the control: a one-line status must be reported cut");
+    panel->statusLabel()->setMinimumHeight(0);
+    panel->statusLabel()->setMaximumHeight(QWIDGETSIZE_MAX);
   }
 
   void fitsShowFreezeResetSave() {

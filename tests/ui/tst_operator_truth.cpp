@@ -16,6 +16,7 @@
 
 #include "tests/net/raw_client.h"
 #include "tests/ui/console_fixture.h"
+#include "tests/ui/readable.h"
 #include "ui/jobs/drive/control_panel.h"
 #include "ui/link_panel.h"
 #include "ui/robot_connection.h"
@@ -146,6 +147,39 @@ class TestOperatorTruth : public QObject {
     QVERIFY(w.isVisible());
     w.controlPanel()->setDrive(0.0, 0.0);
     QTRY_VERIFY_WITH_TIMEOUT(w.robotSpeed() < 0.05, 5000);
+  }
+
+  // The Link dock's rows read whole. A message longer than the room the
+  // status bar's fields leave is shown
+  // elided to that room, whole in the tooltip and in the event list; every
+  // field reads whole beside it (issue 59: messages over ~45 characters ran
+  // under the next field, cut mid-letter). Control: the same text shown
+  // as QStatusBar shows it fails the check.
+  void statusBarAndLinkReadable() {
+    MainWindow& w = *window_;
+    QCOMPARE(w.size(), QSize(1280, 800));
+    QTest::qWait(400);  // the fields refreshed with the link's figures
+    const QString text = QStringLiteral(
+        "Aborted by the guard: position 0.311 m from the rehearsal 1.5 s into the sequence (its limit 0.30 m); "
+        "the robot was sent a stop, and the sequence can be rehearsed again from where the robot stands");
+    QStringList bad = test::unreadable(w.statusBar());
+    QVERIFY2(bad.isEmpty(), qPrintable("the fields alone:\n" + bad.join('\n')));
+    bad = test::unreadable(w.linkPanel());
+    QVERIFY2(bad.isEmpty(), qPrintable("the Link dock:\n" + bad.join('\n')));
+    w.statusBar()->showMessage(text);
+    QVERIFY2(!test::unreadable(w.statusBar()).isEmpty(), "the control: the whole text must not fit");
+    const qsizetype before = w.linkPanel()->events().size();
+    w.context().status(text);
+    bad = test::unreadable(w.statusBar());
+    QVERIFY2(bad.isEmpty(), qPrintable(bad.join('\n')));
+    QVERIFY(w.statusBar()->currentMessage().endsWith(QChar(0x2026)));
+    QCOMPARE(w.statusBar()->toolTip(), text);
+    QVERIFY(w.linkPanel()->events().mid(before).join('\n').contains(text));
+    // A short one is shown whole and not repeated in the event list.
+    const qsizetype listed = w.linkPanel()->events().size();
+    w.context().status(QStringLiteral("Saved."));
+    QCOMPARE(w.statusBar()->currentMessage(), QStringLiteral("Saved."));
+    QCOMPARE(w.linkPanel()->events().size(), listed);
   }
 
   // Esc after a disconnect: the event list and the status bar say the

@@ -34,58 +34,12 @@
 #include "ui/robot_connection.h"
 #include "app/log/session_log.h"
 #include "tests/ui/console_fixture.h"
+#include "tests/ui/readable.h"
 #include "ui/main_window.h"
 #include "ui/scene_view.h"
 #include "ui/jobs/sequence/sequence_panel.h"
 
 using namespace sp;
-
-namespace {
-
-// What of `panel` an operator cannot read at the window's size: a widget
-// outside the dock's view (below the fold: the dock scrolls), a wrapped
-// label shorter than its text, a one-line label or a button narrower than
-// its text. Each as "what: why".
-QStringList unreadable(QWidget* panel) {
-  QWidget* view = panel;
-  for (QWidget* w = panel->parentWidget(); w; w = w->parentWidget())
-    if (auto* area = qobject_cast<QAbstractScrollArea*>(w)) {
-      view = area->viewport();
-      break;
-    }
-  QStringList bad;
-  const auto name = [](QWidget* w) {
-    if (auto* l = qobject_cast<QLabel*>(w)) return QStringLiteral("label '%1'").arg(l->text().left(40));
-    if (auto* b = qobject_cast<QAbstractButton*>(w)) return QStringLiteral("button '%1'").arg(b->text());
-    return QString::fromLatin1(w->metaObject()->className());
-  };
-  for (QWidget* w : panel->findChildren<QWidget*>()) {
-    if (!w->isVisibleTo(view) || w->size().isEmpty()) continue;
-    auto* label = qobject_cast<QLabel*>(w);
-    auto* button = qobject_cast<QPushButton*>(w);
-    if (!label && !button && !qobject_cast<QPlainTextEdit*>(w) && !qobject_cast<QTreeWidget*>(w) &&
-        !qobject_cast<QSlider*>(w))
-      continue;
-    const QRect r(w->mapTo(view, QPoint(0, 0)), w->size());
-    if (!view->rect().contains(r))
-      bad << QStringLiteral("%1: at %2,%3 %4x%5, outside the dock's %6x%7")
-                 .arg(name(w)).arg(r.x()).arg(r.y()).arg(r.width()).arg(r.height())
-                 .arg(view->width()).arg(view->height());
-    if (label && !label->text().isEmpty()) {
-      if (label->wordWrap() && label->height() < label->heightForWidth(label->width()))
-        bad << QStringLiteral("%1: %2 px tall, its text takes %3").arg(name(w)).arg(label->height()).arg(label->heightForWidth(label->width()));
-      if (!label->wordWrap() && label->fontMetrics().horizontalAdvance(label->text()) > label->contentsRect().width())
-        bad << QStringLiteral("%1: %2 px wide, its text takes %3").arg(name(w)).arg(label->contentsRect().width())
-                   .arg(label->fontMetrics().horizontalAdvance(label->text()));
-    }
-    if (button && button->fontMetrics().horizontalAdvance(button->text()) + 8 > button->width())
-      bad << QStringLiteral("%1: %2 px wide, its text takes %3").arg(name(w)).arg(button->width())
-                 .arg(button->fontMetrics().horizontalAdvance(button->text()));
-  }
-  return bad;
-}
-
-}  // namespace
 
 class TestSequencePanel : public QObject {
   Q_OBJECT
@@ -219,7 +173,7 @@ class TestSequencePanel : public QObject {
     p->setText(QStringLiteral("1.0 drive 0.5 0\n2.0 drvie 0.5 0\n6.0 stop\n"));
     QTRY_VERIFY(!p->errors().isEmpty());
     QTest::qWait(100);  // laid out
-    QStringList bad = unreadable(p);
+    QStringList bad = test::unreadable(p);
     QVERIFY2(bad.isEmpty(), qPrintable("with a typo:\n" + bad.join('\n')));
     QVERIFY(p->findChild<QPlainTextEdit*>()->height() >= 4 * p->fontMetrics().lineSpacing());
     // A rule that fails: full speed with the hinge at its 30 degrees.
@@ -230,7 +184,7 @@ class TestSequencePanel : public QObject {
     QVERIFY2(rehearsed.wait(60000), qPrintable(p->status()));
     QVERIFY2(!rehearsed.at(0).at(0).toBool(), "the control: this sequence must fail a rule");
     QTest::qWait(100);
-    bad = unreadable(p);
+    bad = test::unreadable(p);
     QVERIFY2(bad.isEmpty(), qPrintable("with a failed rule:\n" + bad.join('\n')));
     QTreeWidget* verdicts = p->verdictList();
     QTreeWidgetItem* first = verdicts->topLevelItem(0);

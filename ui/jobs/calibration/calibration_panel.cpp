@@ -9,6 +9,7 @@
 #include <QLabel>
 #include <QLineSeries>
 #include <QPushButton>
+#include <QTabWidget>
 #include <QTableWidget>
 #include <QValueAxis>
 #include <QVBoxLayout>
@@ -100,15 +101,20 @@ CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(k
     table_->setItem(i, 4, new QTableWidgetItem(shown(static_cast<size_t>(i), p.files)));
   }
   table_->resizeColumnsToContents();
-  table_->setMinimumHeight(table_->verticalHeader()->length() + table_->horizontalHeader()->height() + 4);
-  layout->addWidget(table_);
+  // At least three rows; the rest scroll inside the table (issue 59: the
+  // whole table as a minimum pushed the buttons and the status below the
+  // fold of a 1280x800 window).
+  table_->setMinimumHeight(3 * table_->verticalHeader()->defaultSectionSize() + table_->horizontalHeader()->height() + 4);
 
+  auto* plot = new QWidget;
+  auto* plotLayout = new QVBoxLayout(plot);
+  plotLayout->setContentsMargins(0, 0, 0, 0);
   auto* plotRow = new QHBoxLayout;
-  plotRow->addWidget(new QLabel(tr("Plot:"), this));
-  plotted_ = new QComboBox(this);
+  plotRow->addWidget(new QLabel(tr("Plot:"), plot));
+  plotted_ = new QComboBox(plot);
   for (const CalParamInfo& p : calParams()) plotted_->addItem(tr(p.label));
   plotRow->addWidget(plotted_, 1);
-  layout->addLayout(plotRow);
+  plotLayout->addLayout(plotRow);
   chart_ = new QChart;
   chart_->legend()->hide();
   chart_->setMargins(QMargins(2, 2, 2, 2));
@@ -129,12 +135,17 @@ CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(k
     s->attachAxis(axisX_);
     s->attachAxis(axisY_);
   }
-  view_ = new QChartView(chart_, this);
-  view_->setMinimumHeight(140);
+  view_ = new QChartView(chart_, plot);
+  view_->setMinimumHeight(100);
   view_->setRenderHint(QPainter::Antialiasing);
-  layout->addWidget(view_, 1);
+  plotLayout->addWidget(view_, 1);
   connect(plotted_, &QComboBox::currentIndexChanged, this, [this] { replot(); });
 
+  // What the calibration does and the buttons that change it first, always
+  // in view; the table and the plot below them, one at a time.
+  status_ = new QLabel(this);
+  status_->setWordWrap(true);
+  layout->addWidget(status_);
   auto* buttons = new QHBoxLayout;
   freeze_ = new QPushButton(tr("Freeze"), this);
   freeze_->setCheckable(true);
@@ -145,9 +156,10 @@ CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(k
   save_->setToolTip(tr("Save the values the rehearsals use as a parameters file (calibration.* keys) or as a robot file with them written in"));
   for (QPushButton* b : {freeze_, reset_, save_}) buttons->addWidget(b);
   layout->addLayout(buttons);
-  status_ = new QLabel(this);
-  status_->setWordWrap(true);
-  layout->addWidget(status_);
+  views_ = new QTabWidget(this);
+  views_->addTab(table_, tr("Values"));
+  views_->addTab(plot, tr("Plot"));
+  layout->addWidget(views_, 1);
   // The button says what it is in (issue 59: a pressed Freeze looked as any other).
   connect(freeze_, &QPushButton::toggled, this,
           [this](bool on) { freeze_->setText(on ? tr("Frozen: unfreeze") : tr("Freeze")); });

@@ -2,7 +2,8 @@
 // The Calibration dock: what the console has fitted of the robot from its
 // telemetry (app/calibration/live_calibrator.h), each parameter with its
 // deviation, the files' value and whether the motion showed it; a plot of
-// one parameter over the fits; Freeze, Reset to files, Save parameters.
+// one parameter over the fits (the two as tabs); Freeze, Reset to files,
+// Save parameters above them.
 // Shows a replayed log's calibration table instead while a replay is shown.
 //
 // Thread: GUI thread only.
@@ -21,6 +22,7 @@ QT_FORWARD_DECLARE_CLASS(QComboBox)
 QT_FORWARD_DECLARE_CLASS(QLabel)
 QT_FORWARD_DECLARE_CLASS(QLineSeries)
 QT_FORWARD_DECLARE_CLASS(QPushButton)
+QT_FORWARD_DECLARE_CLASS(QTabWidget)
 QT_FORWARD_DECLARE_CLASS(QTableWidget)
 QT_FORWARD_DECLARE_CLASS(QValueAxis)
 
@@ -59,6 +61,7 @@ class CalibrationPanel : public QWidget {
   void showRow(int row, double value, double sigma, bool observed, const QString& status);
   void replot();
 
+  QTabWidget* views_ = nullptr;  // the table, the plot
   QTableWidget* table_ = nullptr;
   QComboBox* plotted_ = nullptr;
   QChart* chart_ = nullptr;
