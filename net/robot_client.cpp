@@ -33,6 +33,32 @@ const char* toString(ConnectionState state) {
   return "?";
 }
 
+double delaySpread(const std::vector<std::pair<double, double>>& frames) {
+  if (frames.size() < 3) return 0;
+  // Centred sums: the wall clock's seconds since boot would cost digits.
+  double mt = 0, mo = 0;
+  for (const auto& [arrival, robot] : frames) {
+    mt += arrival;
+    mo += arrival - robot;
+  }
+  const double n = static_cast<double>(frames.size());
+  mt /= n;
+  mo /= n;
+  double stt = 0, sto = 0;
+  for (const auto& [arrival, robot] : frames) {
+    stt += (arrival - mt) * (arrival - mt);
+    sto += (arrival - mt) * (arrival - robot - mo);
+  }
+  const double slope = stt > 0 ? sto / stt : 0;
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto& [arrival, robot] : frames) {
+    const double r = arrival - robot - mo - slope * (arrival - mt);
+    lo = std::min(lo, r);
+    hi = std::max(hi, r);
+  }
+  return hi - lo;
+}
+
 std::string linkAdvice(double deadman, double keepalive, double stretch) {
   // Two seconds of frames underrate the worst a session meets (a link that
   // keeps order also hides its shortest delays): half as much again.
@@ -561,8 +587,7 @@ class RobotClient::Impl {
     rateWindowStart_ = now();
     rateWindowCount_ = 0;
     readyAt_ = now();
-    minOffset_ = INFINITY;
-    maxOffset_ = -INFINITY;
+    linkFrames_.clear();
     ownLate_ = 0;
     linkChecked_ = false;
     updateStats([&](RobotClientStats& s) {
@@ -658,22 +683,22 @@ class RobotClient::Impl {
   }
 
   // The first kLinkCheckSeconds of telemetry after WELCOME: arrival minus
-  // the frame's robot time is the one-way delay plus a constant, so its
-  // spread is what the link's jitter can add to a gap between two frames
+  // the frame's robot time is the one-way delay plus a constant (plus a
+  // trend when the robot's clock runs slow or fast), so its spread about
+  // the trend is what the link's jitter can add to a gap between two frames
   // (gaps between arrivals alone underrate it: the link keeps order). Then,
   // once, whether our keep-alives so stretched fit the robot's deadman.
   void checkLink(double robotTime) {
     if (linkChecked_ || !ready_) return;  // once per connection: nothing more per frame
     const double t = now();
-    const double offset = t - robotTime;
-    minOffset_ = std::min(minOffset_, offset);
-    maxOffset_ = std::max(maxOffset_, offset);
+    if (linkFrames_.size() < 100000) linkFrames_.emplace_back(t, robotTime);
     if (t - readyAt_ < kLinkCheckSeconds) return;
     linkChecked_ = true;
     const RobotClientStats s = stats();
     // Our own emulated link's jitter stretches what we send, not what we
     // get; our own thread's lateness (a loaded machine) is not the link's.
-    const double stretch = std::max(maxOffset_ - minOffset_ - ownLate_, 2 * config_.emulation.jitter);
+    const double stretch = std::max(delaySpread(linkFrames_) - ownLate_, 2 * config_.emulation.jitter);
+    linkFrames_ = {};
     const std::string advice = linkAdvice(s.robotDeadman, keepaliveInterval_, std::max(0.0, stretch));
     updateStats([&](RobotClientStats& st) {
       st.delaySpreadMs = std::max(0.0, stretch) * 1000;
@@ -832,7 +857,8 @@ class RobotClient::Impl {
   const std::string errorShedKind_ = "robot ERRORs beyond " + std::to_string(static_cast<int>(config_.eventRate)) + " a second";
   double rateWindowStart_ = 0;
   uint64_t rateWindowCount_ = 0;
-  double readyAt_ = 0, minOffset_ = INFINITY, maxOffset_ = -INFINITY;  // [s] the link check (checkLink)
+  double readyAt_ = 0;  // [s] the link check (checkLink)
+  std::vector<std::pair<double, double>> linkFrames_;  // its frames: (arrival, robot time)
   double ownLate_ = 0;  // [s] the keep-alive timer's worst lateness over the check
   bool linkChecked_ = false;
 };

@@ -127,8 +127,9 @@ struct RobotClientStats {
   uint64_t shed = 0;      ///< TELEMETRY, LASER and EVENTs beyond their rates, not passed on
   uint64_t renumbered = 0;  ///< TELEMETRY `seq` jumps too large to be loss (not counted in telemetryLost)
   std::string lastError;              ///< the last connection problem or robot ERROR, for the operator
-  /// [ms] the spread of the one-way delay (arrival minus robot time) of
-  /// the telemetry over the first kLinkCheckSeconds of this connection: as
+  /// [ms] the spread of the one-way delay (arrival minus robot time, its
+  /// trend removed: delaySpread()) of the telemetry over the first
+  /// kLinkCheckSeconds of this connection: as
   /// much as the link's jitter can stretch a gap between two frames sent
   /// at a steady rate (our keep-alives too, the other way); 0 before.
   double delaySpreadMs = 0;
@@ -146,6 +147,15 @@ constexpr double kRefusalReport = 5.0;
 
 /// [s] telemetry looked at after WELCOME before the link is judged.
 constexpr double kLinkCheckSeconds = 2.0;
+/// [s] how much a link's one-way delay varies, from telemetry frames'
+/// (arrival wall time, robot time) [s]: the peak-to-peak of arrival minus
+/// robot time about its least-squares line. A trend is not the link's
+/// jitter: a robot whose clock runs slow (a twin below real time on a
+/// loaded machine, issue 59: "delay varies by 336 ms" on loopback) or a
+/// delay that builds up slowly stretches no gap between two keep-alives.
+/// 0 for fewer than 3 frames.
+double delaySpread(const std::vector<std::pair<double, double>>& frames);
+
 /// "" when keep-alives every `keepalive` [s], on a link whose one-way delay
 /// was seen to vary by `stretch` [s] (1.5 times that taken as its worst),
 /// stay within the robot's `deadman` [s]; else what will happen and the

@@ -343,6 +343,30 @@ class TestRobotClient : public QObject {
     }
   }
 
+  // Issue 59: on loopback, a stand-in twin at 0.83 of real time (a loaded
+  // machine) was taken for a link whose delay varies by 336 ms. The spread
+  // is about the trend: a robot clock running slow adds nothing, the link's
+  // jitter all of its peak-to-peak. Control: the raw peak-to-peak of the
+  // slow clock (what was judged before) is 0.4 s.
+  void delaySpreadIgnoresATrend() {
+    std::vector<std::pair<double, double>> slow, jittery, both;
+    double rawLo = INFINITY, rawHi = -INFINITY;
+    for (int i = 0; i <= 100; ++i) {
+      const double wall = 5000 + 0.02 * i;  // arrivals at 50 Hz, seconds since boot
+      const double jitter = (i % 2 ? 0.05 : -0.05) * (i % 7 == 3 ? 1 : 0.5);  // +-50 ms at most
+      slow.emplace_back(wall, 0.8 * 0.02 * i);
+      jittery.emplace_back(wall, 0.02 * i - jitter);
+      both.emplace_back(wall, 0.8 * 0.02 * i - jitter);
+      rawLo = std::min(rawLo, wall - 0.8 * 0.02 * i);
+      rawHi = std::max(rawHi, wall - 0.8 * 0.02 * i);
+    }
+    QVERIFY2(rawHi - rawLo > 0.39, qPrintable(QString::number(rawHi - rawLo)));
+    QVERIFY2(delaySpread(slow) < 1e-6, qPrintable(QString::number(delaySpread(slow))));
+    QVERIFY2(std::abs(delaySpread(jittery) - 0.1) < 0.005, qPrintable(QString::number(delaySpread(jittery))));
+    QVERIFY2(std::abs(delaySpread(both) - 0.1) < 0.005, qPrintable(QString::number(delaySpread(both))));
+    QCOMPARE(delaySpread({{1, 0}, {2, 1}}), 0.0);
+  }
+
   // The advice's arithmetic: keep-alives every 50 ms on a delay seen to
   // vary by 140 ms need 50 + 1.5 x 140 = 260 ms; at 1.5 times that,
   // rounded up to 50 ms: 0.40 s.
