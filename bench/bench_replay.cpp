@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "app/log/log_player.h"
+#include "ui/jobs/jobs.h"
 #include "ui/main_window.h"
 #include "ui/jobs/replay/replay_panel.h"
 #include "ui/scene_view.h"
@@ -74,7 +75,7 @@ int main(int argc, char** argv) {
   options.world = QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml");
   options.log = false;
   options.logDir = dir.path();
-  sp::MainWindow window(options);
+  sp::MainWindow window(options, sp::builtInJobs());
   if (const QString e = window.start(); !e.isEmpty()) {
     std::fprintf(stderr, "%s\n", qPrintable(e));
     return 1;

@@ -14,6 +14,7 @@
 //
 // Thread: GUI thread only, as every job.
 
+#include <QCommandLineOption>
 #include <QMainWindow>
 #include <QMessageBox>
 #include <QObject>
@@ -22,6 +23,8 @@
 #include <functional>
 #include <memory>
 #include <vector>
+
+QT_FORWARD_DECLARE_CLASS(QCommandLineParser)
 
 #include "app/console/console_state.h"
 #include "app/rehearse/rehearsal.h"
@@ -184,9 +187,22 @@ class ConsoleJob : public QObject {
   /// Builds the job's widgets into `context`'s window; called once, after
   /// the window's own views exist. `context` outlives the job.
   virtual void install(ConsoleContext& context) = 0;
+  /// The job's own command-line options (ui/jobs/jobs.h addJobOptions():
+  /// the console's parser takes them beside its own); none by default.
+  virtual QList<QCommandLineOption> commandLineOptions() const { return {}; }
+  /// The command line parsed, before install(): the job takes its options'
+  /// values. "" or what is wrong with them, naming where (`FILE: error: ...`,
+  /// `<command line>: error: --option: ...`).
+  virtual QString takeCommandLine(const QCommandLineParser& parser) {
+    Q_UNUSED(parser);
+    return {};
+  }
   /// The console is starting (after every job is installed): a job may
   /// open what the command line named. "" or why the console cannot start.
   virtual QString start() { return {}; }
 };
+
+/// Jobs, in the order their docks are laid out (ui/jobs/jobs.h).
+using ConsoleJobs = std::vector<std::unique_ptr<ConsoleJob>>;
 
 }  // namespace sp

@@ -18,9 +18,8 @@
 #include "app/console/console_session.h"
 #include "app/data/data_files.h"
 #include "ui/icons.h"
-#include "ui/jobs/drive/control_panel.h"
-#include "ui/link_panel.h"
 #include "ui/live_plots.h"
+#include "ui/jobs/jobs.h"
 #include "ui/main_window.h"
 #include "ui/scene_view.h"
 
@@ -66,7 +65,6 @@ int main(int argc, char** argv) {
   const QCommandLineOption logDir(QStringLiteral("log-dir"), QStringLiteral("Folder for session logs (default: the user's data folder)."), QStringLiteral("DIR"));
   const QCommandLineOption noLog(QStringLiteral("no-log"), QStringLiteral("Do not log the session."));
   const QCommandLineOption rtf(QStringLiteral("rtf"), QStringLiteral("Stand-in real-time factor."), QStringLiteral("X"));
-  const QCommandLineOption monitor(QStringLiteral("monitor"), QStringLiteral("Do not take control on connecting."));
   const QCommandLineOption screenshot(QStringLiteral("screenshot"), QStringLiteral("Save a picture of the window after --quit-after seconds, then quit."), QStringLiteral("PNG"));
   const QCommandLineOption quitAfter(QStringLiteral("quit-after"), QStringLiteral("Quit after S seconds, printing the frame rate (for measurements)."), QStringLiteral("S"));
   const QCommandLineOption delay(QStringLiteral("delay"), QStringLiteral("The stand-in's link delays every frame by S seconds each way (rehearse a slow link; the ghost spans it)."), QStringLiteral("S"));
@@ -74,13 +72,13 @@ int main(int argc, char** argv) {
   const QCommandLineOption noGhost(QStringLiteral("no-ghost"), QStringLiteral("Do not run the predictive ghost."));
   const QCommandLineOption noCalibration(QStringLiteral("no-calibration"),
                                          QStringLiteral("Do not calibrate the twin from telemetry while driving."));
-  const QCommandLineOption rules(QStringLiteral("rules"), QStringLiteral("Flight rules for rehearsals (default: built-in, see config/flight.rules)."), QStringLiteral("FILE"));
-  const QCommandLineOption sequenceFile(QStringLiteral("sequence"), QStringLiteral("Open this command sequence in the Sequence dock."), QStringLiteral("FILE"));
-  const QCommandLineOption replay(QStringLiteral("replay"), QStringLiteral("Open this session log in the Replay dock."), QStringLiteral("LOG"));
-  const QCommandLineOption drive(QStringLiteral("drive"), QStringLiteral("Drive at SPEED m/s once in control (for demonstrations)."), QStringLiteral("SPEED"));
   const QCommandLineOption errorDialog(QStringLiteral("error-dialog"), QStringLiteral("Show an error that stops the start in a dialog too (the desktop entry sets it: no terminal shows stderr there)."));
-  parser.addOptions({errorDialog, world, params, set, connectTo, token, logDir, noLog, rtf, delay, perturb, noGhost, noCalibration, monitor, screenshot, quitAfter, drive, rules,
-                     sequenceFile, replay});
+  parser.addOptions({errorDialog, world, params, set, connectTo, token, logDir, noLog, rtf, delay, perturb, noGhost,
+                     noCalibration, screenshot, quitAfter});
+  // Each job's own (--monitor, --rules, --sequence, --replay, ...): the jobs
+  // exist before the window, and take their values before it installs them.
+  sp::ConsoleJobs jobs = sp::builtInJobs();
+  sp::addJobOptions(parser, jobs);
   if (!parser.parse(QCoreApplication::arguments())) {
     std::cerr << "<command line>: error: " << parser.errorText().toStdString() << "\n";
     return 2;
@@ -124,11 +122,16 @@ int main(int argc, char** argv) {
   options.token = parser.value(token);
   options.logDir = parser.value(logDir);
   options.log = !parser.isSet(noLog);
-  options.takeControl = !parser.isSet(monitor);
-  options.rules = parser.isSet(rules) ? findDataFile(parser.value(rules)) : QString();
-  options.sequence = parser.isSet(sequenceFile) ? findDataFile(parser.value(sequenceFile)) : QString();
-  options.replay = parser.value(replay);
-  std::optional<double> driveSpeed, quitSeconds;
+  // A job's bad option value is a command-line error (exit 2, as every
+  // other one); a file it names not found stops the start as ours do.
+  if (const QString error = sp::takeJobOptions(parser, jobs); !error.isEmpty()) {
+    if (error.startsWith(QLatin1String("<command line>:"))) {
+      std::cerr << error.toStdString() << "\n";
+      return 2;
+    }
+    if (startError.isEmpty()) startError = error;
+  }
+  std::optional<double> quitSeconds;
   if (parser.isSet(rtf)) {
     const std::optional<double> x = numberOption(parser, rtf, 0, 1000);
     if (!x) return 2;
@@ -155,7 +158,6 @@ int main(int argc, char** argv) {
   }
   options.ghost = !parser.isSet(noGhost);
   options.calibrate = !parser.isSet(noCalibration);
-  if (parser.isSet(drive) && !(driveSpeed = numberOption(parser, drive, -10, 10))) return 2;
   if (parser.isSet(quitAfter) && !(quitSeconds = numberOption(parser, quitAfter, 0.1, 1e6))) return 2;
 
   bare.reset();
@@ -170,28 +172,18 @@ int main(int argc, char** argv) {
   // SimPartner tool does (a dialog would hang a scripted start), and in a
   // dialog when the desktop entry started us.
   const auto failed = [&](const QString& error) {
+    jobs.clear();  // before the application they were made for
     std::cerr << error.toStdString() << "\n";
     if (parser.isSet(errorDialog))
       QMessageBox::critical(nullptr, QObject::tr("SimPartner cannot start"), error);
     return 1;
   };
   if (!startError.isEmpty()) return failed(startError);
-  sp::MainWindow window(options);
+  sp::MainWindow window(options, std::move(jobs));
   if (const QString error = window.start(); !error.isEmpty()) return failed(error);
   window.show();
   if (!window.logPath().isEmpty()) std::cout << "logging to " << window.logPath().toStdString() << std::endl;
 
-  if (driveSpeed) {
-    const double speed = *driveSpeed;
-    // Drive once the lease is ours; poll, since the lease arrives over the link.
-    auto* poll = new QTimer(&window);
-    QObject::connect(poll, &QTimer::timeout, &window, [&window, poll, speed] {
-      if (!window.linkPanel()->leaseHeld()) return;
-      window.controlPanel()->setDrive(speed, 0.0);
-      poll->stop();
-    });
-    poll->start(100);
-  }
   if (parser.isSet(quitAfter) || parser.isSet(screenshot)) {
     const double seconds = quitSeconds.value_or(5.0);
     // The frame rate is measured after a warm-up (start, first telemetry,

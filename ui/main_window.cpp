@@ -74,7 +74,7 @@ ConsoleSessionOptions toSessionOptions(const ConsoleOptions& o, const QString& l
 
 }  // namespace
 
-MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
+MainWindow::MainWindow(ConsoleOptions options, ConsoleJobs jobs, QWidget* parent)
     : QMainWindow(parent),
       options_(std::move(options)),
       logDir_(options_.logDir.isEmpty() ? QStandardPaths::writableLocation(QStandardPaths::GenericDataLocation) +
@@ -183,7 +183,7 @@ MainWindow::MainWindow(ConsoleOptions options, QWidget* parent)
   // 3D view only (defaultLayout()).
   setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
   setCorner(Qt::TopRightCorner, Qt::RightDockWidgetArea);
-  for (std::unique_ptr<ConsoleJob>& job : builtInJobs(options_, logDir_)) installJob(std::move(job));
+  for (std::unique_ptr<ConsoleJob>& job : jobs) installJob(std::move(job));
   status_ = new StatusFields(statusBar());
   stateChanged();
 

@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "app/console/console_state.h"
-#include "app/console/robot_frame.h"
+#include "app/state/robot_frame.h"
 #include "net/message.h"
 #include "net/robot_client.h"
 #include "sim/robot_model.h"
@@ -77,17 +77,15 @@ struct ConsoleOptions {
   std::optional<uint64_t> perturbSeed;  ///< the stand-in is a robot that is not its twin (sim/perturbation.h)
   bool ghost = true;          ///< run and show the predictive ghost
   bool calibrate = true;      ///< calibrate the twin from telemetry (app/calibration/live_calibrator.h)
-  bool takeControl = true;    ///< ask for the lease as soon as connected
-  QString rules;              ///< flight rules file for rehearsals; "" = the built-in defaults
-  QString sequence;           ///< a sequence file to open in the Sequence dock
-  QString replay;             ///< a session log to open in the Replay dock
 };
 
 class MainWindow : public QMainWindow, public ConsoleHost {
   Q_OBJECT
 
  public:
-  explicit MainWindow(ConsoleOptions options, QWidget* parent = nullptr);
+  /// Installs `jobs` (ui/jobs/jobs.h builtInJobs(), having taken the
+  /// command line) once the window's own views exist.
+  MainWindow(ConsoleOptions options, ConsoleJobs jobs, QWidget* parent = nullptr);
   ~MainWindow() override;
 
   /// Loads the world, starts the stand-in (unless connecting elsewhere),

@@ -5,33 +5,55 @@
 // context OpenSceneGraph needs (shared/STACK.md).
 
 #include <QApplication>
+#include <QCommandLineParser>
 #include <QSettings>
 #include <QTemporaryDir>
 #include <QTest>
 
 #include <memory>
 
+#include "ui/jobs/jobs.h"
 #include "ui/main_window.h"
 #include "ui/scene_view.h"
 
 namespace sp::test {
 
-/// Starts a console window on `world` with settings and logs under `dir`;
-/// "" or what went wrong. `options` gets the world and log folder.
+/// The built-in jobs, having taken `arguments` (their own options only,
+/// e.g. {"--monitor"}) as the console's command line hands them; a parse
+/// error or a job's complaint fails the test that asked.
+inline ConsoleJobs jobsWith(const QStringList& arguments) {
+  ConsoleJobs jobs = builtInJobs();
+  QCommandLineParser parser;
+  addJobOptions(parser, jobs);
+  if (!parser.parse(QStringList{QStringLiteral("simpartner")} + arguments))
+    qFatal("jobsWith: %s", qPrintable(parser.errorText()));
+  if (const QString error = takeJobOptions(parser, jobs); !error.isEmpty()) qFatal("jobsWith: %s", qPrintable(error));
+  return jobs;
+}
+
+/// Starts a console window on `world` with settings and logs under `dir`
+/// and `jobs` installed; "" or what went wrong. `options` gets the world
+/// and log folder.
 inline QString startConsole(const QTemporaryDir& dir, const QString& world, ConsoleOptions& options,
-                            std::unique_ptr<MainWindow>& window) {
+                            std::unique_ptr<MainWindow>& window, ConsoleJobs jobs) {
   QSettings::setDefaultFormat(QSettings::IniFormat);
   QSettings::setPath(QSettings::IniFormat, QSettings::UserScope, dir.filePath(QStringLiteral("settings")));
   QSettings().clear();
   options.world = world;
   options.logDir = dir.filePath(QStringLiteral("sessions"));
-  window = std::make_unique<MainWindow>(options);
+  window = std::make_unique<MainWindow>(options, std::move(jobs));
   const QString error = window->start();
   if (!error.isEmpty()) return error;
   window->resize(1280, 800);
   window->show();
   if (!QTest::qWaitForWindowExposed(window.get())) return QStringLiteral("the window was not exposed");
   return {};
+}
+
+/// The same with the built-in jobs, given `jobArguments`.
+inline QString startConsole(const QTemporaryDir& dir, const QString& world, ConsoleOptions& options,
+                            std::unique_ptr<MainWindow>& window, const QStringList& jobArguments = {}) {
+  return startConsole(dir, world, options, window, jobsWith(jobArguments));
 }
 
 /// main() of a GL test: the default surface format first, then the application.

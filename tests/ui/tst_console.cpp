@@ -40,6 +40,7 @@
 #include "ui/link_panel.h"
 #include "ui/live_plots.h"
 #include "tests/ui/console_fixture.h"
+#include "ui/jobs/jobs.h"
 #include "ui/main_window.h"
 #include "ui/robot_connection.h"
 #include "ui/scene_view.h"
@@ -337,8 +338,7 @@ class TestConsole : public QObject {
     QVERIFY(!port.isEmpty());
     ConsoleOptions o = options_;
     o.log = false;
-    o.takeControl = false;
-    MainWindow w(o);
+    MainWindow w(o, test::jobsWith({QStringLiteral("--monitor")}));
     QCOMPARE(w.start(), QString());
     w.show();
     QTRY_VERIFY_WITH_TIMEOUT(w.telemetryReceived() > 5, 5000);
@@ -392,10 +392,9 @@ class TestConsole : public QObject {
     ConsoleOptions o = options_;
     o.connectTo = QStringLiteral("127.0.0.1:") + port;
     o.token = kRobotToken;
-    o.takeControl = false;
     o.log = false;
     {
-      MainWindow remote(o);
+      MainWindow remote(o, test::jobsWith({QStringLiteral("--monitor")}));
       QCOMPARE(remote.start(), QString());
       remote.show();
       QTRY_VERIFY_WITH_TIMEOUT(remote.telemetryReceived() > 10, 5000);
@@ -429,7 +428,7 @@ class TestConsole : public QObject {
     o.delay = 1.0;
     o.overrides = {QStringLiteral("link.deadman=0.5")};
     o.log = false;
-    MainWindow w(o);
+    MainWindow w(o, builtInJobs());
     QCOMPARE(w.start(), QString());
     w.resize(1280, 800);
     w.show();
@@ -570,11 +569,10 @@ class TestConsole : public QObject {
     ConsoleOptions o = options_;
     o.connectTo = QStringLiteral("127.0.0.1:%1").arg(first.port);
     o.token = QString::fromStdString(first.token);
-    o.takeControl = false;
     o.logDir = dir_.filePath(QStringLiteral("remote"));
     QString logFile;
     {
-      MainWindow remote(o);
+      MainWindow remote(o, test::jobsWith({QStringLiteral("--monitor")}));
       QCOMPARE(remote.start(), QString());
       logFile = remote.logPath();
       QVERIFY(logFile.startsWith(o.logDir));
@@ -663,7 +661,7 @@ class TestConsole : public QObject {
       o.logDir = dir_.filePath(QString::fromLatin1(name));
       return o;
     };
-    MainWindow w(onBumpy("edge", "9"));
+    MainWindow w(onBumpy("edge", "9"), builtInJobs());
     QCOMPARE(w.start(), QString());
     w.show();
     QTRY_VERIFY_WITH_TIMEOUT(w.telemetryReceived() > 5, 5000);
@@ -695,7 +693,7 @@ class TestConsole : public QObject {
 
     // Off the terrain (the robot placed 2 m beyond its edge): an alarm, and
     // the banner offers the way out beside it (issue 31); it resets.
-    MainWindow away(onBumpy("off", "12.5"));
+    MainWindow away(onBumpy("off", "12.5"), builtInJobs());
     QCOMPARE(away.start(), QString());
     away.show();
     QTRY_VERIFY_WITH_TIMEOUT(away.bannerText().contains(QLatin1String("off the terrain")), 5000);
@@ -716,8 +714,9 @@ class TestConsole : public QObject {
       QSettings().clear();
       ConsoleOptions o = options_;
       o.log = false;
-      if (withSequence) o.sequence = QStringLiteral(SP_SOURCE_DIR "/terrains/demo.seq");
-      MainWindow w(o);
+      MainWindow w(o, test::jobsWith(withSequence ? QStringList{QStringLiteral("--sequence"),
+                                                               QStringLiteral(SP_SOURCE_DIR "/terrains/demo.seq")}
+                                                  : QStringList{}));
       QCOMPARE(w.start(), QString());
       w.resize(1280, 800);
       w.show();
@@ -749,7 +748,7 @@ class TestConsole : public QObject {
     ConsoleOptions o = options_;
     o.log = false;
     {
-      MainWindow w(o);
+      MainWindow w(o, builtInJobs());
       QCOMPARE(w.start(), QString());
       w.resize(1280, 800);
       w.show();
@@ -777,7 +776,7 @@ class TestConsole : public QObject {
       QVERIFY(w.viewShare() < MainWindow::kMinViewShare);  // the control: it was squeezed
       w.close();
     }
-    MainWindow again(o);
+    MainWindow again(o, builtInJobs());
     again.show();
     QVERIFY(QTest::qWaitForWindowExposed(&again));
     QTRY_VERIFY(again.viewShare() >= 0.5);
@@ -790,7 +789,7 @@ class TestConsole : public QObject {
     QVERIFY(dock);
     dock->hide();
     window_->close();
-    MainWindow second(options_);
+    MainWindow second(options_, builtInJobs());
     auto* again = second.findChild<QDockWidget*>(QStringLiteral("plotsDock"));
     QVERIFY(again);
     second.show();

@@ -7,6 +7,7 @@
 
 #include <QAction>
 #include <QApplication>
+#include <QCommandLineParser>
 #include <QComboBox>
 #include <QDockWidget>
 #include <QLabel>
@@ -24,6 +25,7 @@
 #include "tests/ui/console_fixture.h"
 #include "ui/background_jobs.h"
 #include "ui/console_context.h"
+#include "ui/jobs/jobs.h"
 #include "ui/jobs/drive/control_panel.h"
 #include "ui/jobs/replay/replay_panel.h"
 #include "ui/link_panel.h"
@@ -40,9 +42,19 @@ class ToyJob : public ConsoleJob {
 
  public:
   QString name() const override { return QStringLiteral("toy"); }
+  // Its own command-line option, which the window knows nothing of.
+  QList<QCommandLineOption> commandLineOptions() const override {
+    return {QCommandLineOption(QStringLiteral("toy-greeting"), QStringLiteral("What the toy dock says."),
+                               QStringLiteral("TEXT"))};
+  }
+  QString takeCommandLine(const QCommandLineParser& parser) override {
+    if (!parser.isSet(QStringLiteral("toy-greeting"))) return {};
+    greeting_ = parser.value(QStringLiteral("toy-greeting"));
+    return greeting_.isEmpty() ? QStringLiteral("<command line>: error: --toy-greeting: empty") : QString();
+  }
   void install(ConsoleContext& context) override {
     context_ = &context;
-    label_ = new QLabel(QStringLiteral("toy"));
+    label_ = new QLabel(greeting_);
     dock_ = context.host().addDock(QStringLiteral("Toy"), QStringLiteral("toyDock"), label_, DockPlace::Side, true);
     action_ = new QAction(QStringLiteral("Toy drive"), this);
     connect(action_, &QAction::triggered, this, [this] { refusal_ = context_->sendCommand(DriveCmd{0.2, 0}); });
@@ -52,6 +64,7 @@ class ToyJob : public ConsoleJob {
       lastX_ = f.base.p.x;
     });
   }
+  QString greeting_ = QStringLiteral("toy");
   ConsoleContext* context_ = nullptr;
   QLabel* label_ = nullptr;
   QDockWidget* dock_ = nullptr;
@@ -68,6 +81,46 @@ class TestJobs : public QObject {
 
  private slots:
   void initTestCase() { QVERIFY(dir_.isValid()); }
+
+  // A job declares its own command-line option: the console's parser
+  // takes it beside the others and the job its value, the window untouched
+  // (issue 60: adding --no-calibration edited MainWindow). A bad value is
+  // the job's to refuse; the built-in jobs' options reach them the same way
+  // (--monitor: no lease taken). Control: without the toy job the option
+  // is unknown to the parser.
+  void toyJobTakesItsOwnOption() {
+    const QStringList arguments = {QStringLiteral("simpartner"), QStringLiteral("--toy-greeting"),
+                                   QStringLiteral("hello"), QStringLiteral("--monitor")};
+    {
+      QCommandLineParser bare;
+      addJobOptions(bare, builtInJobs());
+      QVERIFY(!bare.parse(arguments));
+      QVERIFY2(bare.errorText().contains(QLatin1String("toy-greeting")), qPrintable(bare.errorText()));
+    }
+    {
+      ConsoleJobs jobs;
+      jobs.push_back(std::make_unique<ToyJob>());
+      QCommandLineParser parser;
+      addJobOptions(parser, jobs);
+      QVERIFY(parser.parse({QStringLiteral("simpartner"), QStringLiteral("--toy-greeting"), QString()}));
+      QCOMPARE(takeJobOptions(parser, jobs), QStringLiteral("<command line>: error: --toy-greeting: empty"));
+    }
+    ConsoleJobs jobs = builtInJobs();
+    jobs.push_back(std::make_unique<ToyJob>());
+    QCommandLineParser parser;
+    addJobOptions(parser, jobs);
+    QVERIFY2(parser.parse(arguments), qPrintable(parser.errorText()));
+    QCOMPARE(takeJobOptions(parser, jobs), QString());
+    ConsoleOptions o;
+    o.log = false;
+    std::unique_ptr<MainWindow> w;
+    QCOMPARE(test::startConsole(dir_, QStringLiteral("terrains/flat.world.xml"), o, w, std::move(jobs)), QString());
+    ToyJob* toy = w->job<ToyJob>();
+    QVERIFY(toy);
+    QCOMPARE(toy->label_->text(), QStringLiteral("hello"));
+    QTRY_VERIFY_WITH_TIMEOUT(toy->frames_ > 25, 10000);
+    QVERIFY(!w->linkPanel()->leaseHeld());
+  }
 
   // A toy job installed into the running console through the context
   // alone: its dock is in the window and the View menu, its menu item in a

@@ -1,6 +1,7 @@
 #include "ui/jobs/drive/drive_job.h"
 
 #include <QAbstractSpinBox>
+#include <QCommandLineParser>
 #include <QApplication>
 #include <QDockWidget>
 #include <QKeyEvent>
@@ -10,6 +11,9 @@
 #include <QAction>
 #include <QPlainTextEdit>
 #include <QTextEdit>
+#include <QTimer>
+
+#include <cmath>
 
 #include "sim/robot_model.h"
 #include "ui/jobs/drive/control_panel.h"
@@ -17,7 +21,40 @@
 
 namespace sp {
 
-DriveJob::~DriveJob() { qApp->removeEventFilter(this); }
+DriveJob::~DriveJob() {
+  // A console that stops before its window (a bad command line) drops its
+  // jobs after the application.
+  if (qApp) qApp->removeEventFilter(this);
+}
+
+QList<QCommandLineOption> DriveJob::commandLineOptions() const {
+  return {QCommandLineOption(QStringLiteral("drive"), tr("Drive at SPEED m/s once in control (for demonstrations)."),
+                             QStringLiteral("SPEED"))};
+}
+
+QString DriveJob::takeCommandLine(const QCommandLineParser& parser) {
+  if (!parser.isSet(QStringLiteral("drive"))) return {};
+  bool ok = false;
+  const QString text = parser.value(QStringLiteral("drive"));
+  const double speed = text.toDouble(&ok);
+  if (!ok || !(std::abs(speed) <= 10))
+    return QStringLiteral("<command line>: error: --drive: expected a number in [-10, 10], got '%1'").arg(text);
+  driveAtStart_ = speed;
+  return {};
+}
+
+QString DriveJob::start() {
+  if (!driveAtStart_) return {};
+  // Once the lease is ours: it arrives over the link, so the state is polled.
+  auto* poll = new QTimer(this);
+  connect(poll, &QTimer::timeout, this, [this, poll] {
+    if (!context_->state().leaseHeld()) return;
+    panel_->setDrive(*driveAtStart_, 0.0);
+    poll->stop();
+  });
+  poll->start(100);
+  return {};
+}
 
 void DriveJob::install(ConsoleContext& context) {
   context_ = &context;

@@ -8,6 +8,8 @@
 //
 // Thread: GUI thread only.
 
+#include <optional>
+
 #include "ui/console_context.h"
 
 class QDockWidget;
@@ -24,6 +26,10 @@ class DriveJob : public ConsoleJob {
   ~DriveJob() override;
   QString name() const override { return QStringLiteral("drive"); }
   void install(ConsoleContext& context) override;
+  /// --drive SPEED: drive at SPEED m/s once in control (demonstrations, measurements).
+  QList<QCommandLineOption> commandLineOptions() const override;
+  QString takeCommandLine(const QCommandLineParser& parser) override;
+  QString start() override;
   ControlPanel* panel() const { return panel_; }
 
  protected:
@@ -33,6 +39,7 @@ class DriveJob : public ConsoleJob {
   ConsoleContext* context_ = nullptr;
   ControlPanel* panel_ = nullptr;
   bool measuredDirty_ = false;  // the live robot's joints changed since the panel showed them
+  std::optional<double> driveAtStart_;  // [m/s] --drive
 };
 
 }  // namespace sp

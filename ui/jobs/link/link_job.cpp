@@ -1,5 +1,7 @@
 #include "ui/jobs/link/link_job.h"
 
+#include <QCommandLineParser>
+
 #include <QAction>
 #include <QCoreApplication>
 #include <QMenu>
@@ -20,6 +22,15 @@ namespace {
 QString qs(const std::string& s) { return QString::fromStdString(s); }
 
 }  // namespace
+
+QList<QCommandLineOption> LinkJob::commandLineOptions() const {
+  return {QCommandLineOption(QStringLiteral("monitor"), tr("Do not take control on connecting."))};
+}
+
+QString LinkJob::takeCommandLine(const QCommandLineParser& parser) {
+  takeControl_ = !parser.isSet(QStringLiteral("monitor"));
+  return {};
+}
 
 void LinkJob::install(ConsoleContext& context) {
   context_ = &context;

@@ -22,9 +22,11 @@ class LinkJob : public ConsoleJob {
   Q_OBJECT
 
  public:
-  /// `takeControl`: ask for the lease as soon as connected.
-  explicit LinkJob(bool takeControl, QObject* parent = nullptr) : ConsoleJob(parent), takeControl_(takeControl) {}
+  using ConsoleJob::ConsoleJob;
   QString name() const override { return QStringLiteral("link"); }
+  /// --monitor: do not ask for the lease on connecting.
+  QList<QCommandLineOption> commandLineOptions() const override;
+  QString takeCommandLine(const QCommandLineParser& parser) override;
   void install(ConsoleContext& context) override;
   LinkPanel* panel() const { return panel_; }
 
@@ -40,7 +42,7 @@ class LinkJob : public ConsoleJob {
  private:
   ConsoleContext* context_ = nullptr;
   LinkPanel* panel_ = nullptr;
-  bool takeControl_;
+  bool takeControl_ = true;  // ask for the lease as soon as connected
   QAction* reconnect_ = nullptr;
   QAction* disconnect_ = nullptr;
   QAction* take_ = nullptr;

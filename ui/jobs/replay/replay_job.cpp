@@ -1,5 +1,7 @@
 #include "ui/jobs/replay/replay_job.h"
 
+#include <QCommandLineParser>
+
 #include <algorithm>
 
 #include <QAction>
@@ -19,8 +21,18 @@
 
 namespace sp {
 
+QList<QCommandLineOption> ReplayJob::commandLineOptions() const {
+  return {QCommandLineOption(QStringLiteral("replay"), tr("Open this session log in the Replay dock."), QStringLiteral("LOG"))};
+}
+
+QString ReplayJob::takeCommandLine(const QCommandLineParser& parser) {
+  replay_ = parser.value(QStringLiteral("replay"));
+  return {};
+}
+
 void ReplayJob::install(ConsoleContext& context) {
   context_ = &context;
+  logDir_ = QString::fromStdString(context.session().logDir());
   panel_ = new ReplayPanel;
   panel_->setBackground(&context.background());
   feed_ = new ReplayFeed(panel_, this);

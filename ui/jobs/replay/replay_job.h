@@ -23,10 +23,11 @@ class ReplayJob : public ConsoleJob {
   Q_OBJECT
 
  public:
-  /// `logDir`: where session logs are; `replay`: a log to open at the start ("" = none).
-  ReplayJob(QString logDir, QString replay, QObject* parent = nullptr)
-      : ConsoleJob(parent), logDir_(std::move(logDir)), replay_(std::move(replay)) {}
+  using ConsoleJob::ConsoleJob;
   QString name() const override { return QStringLiteral("replay"); }
+  /// --replay LOG: a session log to open at the start.
+  QList<QCommandLineOption> commandLineOptions() const override;
+  QString takeCommandLine(const QCommandLineParser& parser) override;
   void install(ConsoleContext& context) override;
   QString start() override;
 
@@ -50,7 +51,8 @@ class ReplayJob : public ConsoleJob {
   ReplayPanel* panel_ = nullptr;
   ReplayFeed* feed_ = nullptr;
   QDockWidget* dock_ = nullptr;
-  QString logDir_, replay_;
+  QString logDir_;  // where the session logs are: the session's
+  QString replay_;  // a log to open at the start; "" = none
 };
 
 }  // namespace sp

@@ -1,5 +1,11 @@
 #include "ui/jobs/sequence/sequence_job.h"
 
+#include <QCommandLineParser>
+
+#include <utility>
+
+#include "app/data/data_files.h"
+
 #include <algorithm>
 
 #include <QDockWidget>
@@ -15,6 +21,26 @@
 #include "ui/scene_view.h"
 
 namespace sp {
+
+QList<QCommandLineOption> SequenceJob::commandLineOptions() const {
+  return {QCommandLineOption(QStringLiteral("rules"),
+                             tr("Flight rules for rehearsals (default: built-in, see config/flight.rules)."),
+                             QStringLiteral("FILE")),
+          QCommandLineOption(QStringLiteral("sequence"), tr("Open this command sequence in the Sequence dock."),
+                             QStringLiteral("FILE"))};
+}
+
+QString SequenceJob::takeCommandLine(const QCommandLineParser& parser) {
+  // Named relative to the data folder (terrains/...) they are found there
+  // from any working directory (app/data/data_files.h).
+  for (const auto& [option, file] : {std::pair{QStringLiteral("rules"), &rules_}, std::pair{QStringLiteral("sequence"), &sequence_}}) {
+    if (!parser.isSet(option)) continue;
+    std::string error;
+    *file = QString::fromStdString(findDataFile(parser.value(option).toStdString(), error));
+    if (!error.empty()) return QString::fromStdString(error);  // "FILE: error: not found; looked in ..."
+  }
+  return {};
+}
 
 void SequenceJob::install(ConsoleContext& context) {
   context_ = &context;

@@ -20,11 +20,12 @@ class SequenceJob : public ConsoleJob {
   Q_OBJECT
 
  public:
-  /// `rules`: a flight rules file ("" = the built-in defaults); `sequence`:
-  /// a sequence file to open at the start ("" = none).
-  SequenceJob(QString rules, QString sequence, QObject* parent = nullptr)
-      : ConsoleJob(parent), rules_(std::move(rules)), sequence_(std::move(sequence)) {}
+  using ConsoleJob::ConsoleJob;
   QString name() const override { return QStringLiteral("sequence"); }
+  /// --rules FILE (flight rules; the built-in defaults without), --sequence
+  /// FILE (opened at the start), each found in the data folder too.
+  QList<QCommandLineOption> commandLineOptions() const override;
+  QString takeCommandLine(const QCommandLineParser& parser) override;
   void install(ConsoleContext& context) override;
   QString start() override;
   SequencePanel* panel() const { return panel_; }
@@ -35,7 +36,7 @@ class SequenceJob : public ConsoleJob {
   ConsoleContext* context_ = nullptr;
   SequencePanel* panel_ = nullptr;
   QDockWidget* dock_ = nullptr;
-  QString rules_, sequence_;
+  QString rules_, sequence_;  // files; "" = the built-in rules, no sequence
 };
 
 }  // namespace sp
