@@ -5,7 +5,7 @@
 #include <iostream>
 
 #include "app/data/data_files.h"
-#include "app/tools/headless_runner.h"
+#include "app/state/run_params.h"
 #include "sim/kinematics.h"
 #include "sim/model_loader.h"
 

@@ -5,7 +5,7 @@
 #include <chrono>
 
 #include "app/console/console_session.h"
-#include "app/console/robot_shapes.h"
+#include "app/state/robot_shapes.h"
 #include "ui/jobs/replay/replay_panel.h"
 #include "ui/robot_connection.h"
 

@@ -18,7 +18,7 @@
 #include <optional>
 #include <vector>
 
-#include "app/console/robot_frame.h"
+#include "app/state/robot_frame.h"
 #include "net/message.h"
 
 namespace sp {

@@ -9,10 +9,10 @@
 #include <cstdio>
 #include <memory>
 #include <mutex>
-#include <thread>
 #include <tuple>
 
-#include "app/console/robot_shapes.h"
+#include "app/state/parallel_for.h"
+#include "app/state/robot_shapes.h"
 #include "app/ghost/hold_policy.h"
 #include "app/log/resimulation.h"
 #include "app/log/session_log.h"
@@ -353,30 +353,24 @@ std::vector<std::optional<std::vector<double>>> runAll(const Problem& pb, const 
                                                        const std::function<bool()>& abort = {}) {
   std::vector<std::optional<std::vector<double>>> out(candidates.size());
   std::vector<std::string> whys(candidates.size());
-  std::atomic<size_t> next{0};
   std::mutex asking;  // `abort` is asked from one thread at a time
-  const auto work = [&] {
-    for (size_t i; (i = next++) < candidates.size();) {
-      if (abort) {
-        std::lock_guard lock(asking);
-        if (abort()) {
-          whys[i] = "cancelled";
-          continue;
-        }
-      }
-      // On a pool thread a throw would end the process: the candidate fails instead.
-      try {
-        out[i] = residuals(pb, candidates[i].values, whys[i], nullptr, candidates[i].jitter);
-      } catch (const std::exception& e) {
-        out[i].reset();
-        whys[i] = std::string("its twin failed: ") + e.what();
+  parallelFor(candidates.size(), threads, [&](size_t i) {
+    if (abort) {
+      std::lock_guard lock(asking);
+      if (abort()) {
+        whys[i] = "cancelled";
+        return true;  // every candidate gets its why
       }
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::min<int>(threads, static_cast<int>(candidates.size())); ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
+    // The candidate fails, not the fit: a twin that throws is a bad candidate.
+    try {
+      out[i] = residuals(pb, candidates[i].values, whys[i], nullptr, candidates[i].jitter);
+    } catch (const std::exception& e) {
+      out[i].reset();
+      whys[i] = std::string("its twin failed: ") + e.what();
+    }
+    return true;
+  });
   for (size_t i = 0; i < out.size(); ++i)
     if (!out[i]) {
       why = whys[i];

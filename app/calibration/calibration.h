@@ -54,7 +54,7 @@
 #include <string>
 #include <vector>
 
-#include "app/console/robot_frame.h"
+#include "app/state/robot_frame.h"
 #include "sim/command.h"
 #include "sim/params.h"
 #include "sim/robot_model.h"

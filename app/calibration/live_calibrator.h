@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "app/calibration/calibration.h"
-#include "app/console/robot_frame.h"
+#include "app/state/robot_frame.h"
 #include "sim/command.h"
 #include "sim/params.h"
 #include "sim/robot_model.h"

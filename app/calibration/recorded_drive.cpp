@@ -4,7 +4,7 @@
 #include <cmath>
 #include <memory>
 
-#include "app/console/robot_shapes.h"
+#include "app/state/robot_shapes.h"
 #include "sim/readout.h"
 #include "sim/runner.h"
 #include "sim/world.h"

@@ -1,13 +1,13 @@
 #include "app/console/console_session.h"
 
-#include "app/console/robot_shapes.h"
+#include "app/state/robot_shapes.h"
 #include "app/console/terrain_editor.h"
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 
-#include "app/tools/headless_runner.h"  // loadRunParams
+#include "app/state/run_params.h"
 #include "app/log/log_player.h"
 #include "app/log/resimulation.h"
 #include "app/log/session_recorder.h"

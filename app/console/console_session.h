@@ -24,7 +24,7 @@
 #include "app/calibration/live_calibrator.h"
 #include "app/ghost/ghost.h"
 #include "app/log/resimulation.h"
-#include "app/console/robot_frame.h"
+#include "app/state/robot_frame.h"
 #include "net/message.h"
 #include "net/robot_client.h"
 #include "sim/params.h"
@@ -94,6 +94,8 @@ class ConsoleSession {
   std::string openRobot(const std::string& path);
 
   bool remote() const { return !options_.connectTo.empty(); }
+  /// Where this session's logs go (and the logs to replay are looked for first).
+  const std::string& logDir() const { return options_.logDir; }
   /// Switches to the robot at HOST:PORT with `token`: the stand-in (if any)
   /// stops with its log complete, a new log of what the console sees
   /// starts. On a bad endpoint or token returns why and changes nothing.

@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "app/console/robot_frame.h"
+#include "app/state/robot_frame.h"
 #include "net/robot_client.h"
 
 namespace sp {

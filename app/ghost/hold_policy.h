@@ -16,7 +16,7 @@
 #include <utility>
 #include <vector>
 
-#include "app/console/robot_frame.h"
+#include "app/state/robot_frame.h"
 #include "app/ghost/in_flight.h"
 #include "sim/rigid.h"
 #include "sim/robot_model.h"

@@ -9,7 +9,7 @@
 #include <optional>
 #include <utility>
 
-#include "app/console/robot_frame.h"
+#include "app/state/robot_frame.h"
 #include "sim/math.h"
 
 namespace sp {

@@ -1,6 +1,6 @@
 #include "app/log/log_player.h"
 
-#include "app/console/robot_shapes.h"
+#include "app/state/robot_shapes.h"
 
 #include <algorithm>
 #include <cmath>

@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "app/rehearse/rehearsal.h"
 #include "app/log/resimulation.h"
-#include "app/console/robot_frame.h"
+#include "app/state/rehearsal_start.h"
+#include "app/state/robot_frame.h"
 #include "app/log/session_log.h"
 
 namespace sp {

@@ -1,6 +1,6 @@
 #include "app/log/session_log.h"
 
-#include "app/console/robot_shapes.h"
+#include "app/state/robot_shapes.h"
 
 #include <sqlite3.h>
 

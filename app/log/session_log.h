@@ -27,6 +27,7 @@
 #include <variant>
 #include <vector>
 
+#include "app/state/log_sample.h"
 #include "sim/command.h"
 #include "sim/hash.h"
 #include "sim/readout.h"  // fnv1a64: the hash of each logged file's contents
@@ -52,18 +53,6 @@ struct SessionInfo {
   std::string startTime;  ///< ISO-8601 UTC; "" = now
   std::vector<SessionFile> files;
   std::map<std::string, std::string> extraMeta;  ///< further meta keys (docs/session-format.md)
-};
-
-/// One state sample at the logging rate.
-struct LogSample {
-  int64_t step = 0;
-  double time = 0;                   ///< [s]
-  std::array<double, 3> base{};      ///< base link position, world [m]
-  std::array<double, 4> quat{1, 0, 0, 0};  ///< base orientation w, x, y, z
-  std::vector<double> joints;        ///< positions [rad or m] then velocities
-  std::array<double, 4> wheelNormal{};  ///< wheel normal forces FL, FR, RL, RR [N]
-  double roll = 0, pitch = 0;        ///< [rad]
-  friend bool operator==(const LogSample&, const LogSample&) = default;
 };
 
 /// One laser scan.
@@ -122,7 +111,7 @@ struct LogEvent {
 
 /// A read-out as logged: the base pose, every joint's position then rate,
 /// the wheel normal forces, roll and pitch (sim/readout.h).
-/// The row of readRobot(world, robot) (app/console/robot_shapes.h:
+/// The row of readRobot(world, robot) (app/state/robot_shapes.h:
 /// sampleFromReadout). Thread: the World's.
 LogSample makeLogSample(const World& world, int robot = 0);
 

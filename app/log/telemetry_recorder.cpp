@@ -1,6 +1,6 @@
 #include "app/log/telemetry_recorder.h"
 
-#include "app/console/robot_shapes.h"
+#include "app/state/robot_shapes.h"
 
 #include <cmath>
 

@@ -16,7 +16,7 @@
 #include <optional>
 #include <string>
 
-#include "app/console/robot_frame.h"
+#include "app/state/robot_frame.h"
 #include "app/log/session_log.h"
 #include "net/message.h"
 #include "sim/robot_model.h"

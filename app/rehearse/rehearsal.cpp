@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <deque>
 #include <mutex>
-#include <thread>
 
+#include "app/state/parallel_for.h"
 #include "sim/hash.h"
 #include "sim/kinematics.h"
 #include "sim/perturbation.h"
@@ -389,29 +389,22 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
   // Per sample, written by the worker threads: chars, not vector<bool>'s
   // shared bits, so two threads never write one word.
   std::vector<char> passed(static_cast<size_t>(n), 0), ranToTheEnd(static_cast<size_t>(n), 0);
-  std::atomic<int> next{0}, done{0}, refined{0};
-  std::atomic<bool> cancelled{false};
+  std::atomic<int> done{0}, refined{0};
   std::mutex progressMutex;
-  auto work = [&] {
-    for (int i; !cancelled && (i = next++) < n;) {
-      const RehearsalResult r = rehearse(perturbed(plan, seed + static_cast<uint64_t>(i)));
-      passed[static_cast<size_t>(i)] = r.passed;
-      out.failures[i] = r.summary();
-      if (!r.path.empty()) out.endPoses[i] = r.path.back().base;
-      out.endHashes[static_cast<size_t>(i)] = r.endHash;
-      ranToTheEnd[static_cast<size_t>(i)] = !r.stoppedEarly;
-      refined += !r.refined.empty();
-      const int d = ++done;
-      if (progress) {
-        std::lock_guard lock(progressMutex);
-        if (!progress(d, n)) cancelled = true;
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
+  parallelFor(static_cast<size_t>(n), threads, [&](size_t s) {
+    const int i = static_cast<int>(s);
+    const RehearsalResult r = rehearse(perturbed(plan, seed + static_cast<uint64_t>(i)));
+    passed[s] = r.passed;
+    out.failures[s] = r.summary();
+    if (!r.path.empty()) out.endPoses[s] = r.path.back().base;
+    out.endHashes[s] = r.endHash;
+    ranToTheEnd[s] = !r.stoppedEarly;
+    refined += !r.refined.empty();
+    const int d = ++done;
+    if (!progress) return true;
+    std::lock_guard lock(progressMutex);
+    return progress(d, n);  // false: cancelled
+  });
   out.samplePassed.assign(passed.begin(), passed.end());
   out.passed = static_cast<int>(std::count(passed.begin(), passed.end(), 1));
   out.refined = refined;

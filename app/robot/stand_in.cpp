@@ -6,7 +6,7 @@
 #include <chrono>
 #include <thread>
 
-#include "app/tools/headless_runner.h"
+#include "app/state/run_params.h"
 #include "app/log/session_recorder.h"
 #include "app/robot/twin_host.h"
 #include "net/auth.h"

@@ -1,6 +1,6 @@
 #include "app/robot/twin_host.h"
 
-#include "app/console/robot_shapes.h"
+#include "app/state/robot_shapes.h"
 
 #include <chrono>
 

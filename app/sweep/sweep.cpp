@@ -9,12 +9,12 @@
 #include <limits>
 #include <map>
 #include <sstream>
-#include <thread>
 
 #include "app/validation/plot_svg.h"
 #include "app/rehearse/rehearsal.h"
 #include "app/log/resimulation.h"
 #include "app/log/session_recorder.h"
+#include "app/state/parallel_for.h"
 #include "sim/command_check.h"
 #include "sim/command_file.h"
 #include "sim/flight_rules.h"
@@ -401,17 +401,11 @@ bool runSweepLocal(const std::string& dir, std::vector<int> indices, int threads
     indices = pendingTasks(dir, error);
     if (!error.empty()) return false;
   }
-  std::atomic<size_t> next{0};
-  const auto worker = [&] {
-    for (size_t k; (k = next++) < indices.size();) {
-      std::string taskError;
-      runSweepTask(dir, indices[k], taskError);  // its status file says how it went
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
+  parallelFor(indices.size(), threads, [&](size_t k) {
+    std::string taskError;
+    runSweepTask(dir, indices[k], taskError);  // its status file says how it went
+    return true;
+  });
   return true;
 }
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "app/tools/headless_runner.h"
+#include "app/run/headless_runner.h"
 
 namespace sp::test {
 

@@ -22,7 +22,7 @@
 #include <thread>
 
 #include "app/console/console_session.h"
-#include "app/console/robot_shapes.h"
+#include "app/state/robot_shapes.h"
 #include "app/log/session_log.h"
 #include "net/robot_client.h"
 #include "sim/model_loader.h"

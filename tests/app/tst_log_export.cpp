@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "app/tools/headless_runner.h"
+#include "app/run/headless_runner.h"
 #include "app/log/log_export.h"
 #include "tests/app/demo_log.h"
 

@@ -16,7 +16,7 @@
 #include <sstream>
 
 #include "tests/default_step.h"
-#include "app/tools/headless_runner.h"
+#include "app/run/headless_runner.h"
 #include "app/console/console_session.h"
 #include "app/log/log_player.h"
 #include "app/log/session_recorder.h"

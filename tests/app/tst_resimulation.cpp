@@ -13,7 +13,7 @@
 #include <sstream>
 
 #include "tests/default_step.h"
-#include "app/tools/headless_runner.h"
+#include "app/run/headless_runner.h"
 #include "app/log/resimulation.h"
 #include "app/log/session_log.h"
 #include "tests/app/demo_log.h"

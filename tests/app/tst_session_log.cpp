@@ -13,7 +13,7 @@
 #include <thread>
 
 #include "tests/default_step.h"
-#include "app/tools/headless_runner.h"
+#include "app/run/headless_runner.h"
 #include "app/log/session_log.h"
 #include "app/log/snapshot_codec.h"
 #include "sim/model_loader.h"

@@ -5,11 +5,16 @@
 
 #include <QTest>
 
+#include <atomic>
 #include <chrono>
+#include <mutex>
+#include <set>
+#include <stdexcept>
 #include <thread>
 
 #include "app/calibration/live_calibrator.h"
-#include "app/console/robot_shapes.h"
+#include "app/state/parallel_for.h"
+#include "app/state/robot_shapes.h"
 #include "app/ghost/ghost.h"
 #include "sim/model_loader.h"
 #include "sim/readout.h"
@@ -53,6 +58,55 @@ double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>
 
 class TestWorkerGuards : public QObject {
   Q_OBJECT
+
+  // The one parallel-for (app/state/parallel_for.h): every index once on
+  // the threads asked for; a body returning false stops what is not begun;
+  // a throw on a pool thread comes back on the caller's (it used to end the
+  // process) once every thread is done.
+  void parallelForEachOnceAndThrowsBack() {
+    std::vector<std::atomic<int>> seen(1000);
+    std::mutex idsMutex;
+    std::set<std::thread::id> ids;
+    parallelFor(seen.size(), 4, [&](size_t i) {
+      ++seen[i];
+      std::lock_guard lock(idsMutex);
+      ids.insert(std::this_thread::get_id());
+      return true;
+    });
+    for (const std::atomic<int>& s : seen) QCOMPARE(s.load(), 1);
+    QVERIFY(ids.size() >= 1 && ids.size() <= 4);
+    QVERIFY(ids.count(std::this_thread::get_id()));  // the caller works too
+    std::atomic<int> ran{0};
+    parallelFor(1000, 1, [&](size_t i) { return ++ran, i < 9; });
+    QCOMPARE(ran.load(), 10);  // one thread: index 9 said stop
+    std::atomic<int> after{0};
+    bool thrown = false;
+    try {
+      parallelFor(1000, 3, [&](size_t i) {
+        if (i == 5) throw std::runtime_error("candidate 5");
+        ++after;
+        return true;
+      });
+    } catch (const std::runtime_error& e) {
+      thrown = std::string(e.what()) == "candidate 5";
+    }
+    QVERIFY(thrown);
+    // On one thread the order is the indices': nothing after the throw ran.
+    after = 0;
+    thrown = false;
+    try {
+      parallelFor(1000, 1, [&](size_t i) {
+        if (i == 5) throw std::runtime_error("candidate 5");
+        ++after;
+        return true;
+      });
+    } catch (const std::runtime_error&) {
+      thrown = true;
+    }
+    QVERIFY(thrown);
+    QCOMPARE(after.load(), 5);
+    parallelFor(0, 4, [&](size_t) -> bool { qFatal("no index to run"); });
+  }
 
  private slots:
   // A model ODE refuses (a link of negative mass, as a wild fit could make)

@@ -62,8 +62,4 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
                                      const ClockFn& clock, const SleepUntilFn& sleepUntil,
                                      const std::atomic<bool>* stop = nullptr);
 
-/// Loads the parameters: defaults, then the file, then the overrides.
-std::optional<SimParams> loadRunParams(const std::string& paramsFile,
-                                       const std::vector<std::string>& overrides, Diagnostics& diag);
-
 }  // namespace sp

@@ -1,4 +1,4 @@
-#include "app/tools/headless_runner.h"
+#include "app/run/headless_runner.h"
 
 #include <cmath>
 #include <cstdio>
@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "app/log/session_recorder.h"
+#include "app/state/run_params.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
 #include "sim/pacer.h"
@@ -52,15 +53,6 @@ class CsvWriter {
 };
 
 }  // namespace
-
-std::optional<SimParams> loadRunParams(const std::string& paramsFile, const std::vector<std::string>& overrides,
-                                       Diagnostics& diag) {
-  SimParams params;
-  bool ok = paramsFile.empty() || loadParams(paramsFile, params, diag);
-  for (const std::string& o : overrides) ok = applyOverride(params, o, diag) && ok;
-  if (!ok) return std::nullopt;
-  return params;
-}
 
 std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& out, std::ostream& err,
                                      const ClockFn& clock, const SleepUntilFn& sleepUntil,

@@ -7,7 +7,7 @@
 //   net::RobotState     what the robot side sends (net/robot_server.h)
 //   net::TelemetryMsg   what arrives over the link (net/message.h)
 //   LogSample           a row of a session log (app/log/session_log.h)
-//   RobotFrame          what the console's views draw (app/console/robot_frame.h)
+//   RobotFrame          what the console's views draw (app/state/robot_frame.h)
 //   GhostView           what the ghost predicts (app/ghost/ghost.h)
 //
 //   RobotReadout ──stateFromReadout──► RobotState ──(link)──► TelemetryMsg
@@ -23,9 +23,9 @@
 #include <string>
 #include <vector>
 
-#include "app/console/robot_frame.h"
-#include "app/ghost/ghost.h"
-#include "app/log/session_log.h"
+#include "app/state/robot_frame.h"
+#include "app/state/ghost_view.h"
+#include "app/state/log_sample.h"
 #include "net/message.h"
 #include "net/robot_server.h"
 #include "sim/readout.h"

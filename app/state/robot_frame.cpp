@@ -1,4 +1,4 @@
-#include "app/console/robot_frame.h"
+#include "app/state/robot_frame.h"
 
 #include "sim/robot_model.h"
 

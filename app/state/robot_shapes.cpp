@@ -1,4 +1,4 @@
-#include "app/console/robot_shapes.h"
+#include "app/state/robot_shapes.h"
 
 namespace sp {
 
