@@ -14,7 +14,7 @@ namespace {
 // WorkPartner on flat ground) ODE's simple space, which tests every pair's
 // boxes, makes a rehearsal ~11 % faster than the hash space, whose every
 // collide call allocates its cells; at 131 geoms it is still 6 % faster, at
-// 231 46 % slower (docs/performance.md "The broad phase"). Results are the
+// 231 46 % slower (docs/performance-log.md "The broad phase"). Results are the
 // same in either: World::collide sorts the contacts by our own geom
 // indices, whatever order a space gives the pairs.
 constexpr size_t kSimpleSpaceGeoms = 128;

@@ -179,7 +179,7 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
 /// (A fading memory, the prior's variance grown to the difference where a
 /// fit lies beyond the deviations, was measured and left out: the track's
 /// ghost 1.16x the matched twin's error against 1.12x, radius error up to
-/// 0.89 % against 0.44 %; docs/performance.md, "Honest deviations".)
+/// 0.89 % against 0.44 %; docs/performance-log.md, "Honest deviations".)
 /// `overlap`: how many fits each frame is in (window over period: the live
 /// fitter's 8 s every 3 s is 2.7); the fit's variances are multiplied by
 /// it, so that overlapping windows are not counted as independent.
@@ -194,7 +194,7 @@ CalValues significantValues(const CalEstimate& estimate);
 /// Two deviations, the usual test, now that the deviations are the fits'
 /// own scatter's (at half a deviation of the old, floored ones a robot
 /// that is its twin kept its twin; at none it got a spurious 1.9 %
-/// diagonal split on flat ground). docs/performance.md, "Honest deviations".
+/// diagonal split on flat ground). docs/performance-log.md, "Honest deviations".
 constexpr double kSignificance = 2;
 
 /// How far the twin calibrated by `values` lands from the robot `horizon`

@@ -64,7 +64,7 @@ class LiveCalibrator {
     /// on both cores at nice 10; each after the first only when the last
     /// left time for it within a period, so that a fit lands every period
     /// or so even on a loaded machine. (Three, not two, since the centre of
-    /// mass is fitted: docs/performance.md, "A third step again".)
+    /// mass is fitted: docs/performance-log.md, "A third step again".)
     CalibrationOptions fit = [] {
       CalibrationOptions o;
       o.window = 8;
