@@ -1,5 +1,6 @@
 // Calibration from telemetry (app/calibration/calibration.h): the segments,
-// the candidate twins, Levenberg-Marquardt and the load-cell mass.
+// the candidate twins, Levenberg-Marquardt, the checks of what was fitted
+// (the parameters in calibration_params.cpp, the load fits in calibration_loads.cpp).
 #include "app/calibration/calibration.h"
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <mutex>
 #include <tuple>
 
+#include "app/calibration/usable_frames.h"
 #include "app/state/parallel_for.h"
 #include "app/state/robot_shapes.h"
 #include "app/ghost/hold_policy.h"
@@ -26,86 +28,7 @@
 
 namespace sp {
 
-const std::array<CalParamInfo, kCalParams>& calParams() {
-  // Bounds are calibration.*'s in sim/params.cpp; scales the issue's ranges
-  // of a real robot's deviations (sim/perturbation.h), so that "observed"
-  // means "pinned well inside what a robot may differ by".
-  static const std::array<CalParamInfo, kCalParams> table{{
-      // Probes of half a scale: a smaller one drowns in the contacts' noise.
-      {"calibration.wheel_radius", "wheel radius", "", 1, 0.8, 1.2, 0.03, 0.015, 0},
-      {"calibration.wheel_radius_split", "radius front - rear", "", 0, -0.1, 0.1, 0.03, 0.015, 0},
-      {"calibration.wheel_radius_side", "radius left - right", "", 0, -0.1, 0.1, 0.03, 0.015, 0},
-      {"calibration.wheel_radius_diag", "radius FL+RR - FR+RL", "", 0, -0.1, 0.1, 0.03, 0.015, 0},
-      {"calibration.friction", "tyre friction", "", 1, 0.3, 3, 0.3, 0.15, 0},
-      {"calibration.motor_gain", "wheel motor gain", "", 1, 0.5, 1.5, 0.2, 0.1, 0},
-      {"calibration.delay", "command delay", "s", 0, 0, 0.5, 0.06, 0.03, 0},
-      {"calibration.mass", "total mass", "", 1, 0.5, 2, 0.15, 0, 0},
-      // Each link's centre may be 2 cm off on each axis (sim/perturbation.h);
-      // the robot's, their mass-weighted mean, rather less.
-      {"calibration.com_x", "centre of mass forward", "m", 0, -0.1, 0.1, 0.02, 0, kComBias},
-      {"calibration.com_y", "centre of mass left", "m", 0, -0.1, 0.1, 0.02, 0, kComBias},
-  }};
-  return table;
-}
-
-namespace {
-
-// Where each parameter lives in SimParams, in CalParam order: the one
-// table calValues and withCalValues read.
-constexpr std::array<double SimParams::*, kCalParams> kCalFields{
-    &SimParams::calWheelRadius, &SimParams::calWheelRadiusSplit, &SimParams::calWheelRadiusSide,
-    &SimParams::calWheelRadiusDiag, &SimParams::calFriction, &SimParams::calMotorGain,
-    &SimParams::calDelay, &SimParams::calMass, &SimParams::calComX, &SimParams::calComY};
-
-}  // namespace
-
-CalValues calValues(const SimParams& p) {
-  CalValues v{};
-  for (size_t i = 0; i < kCalParams; ++i) v[i] = p.*kCalFields[i];
-  return v;
-}
-
-SimParams withCalValues(SimParams p, const CalValues& v) {
-  for (size_t i = 0; i < kCalParams; ++i) p.*kCalFields[i] = v[i];
-  return p;
-}
-
-CalValues filesCalValues() { return calValues(SimParams{}); }
-
-CalEstimate filesEstimate() {
-  CalEstimate e;
-  e.value = filesCalValues();
-  return e;
-}
-
-CalValues significantValues(const CalEstimate& e) {
-  CalValues out = e.value;
-  for (size_t i = 0; i < kCalParams; ++i)
-    if (e.observed[i] && std::abs(e.value[i] - calParams()[i].files) <= kSignificance * e.sigma[i]) out[i] = calParams()[i].files;
-  return out;
-}
-
-CalEstimate fuse(const CalEstimate& prior, const CalibrationFit& fit, double overlap) {
-  CalEstimate out = prior;
-  out.time = std::max(prior.time, fit.to);
-  const double dt = std::max(0.0, fit.to - prior.time);
-  for (size_t i = 0; i < kCalParams; ++i) {
-    if (!fit.observed[i] || !(fit.sigma[i] > 0) || !std::isfinite(fit.sigma[i])) continue;  // no information
-    const double sigma = fit.sigma[i] * std::sqrt(std::max(1.0, overlap));
-    if (!prior.observed[i]) {
-      out.value[i] = fit.value[i];
-      out.sigma[i] = sigma;
-      out.observed[i] = true;
-      continue;
-    }
-    const double drift = kDrift * calParams()[i].scale;
-    const double p = prior.sigma[i] * prior.sigma[i] + drift * drift * dt;
-    const double q = sigma * sigma;
-    out.value[i] = (prior.value[i] * q + fit.value[i] * p) / (p + q);
-    out.sigma[i] = std::max(std::sqrt(p * q / (p + q)), calParams()[i].floor);
-  }
-  return out;
-}
+using calibration_detail::usableFrames;
 
 namespace {
 
@@ -156,33 +79,6 @@ struct Problem {
   std::array<int, 4> wheels{-1, -1, -1, -1};
   int articulation = -1;
 };
-
-// The robot's frames for calibration: the healthy, unlatched ones, with a
-// base twist from their neighbours where the source did not report one (a
-// session log's samples carry none).
-std::vector<RobotFrame> usableFrames(const std::vector<RobotFrame>& in, double window) {
-  std::vector<RobotFrame> f;
-  const double from = in.empty() || window <= 0 ? -1e300 : in.back().time - window;
-  for (const RobotFrame& r : in)
-    if (r.time >= from && r.health.empty() && !r.estop && !r.failsafe && (f.empty() || r.time > f.back().time))
-      f.push_back(r);
-  for (size_t i = 0; i < f.size(); ++i) {
-    if (f[i].hasBaseVelocity) continue;
-    const RobotFrame& a = f[i == 0 ? 0 : i - 1];
-    const RobotFrame& b = f[i + 1 < f.size() ? i + 1 : i];
-    const double dt = b.time - a.time;
-    if (dt <= 0) continue;
-    f[i].baseLinearVelocity = (1 / dt) * (b.base.p - a.base.p);
-    // Rotation vector of a -> b, world frame.
-    Quat d = b.base.q * conjugate(a.base.q);
-    if (d.w < 0) d = Quat{-d.w, -d.x, -d.y, -d.z};
-    const double s = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    const double angle = 2 * std::atan2(s, d.w);
-    f[i].baseAngularVelocity = s > 1e-12 ? (angle / dt / s) * Vec3{d.x, d.y, d.z} : Vec3{};
-    f[i].hasBaseVelocity = true;
-  }
-  return f;
-}
 
 // The frame nearest robot time `t`, if one lies within `tolerance`.
 std::optional<size_t> frameAt(const std::vector<RobotFrame>& f, double t, double tolerance) {
@@ -492,207 +388,6 @@ std::optional<std::pair<double, double>> massFromLoads(const WorldModel& files, 
 
 namespace {
 
-// Each link's mass properties, and the robot's total mass.
-std::vector<MassProperties> linkMasses(const RobotModel& robot, double& total) {
-  std::vector<MassProperties> mass;
-  total = 0;
-  for (const LinkSpec& l : robot.links) total += mass.emplace_back(massProperties(l)).mass;
-  return mass;
-}
-
-// The centre of mass of `robot` at a pose (its links' motions `m`).
-Vec3 centreAt(const std::vector<MassProperties>& mass, double total, const std::vector<LinkMotion>& m) {
-  Vec3 centre{};
-  for (size_t i = 0; i < mass.size(); ++i) centre = centre + (mass[i].mass / total) * transformPoint(m[i].pose, mass[i].centre);
-  return centre;
-}
-
-// Least squares of (com_x, com_y) over frames. The parameter moves each
-// link's centre in its own frame at zero pose, so at a frame's pose the
-// robot's centre moves by A (com_x, com_y), A the mass-weighted mean of the
-// links' turns since zero pose (a bent leg turns its part of a forward shift
-// downward): the twin's own meaning of calibration.com_x. Each row: A (2 x 2,
-// by rows) and the centre's observed move d, in the robot's heading.
-class CentreFit {
- public:
-  CentreFit(const RobotModel& robot, const std::vector<MassProperties>& mass, double total)
-      : robot_(robot), mass_(mass), total_(total) {}
-  void add(const std::vector<LinkMotion>& m, const Quat& base, Vec3 moved) {
-    Vec3 ux{}, uy{};
-    for (size_t i = 0; i < mass_.size(); ++i) {
-      const double share = mass_[i].mass / total_;
-      const Quat turned = m[i].pose.q * conjugate(robot_.links[i].pose.q);
-      ux = ux + share * rotate(turned, Vec3{1, 0, 0});
-      uy = uy + share * rotate(turned, Vec3{0, 1, 0});
-    }
-    const double c = std::cos(heading(base)), s = std::sin(heading(base));
-    const auto fwd = [&](Vec3 v) { return c * v.x + s * v.y; };
-    const auto lft = [&](Vec3 v) { return -s * v.x + c * v.y; };
-    rows_.push_back({fwd(ux), fwd(uy), lft(ux), lft(uy), fwd(moved), lft(moved)});
-  }
-  std::optional<LoadCentre> solve() const {
-    double n11 = 0, n12 = 0, n22 = 0, b1 = 0, b2 = 0;
-    for (const auto& r : rows_) {
-      n11 += r[0] * r[0] + r[2] * r[2];
-      n12 += r[0] * r[1] + r[2] * r[3];
-      n22 += r[1] * r[1] + r[3] * r[3];
-      b1 += r[0] * r[4] + r[2] * r[5];
-      b2 += r[1] * r[4] + r[3] * r[5];
-    }
-    const double det = n11 * n22 - n12 * n12;
-    if (rows_.size() < 50 || !(det > 0)) return std::nullopt;
-    LoadCentre out;
-    out.forward = (n22 * b1 - n12 * b2) / det;
-    out.left = (n11 * b2 - n12 * b1) / det;
-    double ss = 0;
-    for (const auto& r : rows_) {
-      const double ef = r[4] - r[0] * out.forward - r[1] * out.left, el = r[5] - r[2] * out.forward - r[3] * out.left;
-      ss += ef * ef + el * el;
-    }
-    // Neighbouring frames are not independent (the body rocks over ~0.2 s):
-    // one sample per 10 frames.
-    const double s2 = ss / static_cast<double>(2 * rows_.size() - 2) * 10;
-    out.sigmaForward = std::sqrt(s2 * n22 / det);
-    out.sigmaLeft = std::sqrt(s2 * n11 / det);
-    out.frames = static_cast<int>(rows_.size());
-    return out;
-  }
-
- private:
-  const RobotModel& robot_;
-  const std::vector<MassProperties>& mass_;
-  double total_;
-  std::vector<std::array<double, 6>> rows_;
-};
-
-}  // namespace
-
-std::optional<LoadCentre> comFromLoads(const WorldModel& files, const std::vector<RobotFrame>& f) {
-  if (files.robots.empty() || !files.robots[0].model.drive) return std::nullopt;
-  const RobotModel& robot = files.robots[0].model;
-  const DriveSpec& drive = *robot.drive;
-  const double g = norm(files.gravity);
-  if (!(g > 0)) return std::nullopt;
-  double total = 0;
-  const std::vector<MassProperties> mass = linkMasses(robot, total);
-  std::array<Vec3, 4> hub{};  // each hub in its wheel link's frame
-  for (size_t w = 0; w < 4; ++w) {
-    if (drive.wheels[w] < 0) return std::nullopt;
-    const JointSpec& j = robot.joints[static_cast<size_t>(drive.wheels[w])];
-    hub[w] = transformPoint(inverse(robot.links[static_cast<size_t>(j.child)].pose), j.anchor);
-  }
-  const TerrainSpec& terrain = files.terrain;
-  const auto groundNormal = [&](Vec3 at) {
-    if (terrain.kind != TerrainSpec::Kind::Heightfield) return Vec3{0, 0, 1};
-    // Over a tyre's half width of ground either way: the contact spreads.
-    const Vec3 l = transformPoint(inverse(terrain.pose), at);
-    const double e = drive.wheelRadius / 2;
-    const double gx = (terrain.grid.heightAt(l.x + e, l.y) - terrain.grid.heightAt(l.x - e, l.y)) / (2 * e);
-    const double gy = (terrain.grid.heightAt(l.x, l.y + e) - terrain.grid.heightAt(l.x, l.y - e)) / (2 * e);
-    return rotate(terrain.pose.q, normalized(Vec3{-gx, -gy, 1}));
-  };
-  CentreFit fit(robot, mass, total);
-  for (size_t k = 1; k + 1 < f.size(); ++k) {
-    const RobotFrame& r = f[k];
-    const double dt = f[k + 1].time - f[k - 1].time;
-    if (!r.hasBaseVelocity || !(dt > 0) || dt > 0.1 || r.jointPositions.size() != robot.joints.size()) continue;
-    const std::vector<LinkMotion> m =
-        linkMotions(robot, r.base, r.baseLinearVelocity, r.baseAngularVelocity, r.jointPositions, r.jointRates);
-    const Vec3 centre = centreAt(mass, total, m);
-    Vec3 balance{};
-    double load = 0, ground = 0;
-    for (size_t w = 0; w < 4; ++w) {
-      const Vec3 at = transformPoint(m[static_cast<size_t>(robot.joints[static_cast<size_t>(drive.wheels[w])].child)].pose, hub[w]);
-      const Vec3 n = groundNormal(at);
-      const double vertical = r.wheelNormal[w] * n.z;
-      const Vec3 contact = at - drive.wheelRadius * n;
-      balance = balance + vertical * contact;
-      load += vertical;
-      ground += contact.z / 4;
-    }
-    if (!(load > 0)) continue;
-    balance = (1 / load) * balance;
-    // Accelerating, the ground's push below the centre loads the rear: the
-    // balance point lies h a / g behind the centre.
-    const Vec3 a = (1 / dt) * (f[k + 1].baseLinearVelocity - f[k - 1].baseLinearVelocity);
-    fit.add(m, r.base.q, balance + ((centre.z - ground) / g) * a - centre);
-  }
-  return fit.solve();
-}
-
-std::optional<LoadCentre> centreShift(const RobotModel& files, const RobotModel& robot, const std::vector<RobotFrame>& f) {
-  if (robot.links.size() != files.links.size()) return std::nullopt;
-  double total = 0, robotTotal = 0;
-  const std::vector<MassProperties> mass = linkMasses(files, total), robotMass = linkMasses(robot, robotTotal);
-  CentreFit fit(files, mass, total);
-  for (const RobotFrame& r : f) {
-    if (r.jointPositions.size() != files.joints.size()) continue;
-    const std::vector<LinkMotion> m =
-        linkMotions(files, r.base, r.baseLinearVelocity, r.baseAngularVelocity, r.jointPositions, r.jointRates);
-    fit.add(m, r.base.q, centreAt(robotMass, robotTotal, m) - centreAt(mass, total, m));
-  }
-  return fit.solve();
-}
-
-RollingRadii radiiFromRolling(const WorldModel& files, const std::vector<RobotFrame>& in) {
-  RollingRadii out;
-  if (files.robots.empty() || !files.robots[0].model.drive) return out;
-  const RobotModel& robot = files.robots[0].model;
-  const DriveSpec& drive = *robot.drive;
-  const std::vector<RobotFrame> frames = usableFrames(in, 0);
-  std::array<std::vector<std::pair<double, double>>, 4> samples;  // (spin [rad/s], speed across the axle [m/s])
-  for (const RobotFrame& f : frames) {
-    if (f.jointPositions.size() != robot.joints.size() || f.jointRates.size() != robot.joints.size()) continue;
-    const std::vector<LinkMotion> m =
-        linkMotions(robot, f.base, f.baseLinearVelocity, f.baseAngularVelocity, f.jointPositions, f.jointRates);
-    for (size_t w = 0; w < 4; ++w) {
-      if (drive.wheels[w] < 0) continue;
-      const JointSpec& joint = robot.joints[static_cast<size_t>(drive.wheels[w])];
-      const WheelRolling roll = wheelRolling(robot, joint, m[static_cast<size_t>(joint.child)]);
-      if (std::abs(roll.spin) < 0.5) continue;
-      // Signed: the hub moves the way the spin rolls it on level ground.
-      const double sign = dot(roll.across, cross(roll.axle, Vec3{0, 0, 1})) * roll.spin > 0 ? 1.0 : -1.0;
-      samples[w].push_back({std::abs(roll.spin), sign * norm(roll.across)});
-    }
-  }
-  for (size_t w = 0; w < 4; ++w) {
-    std::vector<std::pair<double, double>>& s = samples[w];
-    if (s.size() < 50) continue;
-    std::vector<double> ratio;
-    for (const auto& [spin, speed] : s) ratio.push_back(speed / spin);
-    std::vector<double> sorted = ratio;
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
-    const double med = sorted[sorted.size() / 2];
-    double ss = 0, sv = 0;
-    std::vector<std::pair<double, double>> kept;
-    for (size_t i = 0; i < s.size(); ++i)
-      if (std::abs(ratio[i] - med) < 0.05 * std::abs(med)) kept.push_back(s[i]);
-    for (const auto& [spin, speed] : kept) {
-      ss += spin * spin;
-      sv += spin * speed;
-    }
-    out.slipping[w] = 1 - static_cast<double>(kept.size()) / static_cast<double>(s.size());
-    if (kept.size() < 50 || ss <= 0) continue;
-    const double r = sv / ss;
-    double e2 = 0;
-    for (const auto& [spin, speed] : kept) e2 += (speed - r * spin) * (speed - r * spin);
-    // Neighbouring frames are not independent: one sample per 10.
-    const double n = static_cast<double>(kept.size());
-    out.factor[w] = r / drive.wheelRadius;
-    out.sigma[w] = std::sqrt(e2 / (n - 1) / ss * 10) / drive.wheelRadius;
-    out.frames[w] = static_cast<int>(kept.size());
-  }
-  return out;
-}
-
-std::array<double, 4> radiusValues(const std::array<double, 4>& w) {
-  const double sum = w[0] + w[1] + w[2] + w[3];
-  return {sum / 4, 2 * ((w[0] + w[1]) - (w[2] + w[3])) / sum, 2 * ((w[0] + w[2]) - (w[1] + w[3])) / sum,
-          2 * ((w[0] + w[3]) - (w[1] + w[2])) / sum};
-}
-
-namespace {
-
 // The fit's problem over `frames` (usable, oldest first): the twin's
 // weld, the commands in order, the driving segments. "" or why not.
 std::string makeProblem(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& frames,
@@ -715,16 +410,6 @@ std::string makeProblem(const WorldModel& files, const SimParams& profile, const
 }
 
 }  // namespace
-
-std::string boundsRefusal(const CalParamInfo& info, double value) {
-  // In words and the parameter's unit, three digits: what the operator
-  // reads in the Calibration panel (issue 59: a raw key with 16 digits).
-  const std::string unit = *info.unit ? std::string(" ") + info.unit : std::string(" ×");
-  char text[200];
-  std::snprintf(text, sizeof text, "the %s came out at %.3g%s, outside what the robot can have (%.3g to %.3g%s; %s)",
-                info.label, value, unit.c_str(), info.lower, info.upper, unit.c_str(), info.key);
-  return text;
-}
 
 CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& frames,
                               const std::vector<TimedCommand>& commands, const CalEstimate& from, CalibrationOptions options,
@@ -1147,18 +832,6 @@ std::optional<CalibrationInput> calibrationInput(const std::string& path, std::s
     in.commands.push_back(TimedCommand{c.time, std::move(*command), 0});
   }
   return in;
-}
-
-std::string calibrationParamsText(const CalibrationFit& fit) {
-  std::string out = "# Calibration fitted from telemetry " + shortestText(fit.from) + " - " + shortestText(fit.to) +
-                    " s (" + std::to_string(fit.segments) + " segments; app/calibration/calibration.h)\n";
-  for (size_t i = 0; i < kCalParams; ++i) {
-    const CalParamInfo& info = calParams()[i];
-    out += "# " + std::string(info.label) + ": " +
-           (fit.observed[i] ? "+- " + shortestText(fit.sigma[i]) : std::string("unobserved, the files' or the previous value")) + "\n";
-    out += std::string(info.key) + " = " + shortestText(fit.value[i]) + "\n";
-  }
-  return out;
 }
 
 }  // namespace sp
