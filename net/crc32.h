@@ -1,7 +1,8 @@
 #pragma once
 // CRC-32 as in IEEE 802.3, zlib and PNG: reflected, polynomial 0xEDB88320,
 // initial value and final xor 0xFFFFFFFF. The check value of the nine
-// bytes "123456789" is 0xCBF43926. Used by the frame codec (net/frame.h).
+// bytes "123456789" is 0xCBF43926. Used by the frame codec (net/frame.h);
+// computed by zlib's crc32 (the same CRC).
 
 #include <cstddef>
 #include <cstdint>
@@ -19,12 +20,12 @@ class Crc32 {
   void update(std::string_view bytes) { update(bytes.data(), bytes.size()); }
 
   /// The CRC of every byte added since construction or reset().
-  uint32_t value() const { return ~state_; }
+  uint32_t value() const { return crc_; }
 
-  void reset() { state_ = 0xFFFFFFFFu; }
+  void reset() { crc_ = 0; }
 
  private:
-  uint32_t state_ = 0xFFFFFFFFu;
+  uint32_t crc_ = 0;  // the finished CRC so far (zlib's running value)
 };
 
 /// The CRC-32 of `bytes` in one call.
