@@ -3,18 +3,10 @@
 #include "app/tools/sim_tool.h"
 
 #include <algorithm>
-#include <atomic>
-#include <chrono>
-#include <cmath>
-#include <csignal>
-#include <cerrno>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
-#include <filesystem>
 #include <cstdio>
 #include <iostream>
-#include <limits>
 #include <string>
 #include <thread>
 #include <vector>

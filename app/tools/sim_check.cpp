@@ -2,21 +2,9 @@
 
 #include "app/tools/sim_tool.h"
 
-#include <algorithm>
-#include <atomic>
-#include <chrono>
-#include <cmath>
-#include <csignal>
-#include <cerrno>
-#include <cstdlib>
-#include <cstring>
-#include <fstream>
 #include <filesystem>
-#include <cstdio>
 #include <iostream>
-#include <limits>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "sim/command_file.h"
