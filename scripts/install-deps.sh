@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config
-  libode-dev libtinyxml2-dev libsqlite3-dev libasio-dev libssl-dev zlib1g-dev
+  libode-dev libtinyxml2-dev libsqlite3-dev libasio-dev libssl-dev zlib1g-dev libeigen3-dev
   qt6-base-dev libqt6opengl6-dev qt6-charts-dev libopenscenegraph-dev
   libxml2-utils xvfb xauth mesa-utils libgl1-mesa-dri imagemagick x11-apps
   python3 clang libclang-rt-14-dev
