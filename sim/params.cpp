@@ -1,5 +1,6 @@
 #include "sim/params.h"
 
+#include "sim/calibration_table.h"
 #include "sim/file_set.h"
 #include "sim/properties.h"
 
@@ -66,7 +67,7 @@ using Getter = std::function<std::string(const SimParams& params)>;
 
 struct Entry {
   const char* key;
-  const char* description;
+  std::string description;
   Setter set;
   Getter get;
 };
@@ -154,15 +155,25 @@ Accessors jointNames(std::string SimParams::*field) {
           [field](const SimParams& p) { return p.*field; }};
 }
 
-Entry entry(const char* key, const char* description, Accessors a) {
-  return {key, description, std::move(a.set), std::move(a.get)};
+Entry entry(const char* key, std::string description, Accessors a) {
+  return {key, std::move(description), std::move(a.set), std::move(a.get)};
+}
+
+// The calibration.* keys, from their one table.
+std::vector<Entry> calibrationEntries() {
+  std::vector<Entry> out;
+  for (const CalParamInfo& c : calParams())
+    out.push_back(entry(c.key,
+                        std::string(c.description) + ", [" + shortestText(c.lower) + ", " + shortestText(c.upper) + "]",
+                        real(c.field, closed(c.lower, c.upper))));
+  return out;
 }
 
 // The one list of keys, in the order of config/defaults.params. Defaults are
 // not repeated here: they are SimParams' in-class initializers.
 const std::vector<Entry>& table() {
   constexpr double kMaxRate = 10000;
-  static const std::vector<Entry> entries = {
+  static const std::vector<Entry> before = {
       // At least 10 us: a finer step simulates nothing in any useful time
       // (1e-300 ran "1 s" as zero steps and exited 0).
       entry("physics.step", "fixed integration step [s], [1e-05, 0.1]",
@@ -239,26 +250,10 @@ const std::vector<Entry>& table() {
             real(&SimParams::ghostAnchorRate, closed(1, 1000))),
       entry("ghost.hold", "ghost: joints whose subtrees it holds rigid while still (the drive's joints turn), comma-separated, or none",
             jointNames(&SimParams::ghostHold)),
-      entry("calibration.wheel_radius", "twins: factor on the tyres' effective radius, both axles, [0.8, 1.2]",
-            real(&SimParams::calWheelRadius, closed(0.8, 1.2))),
-      entry("calibration.wheel_radius_split", "twins: front minus rear tyre radius, relative, [-0.1, 0.1]",
-            real(&SimParams::calWheelRadiusSplit, closed(-0.1, 0.1))),
-      entry("calibration.wheel_radius_side", "twins: left minus right tyre radius, relative, [-0.1, 0.1]",
-            real(&SimParams::calWheelRadiusSide, closed(-0.1, 0.1))),
-      entry("calibration.wheel_radius_diag", "twins: front-left and rear-right minus front-right and rear-left tyre radius, relative, [-0.1, 0.1]",
-            real(&SimParams::calWheelRadiusDiag, closed(-0.1, 0.1))),
-      entry("calibration.friction", "twins: factor on every contact's friction, [0.3, 3]",
-            real(&SimParams::calFriction, closed(0.3, 3))),
-      entry("calibration.motor_gain", "twins: the wheel motors reach this times the commanded speed, [0.5, 1.5]",
-            real(&SimParams::calMotorGain, closed(0.5, 1.5))),
-      entry("calibration.delay", "twins: a command acts this long after it arrives [s], [0, 0.5]",
-            real(&SimParams::calDelay, closed(0, 0.5))),
-      entry("calibration.mass", "twins: factor on every link's mass, [0.5, 2]",
-            real(&SimParams::calMass, closed(0.5, 2))),
-      entry("calibration.com_x", "twins: [m] the centre of mass moved forward (every link's centre), [-0.1, 0.1]",
-            real(&SimParams::calComX, closed(-0.1, 0.1))),
-      entry("calibration.com_y", "twins: [m] the centre of mass moved left (every link's centre), [-0.1, 0.1]",
-            real(&SimParams::calComY, closed(-0.1, 0.1))),
+  };
+  // Appended in place: the keys keep the order of config/defaults.params.
+  static const std::vector<Entry> calibration = calibrationEntries();
+  static const std::vector<Entry> after = {
       entry("gait.caterpillar.hip_swing", "caterpillar: hip swing about the stance pose [deg], (0, 45]",
             real(&SimParams::caterpillarHipSwing, openClosed(0, 45))),
       entry("gait.caterpillar.phase_time", "caterpillar: duration of each half cycle [s], (0, 60]",
@@ -282,6 +277,12 @@ const std::vector<Entry>& table() {
       entry("health.max_penetration", "body below the ground by more than this [m], > 0",
             real(&SimParams::maxPenetration, above(0))),
   };
+  static const std::vector<Entry> entries = [] {
+    std::vector<Entry> all = before;
+    all.insert(all.end(), calibration.begin(), calibration.end());
+    all.insert(all.end(), after.begin(), after.end());
+    return all;
+  }();
   return entries;
 }
 
@@ -364,6 +365,12 @@ std::vector<ParamInfo> paramTable() {
 std::string paramValue(const SimParams& params, std::string_view key) {
   const Entry* e = findEntry(key);
   return e ? e->get(params) : std::string();
+}
+
+bool SimParams::calibrated() const {
+  for (const CalParamInfo& c : calParams())
+    if (this->*c.field != c.files) return true;
+  return false;
 }
 
 }  // namespace sp

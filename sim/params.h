@@ -85,6 +85,7 @@ struct SimParams {
   // The twin calibrated to a robot (app/calibration/calibration.h): what
   // the twins the console starts (ghost, rehearsals, sweeps, run) differ
   // from the files by. Factors on the files' values; identity by default.
+  // Their keys, bounds and names: sim/calibration_table.h.
   double calWheelRadius = 1;       ///< tyres' effective radius, both axles
   double calWheelRadiusSplit = 0;  ///< front minus rear radius, relative (front x (1 + s/2), rear x (1 - s/2))
   double calWheelRadiusSide = 0;   ///< left minus right radius, relative (left x (1 + s/2), right x (1 - s/2))
@@ -97,10 +98,7 @@ struct SimParams {
   /// files', robot frame at zero pose: every link's centre moved by as much.
   double calComX = 0, calComY = 0;
   /// Whether any calibration.* key differs from the files (identity).
-  bool calibrated() const {
-    return calWheelRadius != 1 || calWheelRadiusSplit != 0 || calWheelRadiusSide != 0 || calWheelRadiusDiag != 0 || calFriction != 1 || calMotorGain != 1 ||
-           calDelay != 0 || calMass != 1 || calComX != 0 || calComY != 0;
-  }
+  bool calibrated() const;
   // Gaits (sim/gait.h); swings in degrees about the stance pose
   double caterpillarHipSwing = 12;   ///< [deg]
   double caterpillarPhaseTime = 1.0; ///< [s] per half cycle

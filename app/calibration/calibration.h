@@ -55,32 +55,16 @@
 #include <vector>
 
 #include "app/state/robot_frame.h"
+#include "sim/calibration_table.h"
 #include "sim/command.h"
 #include "sim/params.h"
 #include "sim/robot_model.h"
 
 namespace sp {
 
-/// The fitted parameters, in the order of calParams().
-enum class CalParam : int { WheelRadius, WheelRadiusSplit, WheelRadiusSide, WheelRadiusDiag, Friction, MotorGain, Delay, Mass, ComX, ComY };
-constexpr int kCalParams = 10;
+/// The fitted parameters: CalParam, calParams() (sim/calibration_table.h).
 using CalValues = std::array<double, kCalParams>;
 using CalFlags = std::array<bool, kCalParams>;
-
-struct CalParamInfo {
-  const char* key;    ///< its SimParams key (calibration.wheel_radius)
-  const char* label;  ///< for people ("wheel radius")
-  const char* unit;   ///< "" for a factor, else the unit ("s")
-  double files;       ///< the files' value (identity)
-  double lower, upper;  ///< physical bounds: a fit beyond is refused
-  double scale;       ///< prior half range: what "observed" is judged against
-  double probe;       ///< finite-difference step
-  /// A deviation no fusing of fits goes below: the estimator's own bias,
-  /// which every window shares (0: none known).
-  double floor;
-};
-const std::array<CalParamInfo, kCalParams>& calParams();
-inline const CalParamInfo& calParam(CalParam p) { return calParams()[static_cast<size_t>(p)]; }
 
 /// The calibration.* values of `params`, and `params` with `values` set.
 CalValues calValues(const SimParams& params);
@@ -270,13 +254,7 @@ std::optional<LoadCentre> comFromLoads(const WorldModel& files, const std::vecto
 /// centres moved every which way is no uniform shift, and bent legs turn
 /// theirs). nullopt without 50 frames, or when the links differ.
 std::optional<LoadCentre> centreShift(const RobotModel& files, const RobotModel& robot, const std::vector<RobotFrame>& frames);
-/// [m] about what comFromLoads reads of a robot that is its twin: 0.3-0.5 mm
-/// on flat ground (tst_calibration centreOfMassFromLoads, 10 s), -2.3 and
-/// -1.3 mm on the test track's bumps (bench_calibration's control, fused over
-/// 30 s: kept at the files' by the two deviations this sets). Each fit's
-/// deviation is at least this, and no fusing of fits goes below it
-/// (CalParamInfo::floor).
-constexpr double kComBias = 0.002;
+/// kComBias (sim/calibration_table.h) is about what it reads of a robot that is its twin.
 
 /// The wheel radius and its front-rear, left-right and diagonal splits of
 /// four tyre radius factors (FL FR RL RR): the inverse of the product the

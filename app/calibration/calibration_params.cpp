@@ -1,5 +1,6 @@
-// The calibrated parameters (app/calibration/calibration.h): their table,
-// the estimates and their fusing, and how a value or a fit is said.
+// The calibrated parameters (app/calibration/calibration.h; their table is
+// sim/calibration_table.h): their values in SimParams, the estimates and
+// their fusing, and how a value or a fit is said.
 #include "app/calibration/calibration.h"
 
 #include <cmath>
@@ -9,51 +10,22 @@
 
 namespace sp {
 
-const std::array<CalParamInfo, kCalParams>& calParams() {
-  // Bounds are calibration.*'s in sim/params.cpp; scales the ranges
-  // of a real robot's deviations (sim/perturbation.h), so that "observed"
-  // means "pinned well inside what a robot may differ by".
-  static const std::array<CalParamInfo, kCalParams> table{{
-      // Probes of half a scale: a smaller one drowns in the contacts' noise.
-      {"calibration.wheel_radius", "wheel radius", "", 1, 0.8, 1.2, 0.03, 0.015, 0},
-      {"calibration.wheel_radius_split", "radius front - rear", "", 0, -0.1, 0.1, 0.03, 0.015, 0},
-      {"calibration.wheel_radius_side", "radius left - right", "", 0, -0.1, 0.1, 0.03, 0.015, 0},
-      {"calibration.wheel_radius_diag", "radius FL+RR - FR+RL", "", 0, -0.1, 0.1, 0.03, 0.015, 0},
-      {"calibration.friction", "tyre friction", "", 1, 0.3, 3, 0.3, 0.15, 0},
-      {"calibration.motor_gain", "wheel motor gain", "", 1, 0.5, 1.5, 0.2, 0.1, 0},
-      {"calibration.delay", "command delay", "s", 0, 0, 0.5, 0.06, 0.03, 0},
-      {"calibration.mass", "total mass", "", 1, 0.5, 2, 0.15, 0, 0},
-      // Each link's centre may be 2 cm off on each axis (sim/perturbation.h);
-      // the robot's, their mass-weighted mean, rather less.
-      {"calibration.com_x", "centre of mass forward", "m", 0, -0.1, 0.1, 0.02, 0, kComBias},
-      {"calibration.com_y", "centre of mass left", "m", 0, -0.1, 0.1, 0.02, 0, kComBias},
-  }};
-  return table;
-}
-
-namespace {
-
-// Where each parameter lives in SimParams, in CalParam order: the one
-// table calValues and withCalValues read.
-constexpr std::array<double SimParams::*, kCalParams> kCalFields{
-    &SimParams::calWheelRadius, &SimParams::calWheelRadiusSplit, &SimParams::calWheelRadiusSide,
-    &SimParams::calWheelRadiusDiag, &SimParams::calFriction, &SimParams::calMotorGain,
-    &SimParams::calDelay, &SimParams::calMass, &SimParams::calComX, &SimParams::calComY};
-
-}  // namespace
-
 CalValues calValues(const SimParams& p) {
   CalValues v{};
-  for (size_t i = 0; i < kCalParams; ++i) v[i] = p.*kCalFields[i];
+  for (size_t i = 0; i < kCalParams; ++i) v[i] = p.*calParams()[i].field;
   return v;
 }
 
 SimParams withCalValues(SimParams p, const CalValues& v) {
-  for (size_t i = 0; i < kCalParams; ++i) p.*kCalFields[i] = v[i];
+  for (size_t i = 0; i < kCalParams; ++i) p.*calParams()[i].field = v[i];
   return p;
 }
 
-CalValues filesCalValues() { return calValues(SimParams{}); }
+CalValues filesCalValues() {
+  CalValues v{};
+  for (size_t i = 0; i < kCalParams; ++i) v[i] = calParams()[i].files;
+  return v;
+}
 
 CalEstimate filesEstimate() {
   CalEstimate e;

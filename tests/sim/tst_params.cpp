@@ -5,6 +5,7 @@
 
 #include <QTemporaryDir>
 
+#include <algorithm>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "tests/test_files.h"
+#include "sim/calibration_table.h"
 #include "sim/params.h"
 
 using namespace sp;
@@ -93,6 +95,7 @@ class TestParams : public QObject {
   void defaultsFileLoadsToDefaults();
   void defaultsFileListsEveryKeyInTableOrder();
   void tableDefaultsAreSimParamsDefaults();
+  void calibrationKeysComeFromTheirTable();
   void setParamAccepts_data();
   void setParamAccepts();
   void setParamStoresTypedValues();
@@ -144,6 +147,35 @@ void TestParams::tableDefaultsAreSimParamsDefaults() {
     QVERIFY2(keyPattern.match(q(info.key)).hasMatch(), info.key.c_str());
     QCOMPARE(q(info.defaultValue), q(paramValue(defaults, info.key)));
     QVERIFY2(!info.description.empty(), info.key.c_str());
+  }
+}
+
+// The calibration.* keys are made from sim/calibration_table.h: each one's
+// default is the table's files value, its bounds the table's (a value just
+// past either is refused by the parser, the bound itself is taken), and a
+// twin is calibrated() exactly when one of them differs from the files.
+void TestParams::calibrationKeysComeFromTheirTable() {
+  const SimParams defaults;
+  QVERIFY(!defaults.calibrated());
+  const std::vector<ParamInfo> table = paramTable();
+  for (const CalParamInfo& c : calParams()) {
+    QCOMPARE(defaults.*c.field, c.files);
+    const auto row = std::find_if(table.begin(), table.end(), [&](const ParamInfo& i) { return i.key == c.key; });
+    QVERIFY2(row != table.end(), c.key);
+    QVERIFY2(row->description.find(c.description) == 0, c.key);
+    for (const double bound : {c.lower, c.upper}) {
+      SimParams p;
+      Diagnostics diag;
+      QVERIFY2(applyOverride(p, std::string(c.key) + "=" + std::to_string(bound), diag), c.key);
+      QCOMPARE(p.*c.field, bound);
+      QCOMPARE(p.calibrated(), bound != c.files);
+    }
+    for (const double outside : {c.lower - 0.01, c.upper + 0.01}) {
+      SimParams p;
+      Diagnostics diag;
+      QVERIFY2(!applyOverride(p, std::string(c.key) + "=" + std::to_string(outside), diag), c.key);
+      QVERIFY(!p.calibrated());
+    }
   }
 }
 

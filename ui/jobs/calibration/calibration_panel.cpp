@@ -48,26 +48,6 @@ QString shown(size_t param, double v, bool compact = false) {
   return QString::number(v * k, 'f', 1) + " " + unit;
 }
 
-// A parameter's name in the table: short enough that the side dock (about
-// 370 px at 1280x800) shows it whole beside four columns of numbers; the
-// full name and the key are its tooltip.
-QString brief(CalParam p) {
-  const auto tr = [](const char* text) { return QCoreApplication::translate("CalibrationPanel", text); };
-  switch (p) {
-    case CalParam::WheelRadius: return tr("radius");
-    case CalParam::WheelRadiusSplit: return tr("radius F−R");
-    case CalParam::WheelRadiusSide: return tr("radius L−R");
-    case CalParam::WheelRadiusDiag: return tr("radius diagonal");
-    case CalParam::Friction: return tr("friction");
-    case CalParam::MotorGain: return tr("motor gain");
-    case CalParam::Delay: return tr("delay");
-    case CalParam::Mass: return tr("mass");
-    case CalParam::ComX: return tr("CoM forward");
-    case CalParam::ComY: return tr("CoM left");
-  }
-  return {};
-}
-
 // The fits a log's rows hold: one time each (a log written before the
 // centre of mass was fitted has fewer rows per fit).
 qsizetype fitsIn(const std::vector<LogCalibration>& rows) {
@@ -93,7 +73,10 @@ CalibrationPanel::CalibrationPanel(QWidget* parent) : QWidget(parent), series_(k
   table_->horizontalHeader()->setSectionResizeMode(0, QHeaderView::Stretch);
   for (int i = 0; i < kCalParams; ++i) {
     const CalParamInfo& p = calParams()[static_cast<size_t>(i)];
-    auto* name = new QTableWidgetItem(brief(static_cast<CalParam>(i)));
+    // The brief name: short enough that the side dock (about 370 px at
+    // 1280x800) shows it whole beside four columns of numbers; the full
+    // name and the key are its tooltip.
+    auto* name = new QTableWidgetItem(tr(p.brief));
     name->setToolTip(tr("%1 (%2)").arg(tr(p.label), QString::fromUtf8(p.key)));
     table_->setItem(i, 0, name);
     table_->setItem(i, 3, new QTableWidgetItem(shown(static_cast<size_t>(i), p.files, true)));
