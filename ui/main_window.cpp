@@ -86,6 +86,29 @@ MainWindow::MainWindow(ConsoleOptions options, ConsoleJobs jobs, QWidget* parent
   // Object names let QSettings restore the docks and toolbars by name.
   setObjectName(QStringLiteral("SimPartnerMainWindow"));
 
+  buildCentral();
+  buildFeeds();
+  buildPlots();
+  buildMenus();
+  buildContext();
+  // The right docks run the window's full height; the plots sit under the
+  // 3D view only (defaultLayout()).
+  setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
+  setCorner(Qt::TopRightCorner, Qt::RightDockWidgetArea);
+  for (std::unique_ptr<ConsoleJob>& job : jobs) installJob(std::move(job));
+  status_ = new StatusFields(statusBar());
+  stateChanged();
+
+  startPanelTimer();
+  // Esc is the e-stop wherever the focus is, dialogs included: an
+  // application-wide filter sees the key before any widget can take it.
+  qApp->installEventFilter(this);
+
+  restoreLayout();
+  refreshStatus();
+}
+
+void MainWindow::buildCentral() {
   auto* central = new QWidget;
   auto* layout = new QVBoxLayout(central);
   layout->setContentsMargins(0, 0, 0, 0);
@@ -119,7 +142,9 @@ MainWindow::MainWindow(ConsoleOptions options, ConsoleJobs jobs, QWidget* parent
   layout->addWidget(staleLabel_);
   layout->addWidget(scene_, 1);
   setCentralWidget(central);
+}
 
+void MainWindow::buildFeeds() {
   // The live link, the ghost and the switch the views draw from.
   connection_ = new RobotConnection(this);
   liveFeed_ = new LiveLinkFeed(connection_, session_.get(), this);
@@ -151,7 +176,9 @@ MainWindow::MainWindow(ConsoleOptions options, ConsoleJobs jobs, QWidget* parent
   connect(ghostFeed_, &RobotFeed::frame, this,
           [this](const RobotFrame& f) { scene_->setGhostState(f.base, f.jointPositions); });
   connect(ghostFeed_, &GhostFeed::trail, scene_, &SceneView::setGhostTrail);
+}
 
+void MainWindow::buildPlots() {
   wheelPlot_ = new WheelForcePlot;
   laserPlot_ = new LaserPlot;
   errorPlot_ = new PredictionErrorPlot;
@@ -161,8 +188,9 @@ MainWindow::MainWindow(ConsoleOptions options, ConsoleJobs jobs, QWidget* parent
   plotsDock_->setObjectName(QStringLiteral("plotsDock"));
   plotsDock_->setWidget(plots);
   addDockWidget(Qt::BottomDockWidgetArea, plotsDock_);
-  buildMenus();
+}
 
+void MainWindow::buildContext() {
   ConsoleContext::Parts parts;
   parts.host = this;
   parts.window = this;
@@ -179,14 +207,9 @@ MainWindow::MainWindow(ConsoleOptions options, ConsoleJobs jobs, QWidget* parent
   parts.status = [this](const QString& text, int ms) { showStatus(text, ms); };
   context_ = new ConsoleContext(std::move(parts), this);
   connect(monitor_, &ConsoleMonitor::robotStopped, context_, &ConsoleContext::robotStopped);
-  // The right docks run the window's full height; the plots sit under the
-  // 3D view only (defaultLayout()).
-  setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
-  setCorner(Qt::TopRightCorner, Qt::RightDockWidgetArea);
-  for (std::unique_ptr<ConsoleJob>& job : jobs) installJob(std::move(job));
-  status_ = new StatusFields(statusBar());
-  stateChanged();
+}
 
+void MainWindow::startPanelTimer() {
   // Everything around the 3D view is refreshed by one 100 ms timer, in one
   // event-loop pass together with a 3D frame: under software GL every window
   // update composites the whole window, so each widget repainting on its own
@@ -210,11 +233,9 @@ MainWindow::MainWindow(ConsoleOptions options, ConsoleJobs jobs, QWidget* parent
     scene_->update();
   });
   panelTimer->start(100);
+}
 
-  // Esc is the e-stop wherever the focus is, dialogs included: an
-  // application-wide filter sees the key before any widget can take it.
-  qApp->installEventFilter(this);
-
+void MainWindow::restoreLayout() {
   // Later runs restore the operator's own layout; the first run gets ours
   // once the window has its size (docks cannot be sized before).
   resize(1280, 800);
@@ -230,7 +251,6 @@ MainWindow::MainWindow(ConsoleOptions options, ConsoleJobs jobs, QWidget* parent
       showStatus(tr("The saved layout left the 3D view too small: the default layout is back."), 8000);
     }
   });
-  refreshStatus();
 }
 
 MainWindow::~MainWindow() {

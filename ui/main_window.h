@@ -196,6 +196,13 @@ class MainWindow : public QMainWindow, public ConsoleHost {
   void closeEvent(QCloseEvent* event) override;
 
  private:
+  // The constructor's parts, in order.
+  void buildCentral();     // the banner, the stale label and the 3D view
+  void buildFeeds();       // the link, the ghost, the feed switch and what they draw
+  void buildPlots();       // the plots dock
+  void buildContext();     // what the jobs are given
+  void startPanelTimer();  // the one refresh of everything around the 3D view
+  void restoreLayout();    // the operator's saved layout, or ours
   void buildMenus();
   /// The console's world changed (`fresh`: a new one, not the same shown
   /// again): jobs and, while the live robot is shown, the views follow.

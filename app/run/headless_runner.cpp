@@ -52,11 +52,14 @@ class CsvWriter {
   std::ostream& out_;
 };
 
-}  // namespace
+// What a run is given, loaded and checked.
+struct LoadedRun {
+  SimParams params;
+  WorldModel model;
+  std::vector<TimedCommand> commands;
+};
 
-std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& out, std::ostream& err,
-                                     const ClockFn& clock, const SleepUntilFn& sleepUntil,
-                                     const std::atomic<bool>* stop) {
+std::optional<LoadedRun> loadRun(const RunOptions& options, std::ostream& err) {
   Diagnostics diag;
   std::optional<SimParams> params = loadRunParams(options.paramsFile, options.overrides, diag);
   std::optional<WorldModel> model = loadWorld(options.worldFile, diag);
@@ -73,61 +76,141 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
   if (!(options.duration > 0)) diag.error("<command line>", 0, "--duration must be > 0");
   err << diag.format();
   if (diag.hasErrors() || !params || !model) return std::nullopt;
+  return LoadedRun{std::move(*params), std::move(*model), std::move(commands)};
+}
 
-  std::unique_ptr<World> world = World::create(calibratedWorld(*model, *params), *params, diag);
-  if (!world) {
-    err << diag.format();
-    return std::nullopt;
-  }
-
-  const RobotInstance& robot = model->robots[0];
+void printHeader(std::ostream& out, const RunOptions& options, const LoadedRun& run) {
+  const SimParams& params = run.params;
+  const RobotInstance& robot = run.model.robots[0];
   out << "SimPartner headless twin\n"
-      << "  world  '" << model->name << "' (" << options.worldFile << "), terrain "
-      << (model->terrain.kind == TerrainSpec::Kind::Plane ? "plane" : "heightfield " + model->terrain.file)
+      << "  world  '" << run.model.name << "' (" << options.worldFile << "), terrain "
+      << (run.model.terrain.kind == TerrainSpec::Kind::Plane ? "plane" : "heightfield " + run.model.terrain.file)
       << "\n  robot  '" << robot.name << "' from " << robot.model.file << ": " << robot.model.links.size()
       << " links, " << robot.model.joints.size() << " joints, " << robot.model.actuators.size()
       << " actuators, " << std::fixed << std::setprecision(1) << robot.model.totalMass() << " kg\n"
-      << "  physics step " << params->step * 1000 << " ms, "
-      << (params->solver == Solver::Quick ? "quick solver, " + std::to_string(params->iterations) + " iterations"
-                                          : std::string("exact solver"))
+      << "  physics step " << params.step * 1000 << " ms, "
+      << (params.solver == Solver::Quick ? "quick solver, " + std::to_string(params.iterations) + " iterations"
+                                         : std::string("exact solver"))
       << "\n  running " << options.duration << " s of sim time "
-      << (params->realTimeFactor > 0 ? "at " + std::to_string(params->realTimeFactor).substr(0, 5) + "x real time"
-                                     : std::string("as fast as possible"))
-      << (commands.empty() ? std::string(", no commands")
-                           : ", " + std::to_string(commands.size()) + " commands from " + options.commandsFile)
+      << (params.realTimeFactor > 0 ? "at " + std::to_string(params.realTimeFactor).substr(0, 5) + "x real time"
+                                    : std::string("as fast as possible"))
+      << (run.commands.empty() ? std::string(", no commands")
+                               : ", " + std::to_string(run.commands.size()) + " commands from " + options.commandsFile)
       << "\n";
+}
 
+// The run's CSV and session log, where asked for.
+struct RunOutputs {
   std::ofstream csvFile;
   std::unique_ptr<CsvWriter> csv;
-  if (!options.csvFile.empty()) {
-    csvFile.open(options.csvFile);
-    if (!csvFile) {
-      err << options.csvFile << ": error: cannot write CSV file\n";
-      return std::nullopt;
-    }
-    csv = std::make_unique<CsvWriter>(csvFile, *world);
-    out << "  writing CSV at " << params->csvRate << " Hz to " << options.csvFile << "\n";
-  }
   std::unique_ptr<SessionRecorder> log;
+};
+
+bool openOutputs(const RunOptions& options, const LoadedRun& run, const World& world, std::ostream& out,
+                 std::ostream& err, RunOutputs& o) {
+  if (!options.csvFile.empty()) {
+    o.csvFile.open(options.csvFile);
+    if (!o.csvFile) {
+      err << options.csvFile << ": error: cannot write CSV file\n";
+      return false;
+    }
+    o.csv = std::make_unique<CsvWriter>(o.csvFile, world);
+    out << "  writing CSV at " << run.params.csvRate << " Hz to " << options.csvFile << "\n";
+  }
   if (!options.logFile.empty()) {
     std::string error;
     std::unique_ptr<SessionLogWriter> writer = openSessionLog(
         options.logFile,
         {.worldFile = options.worldFile,
-         .robotFile = robot.model.file,
+         .robotFile = run.model.robots[0].model.file,
          .paramsFile = options.paramsFile,
-         .terrainFile = model->terrain.file,
+         .terrainFile = run.model.terrain.file,
          .commandsFile = options.commandsFile,
          .overrides = options.overrides,
          .replacedRobotFile = {}},
         error);
     if (!writer) {
       err << error << "\n";
-      return std::nullopt;
+      return false;
     }
-    log = std::make_unique<SessionRecorder>(std::move(writer), *world);
-    out << "  logging the session at " << params->logRate << " Hz to " << options.logFile << "\n";
+    o.log = std::make_unique<SessionRecorder>(std::move(writer), world);
+    out << "  logging the session at " << run.params.logRate << " Hz to " << options.logFile << "\n";
   }
+  return true;
+}
+
+// Ends the log and the CSV, their troubles into `report`.
+void closeOutputs(const RunOptions& options, const World& world, RunReport& report, RunOutputs& o, std::ostream& err) {
+  if (o.log) {
+    if (!report.health.healthy())
+      o.log->writer().logEvent(report.health.step, report.health.time, "health", report.health.message());
+    if (report.interrupted) o.log->writer().logEvent(world.stepCount(), world.time(), "interrupted", "");
+    o.log->finish(world);
+    o.log->writer().close();
+    report.logDropped = o.log->writer().dropped();
+    report.logError = o.log->writer().errorMessage();
+  }
+  if (o.csv) {
+    // A full disk cuts the file mid-line; the stream only says so when asked.
+    o.csvFile.flush();
+    o.csvFile.close();
+    if (!o.csvFile) {
+      report.csvError = options.csvFile + ": error: writing the CSV failed (is the disk full?): the file is incomplete";
+      err << report.csvError << "\n";
+    }
+  }
+}
+
+void printSummary(std::ostream& out, std::ostream& err, const RunOptions& options, const RunReport& report,
+                  const World& world, bool paced, const RunOutputs& o) {
+  const Pose base = world.linkPose(0, 0);
+  if (!report.health.healthy()) err << "error: the twin diverged: " << report.health.message() << "\n";
+  out << std::setprecision(3)
+      << (report.interrupted ? "interrupted" : report.health.healthy() ? "done" : "stopped") << ": "
+      << report.simTime
+      << " s simulated in " << report.wallTime << " s wall, " << std::setprecision(2) << report.achievedFactor
+      << "x real time";
+  if (paced)
+    out << " (requested " << report.requestedFactor << "x; sim time - wall x factor at the end "
+        << std::setprecision(3) << report.finalError * 1000 << " ms, worst lag " << report.maxLag * 1000
+        << " ms, " << report.resyncs << " resyncs)";
+  char hash[32];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(report.stateHash));
+  out << "\n  " << report.commandsApplied << " commands applied"
+      << (report.commandsRefused ? ", " + std::to_string(report.commandsRefused) + " refused" : std::string())
+      << "; base ended at (" << base.p.x << ", "
+      << base.p.y << ", " << base.p.z << ") m; state hash " << hash << "\n";
+  if (o.log && !report.logError.empty() && o.log->newlyFailed()) err << "error: " << report.logError << "\n";
+  if (o.log && report.logError.empty() && report.logDropped > 0)
+    err << "warning: " << options.logFile << ": " << report.logDropped
+        << " log items dropped (the writer could not keep up)\n";
+  if (paced && report.resyncs > 0)
+    out << "warning: this machine cannot keep up with " << report.requestedFactor << "x real time: achieved "
+        << std::setprecision(2) << report.achievedFactor << "x, " << std::setprecision(3) << report.slipped
+        << " s of sim time ran late\n";
+}
+
+}  // namespace
+
+std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& out, std::ostream& err,
+                                     const ClockFn& clock, const SleepUntilFn& sleepUntil,
+                                     const std::atomic<bool>* stop) {
+  std::optional<LoadedRun> run = loadRun(options, err);
+  if (!run) return std::nullopt;
+  const SimParams* params = &run->params;
+  Diagnostics diag;
+  std::unique_ptr<World> world = World::create(calibratedWorld(run->model, *params), *params, diag);
+  if (!world) {
+    err << diag.format();
+    return std::nullopt;
+  }
+  const RobotInstance& robot = run->model.robots[0];
+  printHeader(out, options, *run);
+  RunOutputs o;
+  if (!openOutputs(options, *run, *world, out, err, o)) return std::nullopt;
+  auto& csv = o.csv;
+  auto& log = o.log;
+  std::vector<TimedCommand>& commands = run->commands;
   const int64_t csvEvery = std::max<int64_t>(1, std::llround(1.0 / (params->csvRate * params->step)));
   const int64_t totalSteps = std::llround(options.duration / params->step);
 
@@ -195,50 +278,8 @@ std::optional<RunReport> runHeadless(const RunOptions& options, std::ostream& ou
   report.commandsApplied = runner.commandsApplied();
   report.stateHash = world->stateHash();
   report.health = world->health();
-  if (log) {
-    if (!report.health.healthy())
-      log->writer().logEvent(report.health.step, report.health.time, "health", report.health.message());
-    if (report.interrupted) log->writer().logEvent(world->stepCount(), world->time(), "interrupted", "");
-    log->finish(*world);
-    log->writer().close();
-    report.logDropped = log->writer().dropped();
-    report.logError = log->writer().errorMessage();
-  }
-
-  if (csv) {
-    // A full disk cuts the file mid-line; the stream only says so when asked.
-    csvFile.flush();
-    csvFile.close();
-    if (!csvFile) {
-      report.csvError = options.csvFile + ": error: writing the CSV failed (is the disk full?): the file is incomplete";
-      err << report.csvError << "\n";
-    }
-  }
-  const Pose base = world->linkPose(0, 0);
-  if (!report.health.healthy()) err << "error: the twin diverged: " << report.health.message() << "\n";
-  out << std::setprecision(3)
-      << (report.interrupted ? "interrupted" : report.health.healthy() ? "done" : "stopped") << ": "
-      << report.simTime
-      << " s simulated in " << report.wallTime << " s wall, " << std::setprecision(2) << report.achievedFactor
-      << "x real time";
-  if (pacer.paced())
-    out << " (requested " << report.requestedFactor << "x; sim time - wall x factor at the end "
-        << std::setprecision(3) << report.finalError * 1000 << " ms, worst lag " << report.maxLag * 1000
-        << " ms, " << report.resyncs << " resyncs)";
-  char hash[32];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(report.stateHash));
-  out << "\n  " << report.commandsApplied << " commands applied"
-      << (report.commandsRefused ? ", " + std::to_string(report.commandsRefused) + " refused" : std::string())
-      << "; base ended at (" << base.p.x << ", "
-      << base.p.y << ", " << base.p.z << ") m; state hash " << hash << "\n";
-  if (log && !report.logError.empty() && log->newlyFailed()) err << "error: " << report.logError << "\n";
-  if (log && report.logError.empty() && report.logDropped > 0)
-    err << "warning: " << options.logFile << ": " << report.logDropped
-        << " log items dropped (the writer could not keep up)\n";
-  if (pacer.paced() && report.resyncs > 0)
-    out << "warning: this machine cannot keep up with " << report.requestedFactor << "x real time: achieved "
-        << std::setprecision(2) << report.achievedFactor << "x, " << std::setprecision(3) << report.slipped
-        << " s of sim time ran late\n";
+  closeOutputs(options, *world, report, o, err);
+  printSummary(out, err, options, report, *world, pacer.paced(), o);
   return report;
 }
 

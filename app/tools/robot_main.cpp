@@ -8,6 +8,7 @@
 
 #include <iostream>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,16 +59,9 @@ constexpr const char* kUsage = R"(usage:
   `simpartner-sim resim PATH`.
 )";
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
-  sp::StandInOptions options;
-  bool perturbReport = false;
-  // The link's lines go through their own thread: the link thread (which
-  // runs the deadman) never waits for a stderr nobody reads.
-  sp::LineWriter lines(STDERR_FILENO, "simpartner-robot: ");
-  options.lineLog = [&lines](const std::string& line) { lines.write(line); };
+// Reads the command line into `options`; an exit code when it is done
+// (--help, --version) or wrong.
+std::optional<int> parseArgs(const std::vector<std::string>& args, sp::StandInOptions& options, bool& perturbReport) {
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--help" || a == "-h") {
@@ -129,6 +123,15 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  return std::nullopt;
+}
+
+int perturbationReport(const sp::StandInOptions& options);
+
+// The files found in the data folder, --perturb-report answered, and the
+// options that contradict each other refused; an exit code when done or
+// something is wrong.
+std::optional<int> checkOptions(sp::StandInOptions& options, bool perturbReport) {
   if (options.worldFile.empty()) options.worldFile = "terrains/flat.world.xml";
   for (std::string* file : {&options.worldFile, &options.paramsFile}) {
     std::string error;
@@ -138,18 +141,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  if (perturbReport) {
-    if (!options.perturbSeed) {
-      std::cerr << "<command line>: error: --perturb-report needs --perturb SEED\n";
-      return 2;
-    }
-    sp::Diagnostics diag;
-    const std::optional<sp::WorldModel> world = sp::loadWorld(options.worldFile, diag);
-    std::cerr << diag.format();
-    if (!world || world->robots.empty()) return 1;
-    std::cout << sp::drawPerturbation(*options.perturbSeed, world->robots[0].model).report(world->robots[0].model);
-    return 0;
-  }
+  if (perturbReport) return perturbationReport(options);
   const std::string& bind = options.bind;
   if (options.token.empty() && !(bind == "127.0.0.1" || bind == "::1" || bind == "localhost")) {
     std::cerr << "<command line>: error: refusing to listen on " << bind
@@ -160,6 +152,66 @@ int main(int argc, char** argv) {
     std::cerr << "<command line>: error: --no-log contradicts --log and --log-dir\n";
     return 2;
   }
+  return std::nullopt;
+}
+
+// --perturb-report: the deviations a seed draws, and nothing run.
+int perturbationReport(const sp::StandInOptions& options) {
+  if (!options.perturbSeed) {
+    std::cerr << "<command line>: error: --perturb-report needs --perturb SEED\n";
+    return 2;
+  }
+  sp::Diagnostics diag;
+  const std::optional<sp::WorldModel> world = sp::loadWorld(options.worldFile, diag);
+  std::cerr << diag.format();
+  if (!world || world->robots.empty()) return 1;
+  std::cout << sp::drawPerturbation(*options.perturbSeed, world->robots[0].model).report(world->robots[0].model);
+  return 0;
+}
+
+// Waits for a stop signal, looking at the log's health meanwhile; then
+// stops the robot and says how the run went.
+int serveUntilSignalled(sp::StandInRobot& robot, const sigset_t& stopSignals, sp::LineWriter& lines) {
+  // A failed log is told once and the twin runs on.
+  bool toldLogFailure = false;
+  const timespec poll{0, 200'000'000};
+  int signal = -1;
+  while ((signal = sigtimedwait(&stopSignals, nullptr, &poll)) < 0) {
+    if (!toldLogFailure && robot.logFailed()) {
+      toldLogFailure = true;
+      lines.write("error: " + robot.logError() + "; the twin runs on without logging");
+    }
+  }
+  // A signal stops the robot before the program ends: every motor first
+  // (as an e-stop), the clients told why, the log ending with the robot at rest.
+  const std::string reason = std::string("robot shutting down (") + (signal == SIGINT ? "SIGINT" : "SIGTERM") + ")";
+  lines.write(reason + ": stopping every motor");
+  if (!robot.shutdown(reason)) lines.write("warning: the robot was still moving 3 s after the stop");
+  const sp::StandInStats stats = robot.stats();
+  std::cout << "stopped: " << stats.clientsAccepted << " clients, " << stats.framesIn << " frames in, "
+            << stats.badFrames << " closed for bad frames, " << stats.telemetryDropped
+            << " telemetry frames dropped for slow clients\n";
+  if (!robot.logPath().empty()) {
+    if (robot.logDropped() > 0)
+      std::cerr << "simpartner-robot: warning: " << robot.logPath() << ": " << robot.logDropped()
+                << " log items dropped\n";
+    std::cout << "session log " << robot.logPath() << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  sp::StandInOptions options;
+  bool perturbReport = false;
+  // The link's lines go through their own thread: the link thread (which
+  // runs the deadman) never waits for a stderr nobody reads.
+  sp::LineWriter lines(STDERR_FILENO, "simpartner-robot: ");
+  options.lineLog = [&lines](const std::string& line) { lines.write(line); };
+  if (const std::optional<int> exit = parseArgs(args, options, perturbReport)) return *exit;
+  if (const std::optional<int> exit = checkOptions(options, perturbReport)) return *exit;
 
   sp::Diagnostics diag;
   std::unique_ptr<sp::StandInRobot> robot = sp::StandInRobot::create(options, diag);
@@ -185,33 +237,7 @@ int main(int argc, char** argv) {
     std::cout << "emulating a link with " << emulation.delay << " s delay, +-" << emulation.jitter << " s jitter, "
               << emulation.loss * 100 << " % loss\n";
   if (!robot->logPath().empty()) std::cout << "logging to " << robot->logPath() << "\n";
-  std::cout << "listening on " << bind << ":" << robot->port() << std::endl;
+  std::cout << "listening on " << options.bind << ":" << robot->port() << std::endl;
 
-  // Waits for a stop signal, looking at the log's health meanwhile: a
-  // failed log is told once and the twin runs on.
-  bool toldLogFailure = false;
-  const timespec poll{0, 200'000'000};
-  int signal = -1;
-  while ((signal = sigtimedwait(&stopSignals, nullptr, &poll)) < 0) {
-    if (!toldLogFailure && robot->logFailed()) {
-      toldLogFailure = true;
-      lines.write("error: " + robot->logError() + "; the twin runs on without logging");
-    }
-  }
-  // A signal stops the robot before the program ends: every motor first
-  // (as an e-stop), the clients told why, the log ending with the robot at rest.
-  const std::string reason = std::string("robot shutting down (") + (signal == SIGINT ? "SIGINT" : "SIGTERM") + ")";
-  lines.write(reason + ": stopping every motor");
-  if (!robot->shutdown(reason)) lines.write("warning: the robot was still moving 3 s after the stop");
-  const sp::StandInStats stats = robot->stats();
-  std::cout << "stopped: " << stats.clientsAccepted << " clients, " << stats.framesIn << " frames in, "
-            << stats.badFrames << " closed for bad frames, " << stats.telemetryDropped
-            << " telemetry frames dropped for slow clients\n";
-  if (!robot->logPath().empty()) {
-    if (robot->logDropped() > 0)
-      std::cerr << "simpartner-robot: warning: " << robot->logPath() << ": " << robot->logDropped()
-                << " log items dropped\n";
-    std::cout << "session log " << robot->logPath() << "\n";
-  }
-  return 0;
+  return serveUntilSignalled(*robot, stopSignals, lines);
 }

@@ -76,6 +76,63 @@ double largestRangeDifference(const LaserSweep& a, const LaserSweep& b, double a
   return worst;
 }
 
+// The report's plots: the 6 m sweep's range error against time, every
+// wall's by distance, and the torso's angle error with its fitted line.
+void addLaserPlots(ExperimentResult& r, const std::vector<LaserSweep>& sweeps, const double (&walls)[3],
+                   const LaserSweep& reference, const LinearFit& angleFit, double jitter, const std::string& nearerPhysics) {
+  const std::string nearer = "the same, " + nearerPhysics + " (nearer convergence)";
+  const LaserSweep& paper = sweeps[1];
+  PlotSpec vsTime{"Laser: range error against time (6 m wall)", "time since the sweep started [s]",
+                  "range error [mm]", {}, 960, 540, {}, {}};
+  const auto errors = [](const std::string& name, const LaserSweep& sw, const std::vector<double> LaserSweep::*series) {
+    PlotSeries out{name, sw.times, {}, PlotSeries::Style::Line};
+    for (double e : sw.*series) out.y.push_back(e * 1000);
+    return out;
+  };
+  vsTime.series = {errors("against the true scanner pose", paper, &LaserSweep::trueError),
+                   errors("against the pose the commanded rate implies", paper, &LaserSweep::commandError),
+                   errors(nearer, reference, &LaserSweep::commandError)};
+  PlotSpec vsDistance{"Laser: range error against the commanded pose, by distance", "measured range [m]",
+                      "range error [mm]", {}, 960, 540, {}, {}};
+  for (size_t k = 0; k < sweeps.size(); ++k) {
+    PlotSeries d{"wall at " + num(walls[k], 0) + " m", sweeps[k].distances, {}, PlotSeries::Style::Points};
+    for (double e : sweeps[k].commandError) d.y.push_back(e * 1000);
+    vsDistance.series.push_back(std::move(d));
+  }
+  PlotSpec angle{"Laser: torso angle error against the commanded rotation", "time since the sweep started [s]",
+                 "angle error [deg]", {}, 960, 400, {}, {}};
+  PlotSeries fitted{"linear fit from " + num(jitter, 1) + " s", {}, {}, PlotSeries::Style::Line};
+  for (double x : paper.times)
+    if (x >= jitter) {
+      fitted.x.push_back(x);
+      fitted.y.push_back(angleFit.intercept + angleFit.slope * x);
+    }
+  angle.series = {{"torso (waist) angle - commanded", paper.times, paper.angleError, PlotSeries::Style::Line},
+                  {nearer, reference.times, reference.angleError, PlotSeries::Style::Line},
+                  fitted};
+  r.plots.push_back({"laser_error_time", vsTime});
+  r.plots.push_back({"laser_error_distance", vsDistance});
+  r.plots.push_back({"laser_angle_error", angle});
+}
+
+// A line through a sweep's samples from `jitter` s on (after the start-up).
+LinearFit fitAfter(const LaserSweep& sw, const std::vector<double> LaserSweep::*series, double jitter) {
+  std::vector<double> t, y;
+  for (size_t i = 0; i < sw.times.size(); ++i)
+    if (sw.times[i] >= jitter) {
+      t.push_back(sw.times[i]);
+      y.push_back((sw.*series)[i]);
+    }
+  return linearFit(t, y);
+}
+
+// The index of the world's object named "wall".
+int wallObject(const WorldModel& model) {
+  for (size_t i = 0; i < model.objects.size(); ++i)
+    if (model.objects[i].name == "wall") return static_cast<int>(i);
+  throw std::runtime_error("laser_wall.world.xml has no object named 'wall'");
+}
+
 }  // namespace
 
 ExperimentResult laserSweep(const ValidationOptions& o) {
@@ -88,10 +145,7 @@ ExperimentResult laserSweep(const ValidationOptions& o) {
   if (scanner < 0) throw std::runtime_error("laser_wall.world.xml: the robot has no sensor named 'laser'");
   const double noise = robot.sensors[static_cast<size_t>(scanner)].noise;  // the scanner's, one deviation [m]
   for (SensorSpec& s : model.robots[0].model.sensors) s.noise = 0;  // the error of the model, not of noise
-  int wall = -1;
-  for (size_t i = 0; i < model.objects.size(); ++i)
-    if (model.objects[i].name == "wall") wall = static_cast<int>(i);
-  if (wall < 0) throw std::runtime_error("laser_wall.world.xml has no object named 'wall'");
+  const int wall = wallObject(model);
   const double rateDeg = 15, from = -45, sweep = 90 / rateDeg, jitter = 0.5;
   const double walls[] = {3, 6, 9};  // [m] the wall's face ahead of the hinge; 6 m is the paper's
   SimParams converged = o.params, ghost = o.params;
@@ -121,15 +175,8 @@ ExperimentResult laserSweep(const ValidationOptions& o) {
   double worstTrue = 0;
   for (const LaserSweep& sw : sweeps)
     for (double e : sw.trueError) worstTrue = std::max(worstTrue, std::abs(e));
-  // A line through a sweep's samples after the start-up jitter.
   const auto fit = [&](const LaserSweep& sw, const std::vector<double> LaserSweep::*series) {
-    std::vector<double> t, y;
-    for (size_t i = 0; i < sw.times.size(); ++i)
-      if (sw.times[i] >= jitter) {
-        t.push_back(sw.times[i]);
-        y.push_back((sw.*series)[i]);
-      }
-    return linearFit(t, y);
+    return fitAfter(sw, series, jitter);
   };
   const LinearFit angleFit = fit(paper, &LaserSweep::angleError);
   const LinearFit rangeFit = fit(paper, &LaserSweep::commandError);
@@ -173,38 +220,7 @@ ExperimentResult laserSweep(const ValidationOptions& o) {
   r.metrics.push_back({"for the record: range error per metre of range, 9 m wall against 3 m wall at the same "
                        "instants, median relative difference (an identity: d tan(phi) dphi)",
                        "proportional to the distance", proportional * 100, "%", "", false, false});
-  const std::string nearer = "the same, " + nearerPhysics + " (nearer convergence)";
-  PlotSpec vsTime{"Laser: range error against time (6 m wall)", "time since the sweep started [s]",
-                  "range error [mm]", {}, 960, 540, {}, {}};
-  const auto errors = [](const std::string& name, const LaserSweep& sw, const std::vector<double> LaserSweep::*series) {
-    PlotSeries out{name, sw.times, {}, PlotSeries::Style::Line};
-    for (double e : sw.*series) out.y.push_back(e * 1000);
-    return out;
-  };
-  vsTime.series = {errors("against the true scanner pose", paper, &LaserSweep::trueError),
-                   errors("against the pose the commanded rate implies", paper, &LaserSweep::commandError),
-                   errors(nearer, reference, &LaserSweep::commandError)};
-  PlotSpec vsDistance{"Laser: range error against the commanded pose, by distance", "measured range [m]",
-                      "range error [mm]", {}, 960, 540, {}, {}};
-  for (size_t k = 0; k < sweeps.size(); ++k) {
-    PlotSeries d{"wall at " + num(walls[k], 0) + " m", sweeps[k].distances, {}, PlotSeries::Style::Points};
-    for (double e : sweeps[k].commandError) d.y.push_back(e * 1000);
-    vsDistance.series.push_back(std::move(d));
-  }
-  PlotSpec angle{"Laser: torso angle error against the commanded rotation", "time since the sweep started [s]",
-                 "angle error [deg]", {}, 960, 400, {}, {}};
-  PlotSeries fitted{"linear fit from " + num(jitter, 1) + " s", {}, {}, PlotSeries::Style::Line};
-  for (double x : paper.times)
-    if (x >= jitter) {
-      fitted.x.push_back(x);
-      fitted.y.push_back(angleFit.intercept + angleFit.slope * x);
-    }
-  angle.series = {{"torso (waist) angle - commanded", paper.times, paper.angleError, PlotSeries::Style::Line},
-                  {nearer, reference.times, reference.angleError, PlotSeries::Style::Line},
-                  fitted};
-  r.plots.push_back({"laser_error_time", vsTime});
-  r.plots.push_back({"laser_error_distance", vsDistance});
-  r.plots.push_back({"laser_angle_error", angle});
+  addLaserPlots(r, sweeps, walls, reference, angleFit, jitter, nearerPhysics);
   const auto last = [](const std::vector<double>& v) { return v.empty() ? 0.0 : v.back(); };
   r.discussion =
       "What the paper saw is, by its own account, its integrator's error: after an initial jitter the torso's "

@@ -90,6 +90,107 @@ std::string colour(std::size_t series) {
 
 std::string px(double v) { return format("%.2f", v); }
 
+// Every series has points, as many x as y, some finite: "" or the problem.
+// The finite points grow the extents.
+std::string seriesProblem(const PlotSpec& plot, Extent& xExtent, Extent& yExtent) {
+  for (const PlotSeries& s : plot.series) {
+    const std::string where = prefix(plot) + "series '" + s.name + "': ";
+    if (s.x.empty() && s.y.empty()) return where + "has no points";
+    if (s.x.size() != s.y.size())
+      return where + std::to_string(s.x.size()) + " x values but " + std::to_string(s.y.size()) + " y values";
+    size_t finite = 0;
+    for (size_t k = 0; k < s.x.size(); ++k) {
+      if (!std::isfinite(s.x[k]) || !std::isfinite(s.y[k])) continue;
+      xExtent.add(s.x[k]);
+      yExtent.add(s.y[k]);
+      ++finite;
+    }
+    if (finite == 0) return where + "no finite point (all " + std::to_string(s.x.size()) + " skipped)";
+  }
+  return {};
+}
+
+struct LegendEntry {
+  size_t series;
+  double x;
+  int row;
+};
+
+// The plot area and its axes' ranges, in user units (= px).
+struct Area {
+  double left, top, pw, ph;
+  std::pair<double, double> xRange, yRange;
+  double sx(double x) const { return left + (x - xRange.first) / (xRange.second - xRange.first) * pw; }
+  double sy(double y) const { return top + ph - (y - yRange.first) / (yRange.second - yRange.first) * ph; }
+};
+
+// Legend entries (named series only) flow into rows from `left`; widths
+// are estimated at about 7.5 units per character at font size 13.
+std::vector<LegendEntry> layoutLegend(const PlotSpec& plot, double left, double right, int& rows) {
+  std::vector<LegendEntry> legend;
+  rows = 0;
+  double x = left;
+  for (size_t i = 0; i < plot.series.size(); ++i) {
+    const std::string& name = plot.series[i].name;
+    if (name.empty()) continue;
+    const double width = 19 + 7.5 * static_cast<double>(name.size()) + 22;
+    if (rows == 0 || (x + width > plot.width - right && x > left)) {
+      ++rows;
+      x = left;
+    }
+    legend.push_back({i, x, rows - 1});
+    x += width;
+  }
+  return legend;
+}
+
+// The grid, the frame, the tick labels and the axis titles.
+void drawAxes(const PlotSpec& plot, const Area& a, std::string& svg) {
+  svg += "<g stroke=\"#dddddd\" stroke-width=\"1\">\n";
+  const std::vector<double> xTicks = ticks(a.xRange, a.pw, 100), yTicks = ticks(a.yRange, a.ph, 60);
+  for (double x : xTicks)
+    svg += "<line x1=\"" + px(a.sx(x)) + "\" y1=\"" + px(a.top) + "\" x2=\"" + px(a.sx(x)) + "\" y2=\"" + px(a.top + a.ph) + "\"/>\n";
+  for (double y : yTicks)
+    svg += "<line x1=\"" + px(a.left) + "\" y1=\"" + px(a.sy(y)) + "\" x2=\"" + px(a.left + a.pw) + "\" y2=\"" + px(a.sy(y)) + "\"/>\n";
+  svg += "</g>\n<rect x=\"" + px(a.left) + "\" y=\"" + px(a.top) + "\" width=\"" + px(a.pw) + "\" height=\"" + px(a.ph) +
+         "\" fill=\"none\" stroke=\"#555555\"/>\n";
+  for (double x : xTicks)
+    svg += "<text x=\"" + px(a.sx(x)) + "\" y=\"" + px(a.top + a.ph + 18) + "\" text-anchor=\"middle\">" +
+           format("%.4g", x) + "</text>\n";
+  for (double y : yTicks)
+    svg += "<text x=\"" + px(a.left - 6) + "\" y=\"" + px(a.sy(y) + 4) + "\" text-anchor=\"end\">" + format("%.4g", y) +
+           "</text>\n";
+  if (!plot.xLabel.empty())
+    svg += "<text x=\"" + px(a.left + a.pw / 2) + "\" y=\"" + px(a.top + a.ph + 40) + "\" text-anchor=\"middle\">" +
+           escape(plot.xLabel) + "</text>\n";
+  if (!plot.yLabel.empty())
+    svg += "<text transform=\"translate(18 " + px(a.top + a.ph / 2) + ") rotate(-90)\" text-anchor=\"middle\">" +
+           escape(plot.yLabel) + "</text>\n";
+}
+
+// The series, clipped to the plot area: points as dots, lines as polylines.
+void drawSeries(const PlotSpec& plot, const Area& a, std::string& svg) {
+  svg += "<g clip-path=\"url(#area)\">\n";
+  for (size_t i = 0; i < plot.series.size(); ++i) {
+    const PlotSeries& s = plot.series[i];
+    const std::string c = colour(i);
+    if (s.style == PlotSeries::Style::Points) {
+      svg += "<g fill=\"" + c + "\" stroke=\"#333333\" stroke-width=\"0.5\">\n";
+      for (size_t k = 0; k < s.x.size(); ++k)
+        if (std::isfinite(s.x[k]) && std::isfinite(s.y[k]))
+          svg += "<circle cx=\"" + px(a.sx(s.x[k])) + "\" cy=\"" + px(a.sy(s.y[k])) + "\" r=\"3.5\"/>\n";
+      svg += "</g>\n";
+    } else {
+      svg += "<polyline fill=\"none\" stroke=\"" + c +
+             "\" stroke-width=\"2\" stroke-linejoin=\"round\" stroke-linecap=\"round\" points=\"";
+      for (size_t k = 0; k < s.x.size(); ++k)
+        if (std::isfinite(s.x[k]) && std::isfinite(s.y[k])) svg += px(a.sx(s.x[k])) + "," + px(a.sy(s.y[k])) + " ";
+      svg += "\"/>\n";
+    }
+  }
+  svg += "</g>\n";
+}
+
 }  // namespace
 
 std::optional<std::string> renderPlotSvg(const PlotSpec& plot, std::string& error) {
@@ -103,27 +204,9 @@ std::optional<std::string> renderPlotSvg(const PlotSpec& plot, std::string& erro
     return std::nullopt;
   }
   Extent xExtent, yExtent;
-  for (const PlotSeries& s : plot.series) {
-    const std::string where = prefix(plot) + "series '" + s.name + "': ";
-    if (s.x.empty() && s.y.empty()) {
-      error = where + "has no points";
-      return std::nullopt;
-    }
-    if (s.x.size() != s.y.size()) {
-      error = where + std::to_string(s.x.size()) + " x values but " + std::to_string(s.y.size()) + " y values";
-      return std::nullopt;
-    }
-    size_t finite = 0;
-    for (size_t k = 0; k < s.x.size(); ++k) {
-      if (!std::isfinite(s.x[k]) || !std::isfinite(s.y[k])) continue;
-      xExtent.add(s.x[k]);
-      yExtent.add(s.y[k]);
-      ++finite;
-    }
-    if (finite == 0) {
-      error = where + "no finite point (all " + std::to_string(s.x.size()) + " skipped)";
-      return std::nullopt;
-    }
+  if (std::string p = seriesProblem(plot, xExtent, yExtent); !p.empty()) {
+    error = p;
+    return std::nullopt;
   }
   const std::pair<double, double> xRange = plot.xRange.value_or(xExtent.withMargin());
   const std::pair<double, double> yRange = plot.yRange.value_or(yExtent.withMargin());
@@ -134,36 +217,14 @@ std::optional<std::string> renderPlotSvg(const PlotSpec& plot, std::string& erro
     }
   }
 
-  // Layout [user units = px]: title on top, y labels left, x labels and
-  // the legend below the plot area. Legend entries flow into rows; widths
-  // are estimated at about 7.5 units per character at font size 13.
+  // Layout: title on top, y labels left, x labels and the legend below the plot area.
   const double w = plot.width, h = plot.height;
   const double left = 78, right = 18, top = plot.title.empty() ? 16 : 40;
-  struct LegendEntry {
-    size_t series;
-    double x;
-    int row;
-  };
-  std::vector<LegendEntry> legend;
   int legendRows = 0;
-  {
-    double x = left;
-    for (size_t i = 0; i < plot.series.size(); ++i) {
-      const std::string& name = plot.series[i].name;
-      if (name.empty()) continue;
-      const double width = 19 + 7.5 * static_cast<double>(name.size()) + 22;
-      if (legendRows == 0 || (x + width > w - right && x > left)) {
-        ++legendRows;
-        x = left;
-      }
-      legend.push_back({i, x, legendRows - 1});
-      x += width;
-    }
-  }
+  const std::vector<LegendEntry> legend = layoutLegend(plot, left, right, legendRows);
   const double bottom = 52 + 22 * legendRows + (legendRows > 0 ? 4 : 0);
-  const double pw = std::max(1.0, w - left - right), ph = std::max(1.0, h - top - bottom);
-  auto sx = [&](double x) { return left + (x - xRange.first) / (xRange.second - xRange.first) * pw; };
-  auto sy = [&](double y) { return top + ph - (y - yRange.first) / (yRange.second - yRange.first) * ph; };
+  const Area area{left, top, std::max(1.0, w - left - right), std::max(1.0, h - top - bottom), xRange, yRange};
+  const double pw = area.pw, ph = area.ph;
 
   std::string svg;
   svg += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(plot.width) + "\" height=\"" +
@@ -176,50 +237,8 @@ std::optional<std::string> renderPlotSvg(const PlotSpec& plot, std::string& erro
   if (!plot.title.empty())
     svg += "<text x=\"" + px(w / 2) + "\" y=\"26\" text-anchor=\"middle\" font-size=\"17\" font-weight=\"bold\">" +
            escape(plot.title) + "</text>\n";
-
-  // Grid and tick labels.
-  svg += "<g stroke=\"#dddddd\" stroke-width=\"1\">\n";
-  const std::vector<double> xTicks = ticks(xRange, pw, 100), yTicks = ticks(yRange, ph, 60);
-  for (double x : xTicks)
-    svg += "<line x1=\"" + px(sx(x)) + "\" y1=\"" + px(top) + "\" x2=\"" + px(sx(x)) + "\" y2=\"" + px(top + ph) + "\"/>\n";
-  for (double y : yTicks)
-    svg += "<line x1=\"" + px(left) + "\" y1=\"" + px(sy(y)) + "\" x2=\"" + px(left + pw) + "\" y2=\"" + px(sy(y)) + "\"/>\n";
-  svg += "</g>\n<rect x=\"" + px(left) + "\" y=\"" + px(top) + "\" width=\"" + px(pw) + "\" height=\"" + px(ph) +
-         "\" fill=\"none\" stroke=\"#555555\"/>\n";
-  for (double x : xTicks)
-    svg += "<text x=\"" + px(sx(x)) + "\" y=\"" + px(top + ph + 18) + "\" text-anchor=\"middle\">" +
-           format("%.4g", x) + "</text>\n";
-  for (double y : yTicks)
-    svg += "<text x=\"" + px(left - 6) + "\" y=\"" + px(sy(y) + 4) + "\" text-anchor=\"end\">" + format("%.4g", y) +
-           "</text>\n";
-  if (!plot.xLabel.empty())
-    svg += "<text x=\"" + px(left + pw / 2) + "\" y=\"" + px(top + ph + 40) + "\" text-anchor=\"middle\">" +
-           escape(plot.xLabel) + "</text>\n";
-  if (!plot.yLabel.empty())
-    svg += "<text transform=\"translate(18 " + px(top + ph / 2) + ") rotate(-90)\" text-anchor=\"middle\">" +
-           escape(plot.yLabel) + "</text>\n";
-
-  // Series.
-  svg += "<g clip-path=\"url(#area)\">\n";
-  for (size_t i = 0; i < plot.series.size(); ++i) {
-    const PlotSeries& s = plot.series[i];
-    const std::string c = colour(i);
-    if (s.style == PlotSeries::Style::Points) {
-      svg += "<g fill=\"" + c + "\" stroke=\"#333333\" stroke-width=\"0.5\">\n";
-      for (size_t k = 0; k < s.x.size(); ++k)
-        if (std::isfinite(s.x[k]) && std::isfinite(s.y[k]))
-          svg += "<circle cx=\"" + px(sx(s.x[k])) + "\" cy=\"" + px(sy(s.y[k])) + "\" r=\"3.5\"/>\n";
-      svg += "</g>\n";
-    } else {
-      svg += "<polyline fill=\"none\" stroke=\"" + c +
-             "\" stroke-width=\"2\" stroke-linejoin=\"round\" stroke-linecap=\"round\" points=\"";
-      for (size_t k = 0; k < s.x.size(); ++k)
-        if (std::isfinite(s.x[k]) && std::isfinite(s.y[k])) svg += px(sx(s.x[k])) + "," + px(sy(s.y[k])) + " ";
-      svg += "\"/>\n";
-    }
-  }
-  svg += "</g>\n";
-
+  drawAxes(plot, area, svg);
+  drawSeries(plot, area, svg);
   // Legend: named series only, in rows under the axis title.
   for (const LegendEntry& e : legend) {
     const double y = top + ph + 66 + 22 * e.row;

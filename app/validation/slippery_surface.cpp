@@ -64,6 +64,42 @@ WorldModel withResistance(WorldModel model, double c, bool sliding) {
   return model;
 }
 
+// The same runs with C changed in every contact, and with braced wheels
+// free of it: a plot into `r`, and the figures said.
+std::string addSensitivity(ExperimentResult& r, const WorldModel& model, const SimParams& params, double c, double start,
+                           double duration, const double (&paper)[3]) {
+  PlotSpec table{"Slippery surface: speed against the motion resistance C", "C", "speed [m/s]", {}, 960, 540, {}, {}};
+  PlotSeries curves[3] = {{kModeNames[0], {}, {}, PlotSeries::Style::Line},
+                          {kModeNames[1], {}, {}, PlotSeries::Style::Line},
+                          {kModeNames[2], {}, {}, PlotSeries::Style::Line}};
+  std::string sensitivity = " Sensitivity (the same runs, C changed in every contact): ";
+  const auto criteria = [&](const double* s) {
+    bool ok = s[1] > s[2] && s[2] > s[0];
+    for (int m = 0; m < 3; ++m) ok = ok && paperFactor(s[m], paper[m]) <= 1.5;
+    return ok;
+  };
+  for (double ci : {0.0, 0.02, 0.03, 0.06, 0.12}) {
+    const SlipperyModes m = runModes(withResistance(model, ci, true), params, start, duration, r.title);
+    r.simSeconds += m.seconds;
+    for (int k = 0; k < 3; ++k) {
+      curves[k].x.push_back(ci);
+      curves[k].y.push_back(m.speed[k]);
+    }
+    sensitivity += "C = " + num(ci, 2) + ": rolling " + num(m.speed[0], 4) + ", caterpillar " + num(m.speed[1], 3) +
+                   ", rolking " + num(m.speed[2], 3) + " m/s (criteria " + (criteria(m.speed) ? "met" : "missed") +
+                   "); ";
+  }
+  const SlipperyModes rollingOnly = runModes(withResistance(model, c, false), params, start, duration, r.title);
+  r.simSeconds += rollingOnly.seconds;
+  sensitivity += "and C = " + num(c, 2) + " on rolling wheels only (braced wheels slide with mu alone): rolling " +
+                 num(rollingOnly.speed[0], 4) + ", caterpillar " + num(rollingOnly.speed[1], 3) + ", rolking " +
+                 num(rollingOnly.speed[2], 3) + " m/s (criteria " + (criteria(rollingOnly.speed) ? "met" : "missed") +
+                 ").";
+  table.series = {curves[0], curves[1], curves[2]};
+  r.plots.push_back({"slippery_sensitivity", table});
+  return sensitivity;
+}
+
 }  // namespace
 
 ExperimentResult slipperySurface(const ValidationOptions& o) {
@@ -124,38 +160,7 @@ ExperimentResult slipperySurface(const ValidationOptions& o) {
 
   // Sensitivity (full runs only): C over the range the literature gives
   // for shallow snow, and braced wheels without it.
-  std::string sensitivity;
-  if (!o.quick) {
-    PlotSpec table{"Slippery surface: speed against the motion resistance C", "C", "speed [m/s]", {}, 960, 540, {}, {}};
-    PlotSeries curves[3] = {{kModeNames[0], {}, {}, PlotSeries::Style::Line},
-                            {kModeNames[1], {}, {}, PlotSeries::Style::Line},
-                            {kModeNames[2], {}, {}, PlotSeries::Style::Line}};
-    sensitivity = " Sensitivity (the same runs, C changed in every contact): ";
-    const auto criteria = [&](const double* s) {
-      bool ok = s[1] > s[2] && s[2] > s[0];
-      for (int m = 0; m < 3; ++m) ok = ok && paperFactor(s[m], paper[m]) <= 1.5;
-      return ok;
-    };
-    for (double ci : {0.0, 0.02, 0.03, 0.06, 0.12}) {
-      const SlipperyModes m = runModes(withResistance(model, ci, true), o.params, start, duration, r.title);
-      r.simSeconds += m.seconds;
-      for (int k = 0; k < 3; ++k) {
-        curves[k].x.push_back(ci);
-        curves[k].y.push_back(m.speed[k]);
-      }
-      sensitivity += "C = " + num(ci, 2) + ": rolling " + num(m.speed[0], 4) + ", caterpillar " + num(m.speed[1], 3) +
-                     ", rolking " + num(m.speed[2], 3) + " m/s (criteria " + (criteria(m.speed) ? "met" : "missed") +
-                     "); ";
-    }
-    const SlipperyModes rollingOnly = runModes(withResistance(model, c, false), o.params, start, duration, r.title);
-    r.simSeconds += rollingOnly.seconds;
-    sensitivity += "and C = " + num(c, 2) + " on rolling wheels only (braced wheels slide with mu alone): rolling " +
-                   num(rollingOnly.speed[0], 4) + ", caterpillar " + num(rollingOnly.speed[1], 3) + ", rolking " +
-                   num(rollingOnly.speed[2], 3) + " m/s (criteria " + (criteria(rollingOnly.speed) ? "met" : "missed") +
-                   ").";
-    table.series = {curves[0], curves[1], curves[2]};
-    r.plots.push_back({"slippery_sensitivity", table});
-  }
+  const std::string sensitivity = o.quick ? std::string() : addSensitivity(r, model, o.params, c, start, duration, paper);
   r.plots.insert(r.plots.begin(), {"slippery_distance", modes.progress});
   const double traction = 0.025 * model.robots[0].model.totalMass() * 9.81;
   r.discussion =

@@ -104,6 +104,101 @@ TrackRun driveStraight(const WorldModel& model, const SimParams& params, double 
   return run;
 }
 
+// The mechanism, for the record: the wheels roll without slipping, and
+// what the hinge gains or loses on them is the body's pitch; and the front
+// load's spikes over each bump.
+struct Mechanism {
+  double worstSlip = 0;
+  LinearFit pitch;
+};
+Mechanism addMechanism(ExperimentResult& r, const TrackRun& track, double settled, const std::vector<Bump>& bumps,
+                       double flatLoad) {
+  std::vector<double> rate, gain;
+  double worstSlip = 0;
+  for (size_t i = 0; i < track.axle.size(); ++i)
+    if (track.axle[i] >= settled) {
+      rate.push_back(track.pitchRate[i]);
+      gain.push_back(track.v[i] - track.rolling[i]);
+      worstSlip = std::max(worstSlip, track.slip[i]);
+    }
+  const LinearFit pitch = linearFit(rate, gain);
+  r.metrics.push_back({"for the record: largest slip of a wheel at speed (front axle past " + num(settled, 1) +
+                           " m), |1 - rolling speed / hub speed|, any 20 ms sample",
+                       "", worstSlip * 100, "%", "", false, false});
+  r.metrics.push_back({"for the record: hinge speed less the wheels' rolling speed against the body's pitch rate, "
+                       "linear fit, R^2 (slope " + num(pitch.slope, 2) + " m: the hinge's height above the ground)",
+                       "", pitch.r2, "", "", false, false});
+  // Force spikes, for the record: the largest front load over each bump.
+  for (size_t k = 0; k < bumps.size(); ++k) {
+    double peak = 0;
+    for (size_t i = 0; i < track.axle.size(); ++i)
+      if (track.axle[i] >= bumps[k].foot && track.axle[i] < bumps[k].end + 1) peak = std::max(peak, track.front[i]);
+    r.metrics.push_back({"bump " + std::to_string(k + 1) + ": largest front load from its foot to 1 m past its end, "
+                         "against the flat stretches' mean",
+                         "spikes matched the real run's", 100 * (peak / flatLoad - 1), "%", "", false, false});
+  }
+
+  return {worstSlip, pitch};
+}
+
+// Flat stretches between bumps (and after the last), at least 0.8 m long,
+// from `settled` to `until`: the front axle's loads there are the reference.
+std::vector<std::pair<double, double>> flatStretches(const std::vector<Bump>& bumps, double settled, double until) {
+  std::vector<std::pair<double, double>> flats;
+  double from = settled;
+  for (const Bump& b : bumps) {
+    if (b.foot - from >= 0.8) flats.emplace_back(from, b.foot);
+    from = std::max(from, b.end);
+  }
+  if (until - from >= 0.8) flats.emplace_back(from, until);
+  return flats;
+}
+
+// The smallest of each load against the mean of the others (the flat
+// stretches' control); 1e9 with fewer than two.
+double smallestAgainstTheOthers(const std::vector<double>& loads) {
+  double smallest = 1e9;
+  for (size_t k = 0; k < loads.size(); ++k) {
+    std::vector<double> others;
+    for (size_t m = 0; m < loads.size(); ++m)
+      if (m != k) others.push_back(loads[m]);
+    if (!others.empty()) smallest = std::min(smallest, loads[k] / mean(others));
+  }
+  return smallest;
+}
+
+// The report's plots: the speeds and the loads against the distance, and
+// the profile with the bumps found in it.
+void addTrackPlots(ExperimentResult& r, const TrackRun& track, const TrackRun& flat, const HeightGrid& grid, int row,
+                   double x0, const std::vector<Bump>& bumps) {
+  const std::vector<double> v = smooth(track.v, 5), vFlat = smooth(flat.v, 5);
+  PlotSpec speedPlot{"Test track: speed against distance", "front axle position [m]", "speed [m/s]", {}, 960, 400,
+                     {}, {}};
+  speedPlot.series = {{"hinge speed, test track", track.axle, v, PlotSeries::Style::Line},
+                      {"wheels' rolling speed, test track", track.axle, smooth(track.rolling, 5), PlotSeries::Style::Line},
+                      {"hinge speed, flat ground (control)", flat.axle, vFlat, PlotSeries::Style::Line}};
+  PlotSpec forcePlot{"Test track: axle loads against distance (0.1 s moving average)", "front axle position [m]",
+                     "normal force [N]", {}, 960, 400, {}, {}};
+  forcePlot.series = {{"front pair", track.axle, smooth(track.front, 5), PlotSeries::Style::Line},
+                      {"rear pair", track.axle, smooth(track.rear, 5), PlotSeries::Style::Line}};
+  PlotSpec profile{"Test track: profile and the bumps found in it", "distance [m]", "height [m]", {}, 960, 300, {}, {}};
+  PlotSeries h{"track middle row", {}, {}, PlotSeries::Style::Line};
+  for (int i = 0; i < grid.columns; ++i) {
+    h.x.push_back(x0 + i * grid.spacingX());
+    h.y.push_back(grid.at(i, row));
+  }
+  PlotSeries marks{"foot, crest, end", {}, {}, PlotSeries::Style::Points};
+  for (const Bump& b : bumps)
+    for (double x : {b.foot, b.crest, b.end}) {
+      marks.x.push_back(x);
+      marks.y.push_back(grid.at(static_cast<int>(std::lround((x - x0) / grid.spacingX())), row));
+    }
+  profile.series = {h, marks};
+  r.plots.push_back({"track_speed", speedPlot});
+  r.plots.push_back({"track_forces", forcePlot});
+  r.plots.push_back({"track_profile", profile});
+}
+
 }  // namespace
 
 ExperimentResult testTrack(const ValidationOptions& o) {
@@ -149,15 +244,7 @@ ExperimentResult testTrack(const ValidationOptions& o) {
     return std::make_pair(lo / steady, hi / steady);
   };
 
-  // Flat stretches between bumps (and after the last), at least 0.8 m long:
-  // the front axle's loads there are the reference.
-  std::vector<std::pair<double, double>> flats;
-  double from = settled;
-  for (const Bump& b : bumps) {
-    if (b.foot - from >= 0.8) flats.emplace_back(from, b.foot);
-    from = std::max(from, b.end);
-  }
-  if (until - from >= 0.8) flats.emplace_back(from, until);
+  const std::vector<std::pair<double, double>> flats = flatStretches(bumps, settled, until);
   std::vector<double> flatLoads;
   for (const auto& [a, b] : flats) flatLoads.push_back(meanOver(track.axle, track.front, a, b));
   const double flatLoad = mean(flatLoads);
@@ -192,13 +279,7 @@ ExperimentResult testTrack(const ValidationOptions& o) {
   // Control: the track's lead-in (the speeds) and its flat stretches, each
   // against the others (the loads).
   const auto [leadSlowest, leadFastest] = extremes(track.axle, v, settled, bumps.front().foot);
-  double stretchWorstLoad = 1e9;
-  for (size_t k = 0; k < flats.size(); ++k) {
-    std::vector<double> others;
-    for (size_t m = 0; m < flats.size(); ++m)
-      if (m != k) others.push_back(flatLoads[m]);
-    if (!others.empty()) stretchWorstLoad = std::min(stretchWorstLoad, flatLoads[k] / mean(others));
-  }
+  const double stretchWorstLoad = smallestAgainstTheOthers(flatLoads);
   const auto control = [&](const std::string& what, double value, const std::string& target, bool fails) {
     r.metrics.push_back({"control: " + what + " (must fail the test)", "", value, "", target, fails, true, Basis::Control});
   };
@@ -211,58 +292,10 @@ ExperimentResult testTrack(const ValidationOptions& o) {
   control("the flat stretches' front load against the other stretches', smallest", stretchWorstLoad,
           "> " + num(unload, 2), stretchWorstLoad > unload);
 
-  // The mechanism, for the record: the wheels roll without slipping, and
-  // what the hinge gains or loses on them is the body's pitch.
-  std::vector<double> rate, gain;
-  double worstSlip = 0;
-  for (size_t i = 0; i < track.axle.size(); ++i)
-    if (track.axle[i] >= settled) {
-      rate.push_back(track.pitchRate[i]);
-      gain.push_back(track.v[i] - track.rolling[i]);
-      worstSlip = std::max(worstSlip, track.slip[i]);
-    }
-  const LinearFit pitch = linearFit(rate, gain);
-  r.metrics.push_back({"for the record: largest slip of a wheel at speed (front axle past " + num(settled, 1) +
-                           " m), |1 - rolling speed / hub speed|, any 20 ms sample",
-                       "", worstSlip * 100, "%", "", false, false});
-  r.metrics.push_back({"for the record: hinge speed less the wheels' rolling speed against the body's pitch rate, "
-                       "linear fit, R^2 (slope " + num(pitch.slope, 2) + " m: the hinge's height above the ground)",
-                       "", pitch.r2, "", "", false, false});
-  // Force spikes, for the record: the largest front load over each bump.
-  for (size_t k = 0; k < bumps.size(); ++k) {
-    double peak = 0;
-    for (size_t i = 0; i < track.axle.size(); ++i)
-      if (track.axle[i] >= bumps[k].foot && track.axle[i] < bumps[k].end + 1) peak = std::max(peak, track.front[i]);
-    r.metrics.push_back({"bump " + std::to_string(k + 1) + ": largest front load from its foot to 1 m past its end, "
-                         "against the flat stretches' mean",
-                         "spikes matched the real run's", 100 * (peak / flatLoad - 1), "%", "", false, false});
-  }
-
-  PlotSpec speedPlot{"Test track: speed against distance", "front axle position [m]", "speed [m/s]", {}, 960, 400,
-                     {}, {}};
-  speedPlot.series = {{"hinge speed, test track", track.axle, v, PlotSeries::Style::Line},
-                      {"wheels' rolling speed, test track", track.axle, smooth(track.rolling, 5), PlotSeries::Style::Line},
-                      {"hinge speed, flat ground (control)", flat.axle, vFlat, PlotSeries::Style::Line}};
-  PlotSpec forcePlot{"Test track: axle loads against distance (0.1 s moving average)", "front axle position [m]",
-                     "normal force [N]", {}, 960, 400, {}, {}};
-  forcePlot.series = {{"front pair", track.axle, smooth(track.front, 5), PlotSeries::Style::Line},
-                      {"rear pair", track.axle, smooth(track.rear, 5), PlotSeries::Style::Line}};
-  PlotSpec profile{"Test track: profile and the bumps found in it", "distance [m]", "height [m]", {}, 960, 300, {}, {}};
-  PlotSeries h{"track middle row", {}, {}, PlotSeries::Style::Line};
-  for (int i = 0; i < grid.columns; ++i) {
-    h.x.push_back(x0 + i * grid.spacingX());
-    h.y.push_back(grid.at(i, row));
-  }
-  PlotSeries marks{"foot, crest, end", {}, {}, PlotSeries::Style::Points};
-  for (const Bump& b : bumps)
-    for (double x : {b.foot, b.crest, b.end}) {
-      marks.x.push_back(x);
-      marks.y.push_back(grid.at(static_cast<int>(std::lround((x - x0) / grid.spacingX())), row));
-    }
-  profile.series = {h, marks};
-  r.plots.push_back({"track_speed", speedPlot});
-  r.plots.push_back({"track_forces", forcePlot});
-  r.plots.push_back({"track_profile", profile});
+  const Mechanism mechanism = addMechanism(r, track, settled, bumps, flatLoad);
+  const double worstSlip = mechanism.worstSlip;
+  const LinearFit& pitch = mechanism.pitch;
+  addTrackPlots(r, track, flat, grid, row, x0, bumps);
   r.discussion =
       "Why the robot slows at the bumps, measured: its wheels roll without slipping (the largest slip of any "
       "wheel in any sample " + num(worstSlip * 100, 1) + " %, on snow of mu 0.3), each turning at the drive's constant rate against "

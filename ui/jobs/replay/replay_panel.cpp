@@ -92,6 +92,17 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   layout->setContentsMargins(4, 4, 4, 4);
   title_ = new QLabel(tr("No log open: File ▸ Open session log…"), this);
   layout->addWidget(title_);
+  buildControls(layout);
+  buildPlot(layout);
+  timer_ = new QTimer(this);
+  timer_->setInterval(16);
+  connect(timer_, &QTimer::timeout, this, &ReplayPanel::tick);
+  connect(slider_, &QSlider::valueChanged, this, [this](int ms) { show(ms / 1000.0); });
+  connect(events_, &QListWidget::itemClicked, this, [this](QListWidgetItem* item) { seekToEvent(events_->row(item)); });
+  setEnabled(false);  // until a log is open (or opening: Cancel)
+}
+
+void ReplayPanel::buildControls(QVBoxLayout* layout) {
   auto* row = new QHBoxLayout;
   auto* back = new QPushButton(actionIcon(QStringLiteral("step-back")), QString(), this);
   back->setToolTip(tr("Step back %1 s").arg(kStep));
@@ -152,6 +163,13 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   track->addWidget(marks_);
   layout->addLayout(track);
   connect(branch, &QPushButton::clicked, this, [this] { branchHere(); });
+  connect(playButton_, &QPushButton::clicked, this, [this] { playing_ ? pause() : play(); });
+  connect(back, &QPushButton::clicked, this, [this] { step(-1); });
+  connect(forward, &QPushButton::clicked, this, [this] { step(+1); });
+  connect(speedBox_, &QComboBox::currentIndexChanged, this, [this](int i) { setSpeed(speedBox_->itemData(i).toDouble()); });
+}
+
+void ReplayPanel::buildPlot(QVBoxLayout* layout) {
   auto* plotRow = new QHBoxLayout;
   signalBox_ = new QComboBox(this);
   signalBox_->setToolTip(tr("The logged signal to plot"));
@@ -202,17 +220,6 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
     const QString path = QFileDialog::getSaveFileName(this, tr("Export PNG"), QString(), tr("PNG (*.png)"));
     if (const QString e = path.isEmpty() ? QString() : exportPng(path); !e.isEmpty()) QMessageBox::warning(this, tr("Export PNG"), e);
   });
-
-  timer_ = new QTimer(this);
-  timer_->setInterval(16);
-  connect(timer_, &QTimer::timeout, this, &ReplayPanel::tick);
-  connect(playButton_, &QPushButton::clicked, this, [this] { playing_ ? pause() : play(); });
-  connect(back, &QPushButton::clicked, this, [this] { step(-1); });
-  connect(forward, &QPushButton::clicked, this, [this] { step(+1); });
-  connect(speedBox_, &QComboBox::currentIndexChanged, this, [this](int i) { setSpeed(speedBox_->itemData(i).toDouble()); });
-  connect(slider_, &QSlider::valueChanged, this, [this](int ms) { show(ms / 1000.0); });
-  connect(events_, &QListWidget::itemClicked, this, [this](QListWidgetItem* item) { seekToEvent(events_->row(item)); });
-  setEnabled(false);  // until a log is open (or opening: Cancel)
 }
 
 ReplayPanel::~ReplayPanel() {

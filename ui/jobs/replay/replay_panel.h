@@ -28,6 +28,7 @@
 
 class QComboBox;
 class QLabel;
+class QVBoxLayout;
 class QListWidget;
 class QProgressBar;
 class QPushButton;
@@ -126,6 +127,10 @@ class ReplayPanel : public QWidget {
   void terrain(const sp::HeightGrid& grid);
 
  private:
+  // The constructor's parts: the transport row, the progress row and the
+  // timeline; the signal's plot beside the events.
+  void buildControls(QVBoxLayout* layout);
+  void buildPlot(QVBoxLayout* layout);
   void tick();
   void show(double time);
   /// Shows a player opened (on the worker or here); `firstPlot`: the
