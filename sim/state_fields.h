@@ -10,7 +10,11 @@
 // hash leaves out (it fingerprints the
 // dynamics, not the sensors' last readings). Fields that are vectors of
 // listed structs are visited element by element by the visitor itself
-// (visitState() on each). The motion resistance pair goes through
+// (visitState() on each). A Snapshot's own fields are listed too; what is
+// not a plain value goes through the visitor's own method: the robots'
+// controllers with their sensors `v.robots(controls, sensors)` (the hash
+// takes them robot by robot, the codec all controls first), the terrain
+// `v.terrain(grid)` (hashed only where edited). The motion resistance pair goes through
 // `v.resistance(forces, shares)`: it is hashed only where a surface has it,
 // so that runs without it keep the hashes they always had.
 //
@@ -30,6 +34,7 @@ static_assert(sizeof(RobotControlState) == 160 && sizeof(GaitState) == 16,
               "list the new RobotControlState field in visitState() below");
 static_assert(sizeof(SensorState) == 8 + 3 * 24 + 8 + sizeof(SensorSample),
               "list the new SensorState field in visitState() below");
+static_assert(sizeof(Snapshot) == 3 * 8 + 3 * 24 + 8 + 32 + 16 + 24, "list the new Snapshot field in visitState() below");
 
 /// Tags of a field: in the state hash or not.
 inline constexpr std::true_type kHashed{};
@@ -88,6 +93,21 @@ void visitState(S& s, V&& v) {
   v(s.contactSum, kUnhashed);
   v(s.stepsSummed, kHashed);
   v(s.latest, kUnhashed);
+}
+
+/// A whole snapshot: its own fields in order, the structs above through them.
+template <class T, class V>
+  requires std::is_same_v<std::remove_const_t<T>, Snapshot>
+void visitState(T& s, V&& v) {
+  v(s.modelKey, kUnhashed);  // the layout it fits: checked by restore(), not state
+  v(s.step, kHashed);
+  v(s.stepSize, kUnhashed);  // the world's, not the state's (a snapshot restores into another step)
+  v(s.bodies, kHashed);
+  v.robots(s.robots, s.sensors);
+  v(s.odeRandom, kHashed);
+  v(s.random, kHashed);
+  v.terrain(s.terrain);
+  v(s.pending, kUnhashed);  // the commands queued: they act at the next step, whose state is hashed
 }
 
 }  // namespace sp

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
+#include <utility>
 
 #include "sim/hash.h"
 #include "sim/state_fields.h"
@@ -157,6 +158,7 @@ namespace {
 // Hashes the fields sim/state_fields.h marks hashed, each as its bytes.
 struct StateHasher {
   Fnv1a64& h;
+  const std::vector<double>& loadedHeights;  // the terrain as the world file gave it
   template <class T, bool Hashed>
   void operator()(const T& v, std::bool_constant<Hashed>) {
     if constexpr (Hashed) {
@@ -168,6 +170,18 @@ struct StateHasher {
   void operator()(const std::vector<T>& items, std::bool_constant<Hashed>) {
     if constexpr (Hashed)
       for (const T& item : items) visitState(item, *this);
+  }
+  // Robot by robot: its controllers, then its sensors.
+  void robots(const std::vector<RobotControlState>& controls, const std::vector<std::vector<SensorState>>& sensors) {
+    for (size_t r = 0; r < controls.size(); ++r) {
+      visitState(controls[r], *this);
+      (*this)(sensors[r], kHashed);
+    }
+  }
+  // Edited terrain is state too. Heights as loaded add nothing, so runs
+  // without edits keep the hashes they always had.
+  void terrain(const std::shared_ptr<const HeightGrid>& grid) {
+    if (grid && grid->heights != loadedHeights) h.bytes(grid->heights.data(), grid->heights.size() * sizeof(double));
   }
   // Motion resistance only where a surface has it: other runs keep the
   // hashes they always had.
@@ -186,23 +200,14 @@ struct StateHasher {
 
 uint64_t World::stateHash() const {
   const Impl& m = *impl_;
+  // The snapshot's fields, as sim/state_fields.h lists them; the bodies'
+  // orientations as ODE holds them (a snapshot keeps each one's preimage,
+  // to restore it exactly).
+  Snapshot s = snapshot();
+  for (size_t b = 0; b < m.allBodies.size(); ++b) s.bodies[b].quaternion = readBody(m.allBodies[b]).quaternion;
   Fnv1a64 h;
-  h.value(steps_);
-  StateHasher hash{h};
-  for (dBodyID b : m.allBodies) {
-    const BodyState body = readBody(b);
-    visitState(body, hash);
-  }
-  for (const Impl::Robot& rt : m.robots) {
-    visitState(rt.control, hash);
-    hash(rt.sensors, kHashed);
-  }
-  h.value(m.randState);
-  h.value(m.random.state());
-  // Edited terrain is state too. Heights as loaded add nothing, so runs
-  // without edits keep the hashes they always had.
-  if (m.grid && m.grid->heights != model_.terrain.grid.heights)
-    h.bytes(m.grid->heights.data(), m.grid->heights.size() * sizeof(double));
+  StateHasher hash{h, model_.terrain.grid.heights};
+  visitState(std::as_const(s), hash);
   return h.digest();
 }
 

@@ -245,6 +245,7 @@ Command readCommand(Reader& r) {
 struct Encode {
   Writer& w;
   void operator()(double v, auto) { w.f64(v); }
+  void operator()(uint64_t v, auto) { w.u64(v); }
   void operator()(bool v, auto) { w.boolean(v); }
   void operator()(int v, auto) { w.i32(v); }
   void operator()(int64_t v, auto) { w.i64(v); }
@@ -253,6 +254,10 @@ struct Encode {
   template <size_t N>
   void operator()(const std::array<double, N>& a, auto) {
     for (double v : a) w.f64(v);
+  }
+  template <size_t N>
+  void operator()(const std::array<uint64_t, N>& a, auto) {
+    for (uint64_t v : a) w.u64(v);
   }
   void operator()(const GaitState& g, auto) {
     w.u8(static_cast<uint8_t>(g.gait));
@@ -270,6 +275,28 @@ struct Encode {
   void operator()(const std::vector<T>& items, auto) {
     w.u64(items.size());
     for (const T& item : items) visitState(item, *this);
+  }
+  void robots(const std::vector<RobotControlState>& controls, const std::vector<std::vector<SensorState>>& sensors) {
+    (*this)(controls, kHashed);
+    w.u64(sensors.size());
+    for (const std::vector<SensorState>& robotSensors : sensors) (*this)(robotSensors, kHashed);
+  }
+  void terrain(const std::shared_ptr<const HeightGrid>& grid) {
+    w.boolean(grid != nullptr);
+    if (!grid) return;
+    w.i32(grid->columns);
+    w.i32(grid->rows);
+    w.f64(grid->width);
+    w.f64(grid->depth);
+    w.u64(grid->heights.size());
+    for (double h : grid->heights) w.f64(h);
+  }
+  void operator()(const std::vector<std::pair<int, Command>>& pending, auto) {
+    w.u64(pending.size());
+    for (const auto& [robot, command] : pending) {
+      w.i32(robot);
+      writeCommand(w, command);
+    }
   }
   void resistance(const std::vector<double>& forces, const std::vector<double>& shares,
                   const std::vector<double>& holds) {
@@ -301,6 +328,7 @@ struct Decode {
   Reader& r;
   uint32_t version;
   void operator()(double& v, auto) { v = r.f64(); }
+  void operator()(uint64_t& v, auto) { v = r.u64(); }
   void operator()(bool& v, auto) { v = r.boolean(); }
   void operator()(int& v, auto) { v = r.i32(); }
   void operator()(int64_t& v, auto) { v = r.i64(); }
@@ -313,6 +341,10 @@ struct Decode {
   template <size_t N>
   void operator()(std::array<double, N>& a, auto) {
     for (double& v : a) v = r.f64();
+  }
+  template <size_t N>
+  void operator()(std::array<uint64_t, N>& a, auto) {
+    for (uint64_t& v : a) v = r.u64();
   }
   void operator()(GaitState& g, auto) {
     const uint8_t v = r.u8();
@@ -332,6 +364,29 @@ struct Decode {
   void operator()(std::vector<T>& items, auto) {
     items.resize(r.count(minEncodedSize<T>()));
     for (T& item : items) visitState(item, *this);
+  }
+  void robots(std::vector<RobotControlState>& controls, std::vector<std::vector<SensorState>>& sensors) {
+    (*this)(controls, kHashed);
+    sensors.resize(r.count(8));
+    for (std::vector<SensorState>& robotSensors : sensors) (*this)(robotSensors, kHashed);
+  }
+  void terrain(std::shared_ptr<const HeightGrid>& terrain) {
+    if (!r.boolean()) return;
+    auto grid = std::make_shared<HeightGrid>();
+    grid->columns = r.i32();
+    grid->rows = r.i32();
+    grid->width = r.f64();
+    grid->depth = r.f64();
+    grid->heights.resize(r.count(8));
+    for (double& h : grid->heights) h = r.f64();
+    terrain = std::move(grid);
+  }
+  void operator()(std::vector<std::pair<int, Command>>& pending, auto) {
+    pending.resize(r.count(9));
+    for (auto& [robot, command] : pending) {
+      robot = r.i32();
+      command = readCommand(r);
+    }
   }
   void resistance(std::vector<double>& forces, std::vector<double>& shares, std::vector<double>& holds) {
     if (version < 2) return;
@@ -354,30 +409,9 @@ std::vector<uint8_t> encodeSnapshot(const Snapshot& s) {
   Writer w;
   for (char c : std::string("SPSN")) w.u8(static_cast<uint8_t>(c));
   w.u32(kSnapshotCodecVersion);
-  w.u64(s.modelKey);
-  w.i64(s.step);
-  w.f64(s.stepSize);
+  static_assert(std::is_same_v<unsigned long, uint64_t>, "odeRandom is written as a u64");
   Encode encode{w};
-  encode(s.bodies, kHashed);
-  encode(s.robots, kHashed);
-  w.u64(s.sensors.size());
-  for (const std::vector<SensorState>& robotSensors : s.sensors) encode(robotSensors, kHashed);
-  w.u64(static_cast<uint64_t>(s.odeRandom));
-  for (uint64_t v : s.random) w.u64(v);
-  w.boolean(s.terrain != nullptr);
-  if (s.terrain) {
-    w.i32(s.terrain->columns);
-    w.i32(s.terrain->rows);
-    w.f64(s.terrain->width);
-    w.f64(s.terrain->depth);
-    w.u64(s.terrain->heights.size());
-    for (double h : s.terrain->heights) w.f64(h);
-  }
-  w.u64(s.pending.size());
-  for (const auto& [robot, command] : s.pending) {
-    w.i32(robot);
-    writeCommand(w, command);
-  }
+  visitState(s, encode);
   return w.take();
 }
 
@@ -395,31 +429,8 @@ std::optional<Snapshot> decodeSnapshot(const std::vector<uint8_t>& data, std::st
       return fail("snapshot format version " + std::to_string(version) + " is not supported (expected " +
                   std::to_string(kSnapshotCodecVersion) + ")");
     Snapshot s;
-    s.modelKey = r.u64();
-    s.step = r.i64();
-    s.stepSize = r.f64();
     Decode decode{r, version};
-    decode(s.bodies, kHashed);
-    decode(s.robots, kHashed);
-    s.sensors.resize(r.count(8));
-    for (std::vector<SensorState>& robotSensors : s.sensors) decode(robotSensors, kHashed);
-    s.odeRandom = static_cast<unsigned long>(r.u64());
-    for (uint64_t& v : s.random) v = r.u64();
-    if (r.boolean()) {
-      auto grid = std::make_shared<HeightGrid>();
-      grid->columns = r.i32();
-      grid->rows = r.i32();
-      grid->width = r.f64();
-      grid->depth = r.f64();
-      grid->heights.resize(r.count(8));
-      for (double& h : grid->heights) h = r.f64();
-      s.terrain = std::move(grid);
-    }
-    s.pending.resize(r.count(9));
-    for (auto& [robot, command] : s.pending) {
-      robot = r.i32();
-      command = readCommand(r);
-    }
+    visitState(s, decode);
     if (!r.atEnd()) return fail("trailing bytes after the snapshot");
     return s;
   } catch (const std::exception& e) {
