@@ -156,7 +156,7 @@ void MainWindow::buildFeeds() {
   connect(monitor_, &ConsoleMonitor::filesDiffer, this, [this](const QString& text) { context_->event(QStringLiteral("link"), text); });
   connect(liveFeed_, &RobotFeed::frame, this, [this](const RobotFrame& f) {
     context_->setMeasuredPositions(f.jointPositions);
-    if (const std::optional<GhostError>& e = session_->lastPrediction()) errorPlot_->addSample(e->time, e->position, e->heading);
+    if (const std::optional<GhostError>& e = liveFeed_->lastPrediction()) errorPlot_->addSample(e->time, e->position, e->heading);
   });
   connect(feeds_, &FeedSwitch::frame, this, &MainWindow::onShownFrame);
   connect(feeds_, &FeedSwitch::laser, this, [this](const LaserFrame& scan) {

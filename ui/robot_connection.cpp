@@ -2,15 +2,26 @@
 
 #include <QMetaObject>
 
+#include <chrono>
 #include <utility>
 
 namespace sp {
 
+namespace {
+
+double wallSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
 RobotConnection::RobotConnection(QObject* parent) : QObject(parent) {}
 
 RobotConnection::~RobotConnection() {
-  // Joins the worker: no callback runs after this, and queued calls to a
-  // destroyed context object are dropped by Qt.
+  // Joins the worker while client_ is still there (its callbacks use it):
+  // no callback runs after this, and queued calls to a destroyed context
+  // object are dropped by Qt.
+  if (client_) client_->stop();
   client_.reset();
 }
 
@@ -36,6 +47,10 @@ void RobotConnection::open(const net::RobotClientConfig& config) {
   callbacks.telemetry = [this](const net::TelemetryMsg& m) {
     // The guard first, here on the worker: its ABORT must not wait for the window.
     if (std::optional<GuardDeparture> d = guard_->telemetry(m)) guardAbort(*d);
+    // Then the log, the ghost and the calibration, here too: they never
+    // wait for the window either.
+    TelemetryTap::Tapped tapped;
+    if (tap_) tapped = tap_->telemetry(m, wallSeconds(), client_->stats().rttMs / 1000);
     // At most kTelemetryQueued frames wait for the window: a window that
     // falls behind (a modal dialog, a loaded machine) gets the newest frame
     // when it is back, not a backlog it would show seconds late.
@@ -44,15 +59,18 @@ void RobotConnection::open(const net::RobotClientConfig& config) {
       return;
     }
     ++telemetryQueued_;
-    post([this, m] {
+    post([this, m, tapped = std::move(tapped)] {
       --telemetryQueued_;
-      emit telemetry(m);
+      emit telemetry(m, tapped);
     });
   };
   callbacks.refusedTelemetry = [this](const net::Refusal& r) {
     if (std::optional<GuardDeparture> d = guard_->cannotJudge(r.kind + ": " + r.detail)) guardAbort(*d);
   };
-  callbacks.laser = [this](const net::LaserMsg& m) { post([this, m] { emit laser(m); }); };
+  callbacks.laser = [this](const net::LaserMsg& m) {
+    if (tap_) tap_->laser(m);
+    post([this, m] { emit laser(m); });
+  };
   callbacks.reply = [this](const net::ReplyMsg& m) { post([this, m] { emit reply(m); }); };
   callbacks.event = [this](const net::EventMsg& m) { post([this, m] { emit event(m); }); };
   callbacks.lease = [this](const net::LeaseStateMsg& m) { post([this, m] { emit lease(m); }); };

@@ -2,7 +2,10 @@
 // The console's end of the robot link, for Qt: a RobotClient whose callbacks
 // (on the client's worker thread) are re-posted to the GUI thread and
 // emitted as signals there, so widgets are only ever touched by the GUI
-// thread (STYLE.md habit 6).
+// thread (STYLE.md habit 6). Telemetry is handed on where it arrives, on
+// the worker: to the sequence guard, then to the tap (the session's log,
+// ghost and calibration: app/console/telemetry_tap.h); the window is sent
+// the frame to draw.
 //
 // Thread: GUI thread only (construction, every method, every signal).
 
@@ -12,6 +15,7 @@
 #include <atomic>
 #include <memory>
 
+#include "app/console/telemetry_tap.h"
 #include "app/rehearse/sequence_guard.h"
 #include "net/robot_client.h"
 
@@ -25,6 +29,10 @@ class RobotConnection : public QObject {
   /// Stops the client: no signal is emitted afterwards.
   ~RobotConnection() override;
 
+  /// Where telemetry goes on the worker, before the window sees it (null:
+  /// nowhere; the `telemetry` signal's frame then has no joints). Set it
+  /// before open().
+  void setTap(std::shared_ptr<TelemetryTap> tap) { tap_ = std::move(tap); }
   /// (Re)connects with `config`; drops a previous connection first.
   void open(const net::RobotClientConfig& config);
   /// Releases the lease if held, then closes the connection.
@@ -54,7 +62,9 @@ class RobotConnection : public QObject {
   uint64_t telemetryShed() const { return telemetryShed_.load(); }
 
  signals:
-  void telemetry(const sp::net::TelemetryMsg& message);
+  /// A telemetry frame, and what the tap made of it (the frame to draw,
+  /// the ghost's error for it).
+  void telemetry(const sp::net::TelemetryMsg& message, const sp::TelemetryTap::Tapped& tapped);
   void laser(const sp::net::LaserMsg& message);
   void reply(const sp::net::ReplyMsg& message);
   void event(const sp::net::EventMsg& message);
@@ -82,6 +92,7 @@ class RobotConnection : public QObject {
   std::atomic<int> telemetryQueued_{0};   // telemetry posted to the window, not yet emitted
   std::atomic<uint64_t> telemetryShed_{0};  // ... not posted: the window was behind
   std::shared_ptr<SequenceGuard> guard_ = std::make_shared<SequenceGuard>();
+  std::shared_ptr<TelemetryTap> tap_;  // read by the worker: set before open()
 };
 
 }  // namespace sp

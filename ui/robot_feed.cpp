@@ -2,8 +2,6 @@
 
 #include <QFileInfo>
 
-#include <chrono>
-
 #include "app/console/console_session.h"
 #include "app/state/robot_shapes.h"
 #include "ui/jobs/replay/replay_panel.h"
@@ -13,25 +11,25 @@ namespace sp {
 
 namespace {
 
-double wallSeconds() {
-  using namespace std::chrono;
-  return duration<double>(steady_clock::now().time_since_epoch()).count();
-}
-
 QString qs(const std::string& s) { return QString::fromStdString(s); }
 
 }  // namespace
 
 LiveLinkFeed::LiveLinkFeed(RobotConnection* connection, ConsoleSession* session, QObject* parent)
     : RobotFeed(parent), session_(session) {
-  connect(connection, &RobotConnection::telemetry, this, [this, connection](const net::TelemetryMsg& t) {
+  // The frames come handed on already (the session's tap, on the link's
+  // worker): here they are only drawn.
+  connection->setTap(session_->tap());
+  connect(connection, &RobotConnection::telemetry, this, [this](const net::TelemetryMsg& t, const TelemetryTap::Tapped& f) {
     ++telemetryCount_;
     lastTelemetry_ = t;
-    emit frame(session_->telemetry(t, wallSeconds(), connection->stats().rttMs / 1000));
+    lastPrediction_ = f.prediction;
+    session_->takeCalibration();
+    emit frame(f.frame);
   });
   connect(connection, &RobotConnection::laser, this, [this](const net::LaserMsg& m) {
     ++laserCount_;
-    emit laser(session_->laser(m));
+    emit laser(laserFrame(m));
   });
   connect(connection, &RobotConnection::reply, this, [this](const net::ReplyMsg& m) {
     if (m.status == net::ReplyStatus::Ok) return;

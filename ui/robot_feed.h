@@ -18,6 +18,7 @@
 #include <optional>
 #include <vector>
 
+#include "app/ghost/prediction_record.h"
 #include "app/state/robot_frame.h"
 #include "net/message.h"
 
@@ -63,9 +64,11 @@ class RobotFeed : public QObject {
   void terrain(const sp::HeightGrid& grid);
 };
 
-/// The robot link as a feed. Telemetry and scans pass through the console
-/// session (`session` must outlive the feed), which turns them into frames
-/// in the model's joint order and logs them when the robot is remote.
+/// The robot link as a feed. Telemetry and scans reach the console
+/// session's tap on the link's worker (`session` must outlive the feed),
+/// which turns them into frames in the model's joint order, logs them when
+/// the robot is remote and anchors the ghost: the feed only passes the
+/// frames on to be drawn.
 class LiveLinkFeed : public RobotFeed {
   Q_OBJECT
 
@@ -76,12 +79,18 @@ class LiveLinkFeed : public RobotFeed {
   /// The session's world changed: shown anew by whoever shows this feed.
   void announceWorld();
 
+  /// The ghost's error for the frame last emitted (nullopt: it had shown
+  /// nothing for that frame's time).
+  const std::optional<GhostError>& lastPrediction() const { return lastPrediction_; }
   /// The latest telemetry as it arrived, if any.
   const std::optional<net::TelemetryMsg>& lastTelemetry() const { return lastTelemetry_; }
   int64_t telemetryCount() const { return telemetryCount_; }
   int64_t laserCount() const { return laserCount_; }
   /// Forgets the last telemetry (a new world is drawn).
-  void clear() { lastTelemetry_.reset(); }
+  void clear() {
+    lastTelemetry_.reset();
+    lastPrediction_.reset();
+  }
 
  private:
   /// An event for the list, logged (when the robot is remote) as `logKind`.
@@ -89,6 +98,7 @@ class LiveLinkFeed : public RobotFeed {
 
   ConsoleSession* session_;
   std::optional<net::TelemetryMsg> lastTelemetry_;
+  std::optional<GhostError> lastPrediction_;
   int64_t telemetryCount_ = 0, laserCount_ = 0;
 };
 

@@ -2,6 +2,7 @@
 
 #include "app/state/robot_shapes.h"
 #include "app/console/terrain_editor.h"
+#include "app/console/telemetry_tap.h"
 
 #include <cmath>
 #include <cstdio>
@@ -32,6 +33,7 @@ std::string text(const Diagnostics& diag) {
 ConsoleSession::ConsoleSession(ConsoleSessionOptions options) : options_(std::move(options)) {}
 
 ConsoleSession::~ConsoleSession() {
+  tap_->unbind();  // the link's worker may outlive the session
   recorder_.reset();
   if (standIn_) standIn_->stop();
 }
@@ -40,18 +42,19 @@ const RobotModel* ConsoleSession::robot() const {
   return world_ && !world_->robots.empty() ? &world_->robots[0].model : nullptr;
 }
 
+void ConsoleSession::bindTap() {
+  tap_->bind({robot(), ghost_.get(), calibrator_.get(), recorder_.get(), standIn_.get()});
+}
+
 void ConsoleSession::setWorld(WorldModel world) {
+  const TapRebind rebind(*this);
   terrain_.reset();  // its history is of the old world's heights
   world_ = std::move(world);
   if (world_->terrain.kind == TerrainSpec::Kind::Heightfield)
     terrain_ = std::make_unique<TerrainEditor>(world_->terrain.grid);
   ++worldVersion_;
-  positions_.reset();
-  rates_.reset();
-  rate_.reset();
   calibrator_.reset();
   ghost_.reset();
-  lastPrediction_.reset();
   ghostError_.clear();
   calibrationSeen_ = calibrationFitsLogged_ = 0;
   if (options_.ghost) ghost_ = Ghost::create(*world_, params_, options_.ghostOptions, ghostError_);
@@ -140,6 +143,7 @@ std::string ConsoleSession::connectTo(const std::string& hostPort, const std::st
   std::string error;
   const std::optional<RobotEndpoint> endpoint = parseEndpoint(hostPort, token, error);
   if (!endpoint) return error;
+  const TapRebind rebind(*this);
   // The stand-in goes (its log complete); the drawing stays until the
   // operator opens the remote robot's world.
   if (standIn_) standIn_->stop();
@@ -159,6 +163,7 @@ std::string ConsoleSession::useStandIn() {
     options_.connectTo = previous;
     return error;
   }
+  const TapRebind rebind(*this);
   recorder_.reset();
   return {};
 }
@@ -185,6 +190,7 @@ std::string ConsoleSession::startStandIn(const std::string& worldFile, const std
   if (!standIn) return text(diag);
   if (std::string error = standIn->start(); !error.empty()) return error;
   // Only now that the new robot runs is the old one replaced.
+  const TapRebind rebind(*this);
   if (standIn_) standIn_->stop();
   standIn_ = std::move(standIn);
   worldFile_ = worldFile;
@@ -227,6 +233,7 @@ std::string ConsoleSession::openRobot(const std::string& path) {
 }
 
 void ConsoleSession::openRemoteLog() {
+  const TapRebind rebind(*this);
   recorder_.reset();
   recorderError_.clear();
   if (!options_.log || !world_) return;
@@ -248,30 +255,21 @@ std::string ConsoleSession::logError() const {
 }
 
 RobotFrame ConsoleSession::telemetry(const net::TelemetryMsg& t, double wall, double roundTrip) {
-  RobotFrame f = frameFromTelemetry(t, robot(), positions_, rates_);
-  if (const RobotModel* model = robot()) {
-    if (recorder_) recorder_->telemetry(t, *model);
-    if (ghost_ && !f.health.empty()) {
-      // A diverged robot twin reports no state to predict from.
-      ghost_->halt("the robot's twin diverged: " + f.health);
-      lastPrediction_.reset();
-    } else if (ghost_) {
-      lastPrediction_ = ghost_->anchor(f, roundTrip > 0 ? roundTrip : t.rttMs / 1000);
-      if (lastPrediction_) logPrediction(*lastPrediction_);
-    }
-    if (calibrator_) {
-      calibrator_->frame(f);
-      takeCalibration();
-    }
-  }
-  rate_.add(wall, t.time);
+  RobotFrame f = tap_->telemetry(t, wall, roundTrip).frame;
+  takeCalibration();
   return f;
 }
 
 LaserFrame ConsoleSession::laser(const net::LaserMsg& m) {
-  if (recorder_) recorder_->laser(m);
-  return {m.time, m.angleMin, m.angleStep, m.ranges};
+  tap_->laser(m);
+  return laserFrame(m);
 }
+
+std::optional<GhostError> ConsoleSession::lastPrediction() const { return tap_->lastPrediction(); }
+
+double ConsoleSession::realTimeFactor() const { return tap_->realTimeFactor(); }
+
+LaserFrame laserFrame(const net::LaserMsg& m) { return {m.time, m.angleMin, m.angleStep, m.ranges}; }
 
 std::string ConsoleSession::commandRefusal(bool leaseHeld) const {
   if (!leaseHeld) return "Not sent: take control first (Robot ▸ Take control)";
@@ -291,7 +289,6 @@ void ConsoleSession::commandSent(const Command& command) {
 
 void ConsoleSession::linkDown(const std::string& why) {
   if (ghost_) ghost_->halt("the robot link is down (" + why + "): no prediction until it is back");
-  lastPrediction_.reset();
 }
 
 void ConsoleSession::estopSent() {
@@ -307,18 +304,6 @@ bool ConsoleSession::terrainEdited(const TerrainPatchCmd& patch) {
   if (!terrain_ || !patchFits(&world_->terrain.grid, patch).empty()) return false;
   commandSent(patch);
   return true;
-}
-
-void ConsoleSession::logPrediction(const GhostError& e) {
-  LogPrediction p;
-  p.time = e.time;
-  p.made = e.made;
-  p.base = {e.predicted.p.x, e.predicted.p.y, e.predicted.p.z};
-  p.quat = {e.predicted.q.w, e.predicted.q.x, e.predicted.q.y, e.predicted.q.z};
-  p.positionError = e.position;
-  p.headingError = e.heading;
-  if (recorder_) recorder_->prediction(p);
-  else if (standIn_) standIn_->logPrediction(p);
 }
 
 std::string ConsoleSession::branchFrom(const std::string& logPath, double time) {

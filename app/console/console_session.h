@@ -10,9 +10,10 @@
 //   on telemetry:  sp::RobotFrame f = session.telemetry(message, wallSeconds);
 //   before a command: if (auto why = session.commandRefusal(leaseHeld); !why.empty()) tell(why);
 //
-// Thread: the owner's (the console's GUI thread) only. The stand-in it runs
-// has threads of its own (app/robot/stand_in.h); nothing here blocks on them or
-// on the disk.
+// Thread: the owner's (the console's GUI thread) only, but for tap(): the
+// link's worker hands telemetry to it (app/console/telemetry_tap.h). The
+// stand-in it runs has threads of its own (app/robot/stand_in.h); nothing
+// here blocks on them or on the disk.
 
 #include <cstdint>
 #include <map>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "app/calibration/live_calibrator.h"
+#include "app/console/telemetry_tap.h"
 #include "app/ghost/ghost.h"
 #include "app/log/resimulation.h"
 #include "app/state/robot_frame.h"
@@ -148,13 +150,21 @@ class ConsoleSession {
   /// Why the log failed, "" while it works.
   std::string logError() const;
 
-  /// A telemetry frame arrived at wall time `wall` [s]: the frame to draw
-  /// (joints in the model's order), logged when the robot is remote. It
-  /// re-anchors the ghost; what the ghost had predicted for the frame's
-  /// time is then lastPrediction(), and logged.
+  /// Where telemetry goes on arrival (app/console/telemetry_tap.h): the
+  /// link's worker hands each frame to it; the session binds it to its
+  /// log, ghost and calibrator, whichever they are now.
+  const std::shared_ptr<TelemetryTap>& tap() const { return tap_; }
+  /// A telemetry frame through tap() here and now (tests; a console's
+  /// link hands frames to the tap on its own thread), then takeCalibration():
+  /// the frame to draw (joints in the model's order), logged when the
+  /// robot is remote; it re-anchors the ghost; what the ghost had
+  /// predicted for the frame's time is then lastPrediction(), and logged.
   /// `roundTrip` [s] is the link's as the client measures it (0 = not
   /// yet; the robot's own figure in the message is used then).
   RobotFrame telemetry(const net::TelemetryMsg& message, double wall, double roundTrip = 0);
+  /// Hands a new calibration (a fit landed) to the ghost and logs the fits
+  /// made since the last call: the GUI calls it as frames come in.
+  void takeCalibration();
   /// The predictive ghost of the drawn world's robot; null without one
   /// (options.ghost false, or it could not be built: ghostError()).
   const Ghost* ghost() const { return ghost_.get(); }
@@ -171,14 +181,14 @@ class ConsoleSession {
   SimParams twinParams() const;
   /// The last telemetry frame against the ghost's prediction for its time;
   /// nullopt when the ghost had shown nothing for that time.
-  const std::optional<GhostError>& lastPrediction() const { return lastPrediction_; }
-  /// A laser scan arrived: the frame to draw, logged when remote.
+  std::optional<GhostError> lastPrediction() const;
+  /// A laser scan through tap() here and now: the frame to draw, logged when remote.
   LaserFrame laser(const net::LaserMsg& message);
   /// The real-time factor the stand-in is asked to run at (`--rtf`, else
   /// the parameters').
   double targetRealTimeFactor() const { return options_.rtf >= 0 ? options_.rtf : params_.realTimeFactor; }
   /// The achieved real-time factor over the last second of telemetry.
-  double realTimeFactor() const { return rate_.factor(); }
+  double realTimeFactor() const;
 
   /// "" when a command may go to the robot now, else why not (for the
   /// operator): only the lease holder commands.
@@ -219,9 +229,14 @@ class ConsoleSession {
   void openRemoteLog();
   /// Deletes logs beyond log.keep in the log folder (never the current one).
   void pruneLogs();
-  void logPrediction(const GhostError& error);
-  /// Hands a new calibration to the ghost and logs the fits made since the last call.
-  void takeCalibration();
+  /// The tap handed frames to the parts as they are now.
+  void bindTap();
+  /// Unbinds the tap while the parts change, binds them again after.
+  struct TapRebind {
+    explicit TapRebind(ConsoleSession& s) : session(s) { s.tap_->unbind(); }
+    ~TapRebind() { session.bindTap(); }
+    ConsoleSession& session;
+  };
 
   ConsoleSessionOptions options_;
   SimParams params_;
@@ -240,9 +255,10 @@ class ConsoleSession {
   int calibrationFitsLogged_ = 0;
   CalValues ghostCalibration_{};  // the calibration the ghost was last handed
   std::string ghostError_;
-  std::optional<GhostError> lastPrediction_;
-  JointNameMap positions_, rates_;
-  RateMeter rate_;
+  std::shared_ptr<TelemetryTap> tap_ = std::make_shared<TelemetryTap>();
 };
+
+/// The frame to draw of laser scan `m`.
+LaserFrame laserFrame(const net::LaserMsg& m);
 
 }  // namespace sp

@@ -54,8 +54,10 @@
 // still; the ghost stops the robot too and ignores the commands in flight
 // (the robot refuses commands while latched).
 //
-// Thread: anchor(), commandSent(), view(), errorMedian() from any one
-// thread (the console's GUI thread); the three workers are internal.
+// Thread: anchor() from one thread (the link's worker, through
+// app/console/telemetry_tap.h), commandSent(), view(), errorMedian() and
+// the rest from one other (the console's GUI thread); each copies under the
+// ghost's mutex. The three workers are internal.
 
 #include <condition_variable>
 #include <cstdint>

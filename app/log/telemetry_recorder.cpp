@@ -39,12 +39,13 @@ void TelemetryRecorder::laser(const net::LaserMsg& m) {
 }
 
 void TelemetryRecorder::command(const Command& command, const RobotModel* robot, std::optional<double> arrival) {
-  const double t = arrival ? *arrival : time_;
+  const double t = arrival ? *arrival : time_.load();
   writer_->logCommand(std::llround(t * 1000), t, "operator", command, robot);
 }
 
 void TelemetryRecorder::event(const std::string& kind, const std::string& text) {
-  writer_->logEvent(rowKey(), time_, kind, text);
+  const double t = time_;
+  writer_->logEvent(std::llround(t * 1000), t, kind, text);
 }
 
 }  // namespace sp

@@ -9,9 +9,11 @@
 // Steps: the robot's own step is not on the link; rows carry the robot's
 // time in milliseconds as their step.
 //
-// Thread: one thread at a time (the console's GUI thread); nothing blocks on
-// the disk (SessionLogWriter queues).
+// Thread: telemetry() and laser() from one thread (the link's worker,
+// through app/console/telemetry_tap.h), the rest from one other (the GUI's);
+// nothing blocks on the disk (SessionLogWriter queues, under its own lock).
 
+#include <atomic>
 #include <memory>
 #include <optional>
 #include <string>
@@ -56,7 +58,7 @@ class TelemetryRecorder {
   int64_t rowKey() const;
 
   std::unique_ptr<SessionLogWriter> writer_;
-  double time_ = 0;  // robot time of the latest telemetry [s]
+  std::atomic<double> time_{0};  // robot time of the latest telemetry [s]: written by telemetry(), read by the rest
   JointNameMap joints_;  // telemetry joint names -> the robot's order
 };
 

@@ -4,6 +4,9 @@
 // keep-alives sent from the GUI thread lose it); an e-stop pressed while
 // disconnected says it was not sent; Re-arm is offered only when something
 // is latched; Ctrl+Q asks before leaving a moving robot to its deadman.
+// Telemetry reaches the ghost on the link's own thread (issue 60): a
+// blocked window does not stop the ghost re-anchoring (control: a ghost fed
+// by the GUI thread, as the console's was, stops).
 
 #include <QApplication>
 #include <QMessageBox>
@@ -21,6 +24,7 @@
 #include "ui/link_panel.h"
 #include "ui/robot_connection.h"
 #include "app/console/console_session.h"
+#include "app/ghost/ghost.h"
 #include "ui/console_context.h"
 
 using namespace sp;
@@ -79,6 +83,37 @@ class TestOperatorTruth : public QObject {
     QVERIFY(w.linkPanel()->leaseHeld());
     QVERIFY(!w.lastTelemetry()->failsafe);
     QVERIFY(!w.context().state().failsafe());
+  }
+
+  // Telemetry goes to the ghost where it arrives, on the link's worker
+  // (app/console/telemetry_tap.h): through a GUI thread blocked for 1 s the
+  // tap hands on the stand-in's 50 frames a second and the ghost re-anchors
+  // (at most ghost.anchor_rate, 15 a second, at nice 10). The control, in
+  // the same second: a second ghost of the same world fed by the GUI thread
+  // from the frames the window is sent, as the console's was, anchors on
+  // nothing while the window is blocked.
+  void ghostAnchorsThroughABlockedWindow() {
+    MainWindow& w = *window_;
+    const Ghost* ghost = w.session()->ghost();
+    QVERIFY(ghost);
+    std::string error;
+    std::unique_ptr<Ghost> relayed = Ghost::create(*w.session()->world(), w.session()->params(), error);
+    QVERIFY2(relayed, error.c_str());
+    const QMetaObject::Connection relay = connect(
+        w.connection(), &RobotConnection::telemetry, this,
+        [&](const net::TelemetryMsg&, const TelemetryTap::Tapped& t) { relayed->anchor(t.frame, 0); });
+    QTRY_VERIFY_WITH_TIMEOUT(relayed->stats().anchors > 2 && ghost->stats().anchors > 2, 5000);
+    const uint64_t frames0 = w.session()->tap()->frames();
+    const int64_t anchors0 = ghost->stats().anchors, relayed0 = relayed->stats().anchors;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // the GUI thread, blocked
+    const uint64_t frames = w.session()->tap()->frames() - frames0;
+    const int64_t anchors = ghost->stats().anchors - anchors0, relayedAnchors = relayed->stats().anchors - relayed0;
+    disconnect(relay);
+    qInfo("in the blocked second: %llu frames tapped, %lld re-anchorings; the GUI-fed ghost %lld",
+          static_cast<unsigned long long>(frames), static_cast<long long>(anchors), static_cast<long long>(relayedAnchors));
+    QVERIFY(frames >= 25);
+    QVERIFY(anchors >= 3);
+    QVERIFY(relayedAnchors <= 1);  // a frame it took just before the block may finish in it
   }
 
   // The control: a client whose keep-alives a GUI-thread timer sends (the
