@@ -65,20 +65,13 @@ void Ghost::guarded(const char* name, void (Ghost::*loop)()) {
     } catch (...) {
       setProblem(std::string("the ghost's ") + name + " thread failed; it starts again");
     }
-    std::unique_lock lock(mutex_);
-    anchorWake_.wait_for(lock, std::chrono::seconds(1), [this] { return stop_; });
-    if (stop_) return;
+    if (!anchorBell_.sleepUntil(std::chrono::steady_clock::now() + std::chrono::seconds(1))) return;
   }
 }
 
 Ghost::~Ghost() {
-  {
-    std::lock_guard lock(mutex_);
-    stop_ = true;
-  }
-  anchorWake_.notify_all();
-  presentWake_.notify_all();
-  trailWake_.notify_all();
+  stop_ = true;
+  for (ghost_detail::Doorbell* bell : {&anchorBell_, &presentBell_, &trailBell_}) bell->close();
   for (std::thread* t : {&anchorThread_, &presentThread_, &trailThread_})
     if (t->joinable()) t->join();
 }
@@ -149,81 +142,91 @@ std::vector<double> Ghost::fullPositions(const Twin& twin, const std::vector<dou
 }
 
 double Ghost::ghostTime(double wall) const {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(timelineMutex_);
   return clock_.ghostTime(wall);
 }
 
 std::optional<GhostError> Ghost::anchor(const RobotFrame& frame, double roundTrip) {
-  std::optional<GhostError> error;
+  bool reset = false;
   {
-    std::lock_guard lock(mutex_);
-    if (clock_.frame(frame.time, now(), roundTrip)) {
-      // The robot's clock went back (it was reset): what was shown and
-      // sent belongs to the old run.
-      record_.clear();
+    std::lock_guard lock(timelineMutex_);
+    // The robot's clock went back (it was reset): what was shown and sent
+    // belongs to the old run.
+    reset = clock_.frame(frame.time, now(), roundTrip);
+    if (reset) {
       commands_.clear();
       ++epoch_;
     }
     // Commands long in effect are in the anchor world's set-points already.
     commands_.forgetBefore(frame.time - PredictionRecord::kErrorWindow);
+  }
+  std::optional<GhostError> error;
+  {
+    std::lock_guard lock(recordMutex_);
+    if (reset) record_.clear();
     error = record_.compare(frame);
-    frame_ = frame;
-    ++frameVersion_;
+  }
+  frames_.publish(std::make_shared<const RobotFrame>(frame));
+  {
+    std::lock_guard lock(viewMutex_);
     halted_.clear();
   }
-  anchorWake_.notify_one();
+  anchorBell_.ring();
   return error;
 }
 
 void Ghost::commandSent(const Command& command) {
   {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(timelineMutex_);
     commands_.add(command, clock_.ghostTime(now()) + delay_);
   }
-  presentWake_.notify_one();
+  presentBell_.ring();
 }
 
 void Ghost::setCalibration(WorldModel world, double delay) {
   {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(calibrationMutex_);
     nextModel_ = std::move(world);
+  }
+  {
+    std::lock_guard lock(timelineMutex_);
     delay_ = delay;
   }
-  anchorWake_.notify_one();
+  anchorBell_.ring();
 }
 
 GhostView Ghost::view() const {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(viewMutex_);
   return view_;
 }
 
 uint64_t Ghost::commandsSent() const {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(timelineMutex_);
   return commands_.sent();
 }
 
 int64_t Ghost::viewVersion() const {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(viewMutex_);
   return view_.version;
 }
 
 std::optional<std::pair<double, double>> Ghost::errorMedian() const {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(recordMutex_);
   return record_.median();
 }
 
 std::optional<double> Ghost::errorWorst() const {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(recordMutex_);
   return record_.worstPosition();
 }
 
 GhostStats Ghost::stats() const {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(statsMutex_);
   return stats_;
 }
 
 void Ghost::halt(const std::string& why) {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(viewMutex_);
   if (halted_ == why) return;
   halted_ = why;
   view_.problem = why;
@@ -231,7 +234,7 @@ void Ghost::halt(const std::string& why) {
 }
 
 void Ghost::setProblem(const std::string& problem) {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(viewMutex_);
   view_.problem = problem;
   ++view_.version;
 }

@@ -54,12 +54,21 @@
 // still; the ghost stops the robot too and ignores the commands in flight
 // (the robot refuses commands while latched).
 //
+// Stages. Each stage publishes its newest output in a slot of its own
+// (ghost_slots.h) and rings the next stage's doorbell: anchor() the frame,
+// the anchor thread the base, the present thread the view and the trail
+// request, the trail thread the trail. A stage takes the newest when it is
+// ready; nothing is queued, and no lock is held while computing or while
+// taking another. The link's timeline (the clock estimate, the commands in
+// flight, resets), the prediction record, the view and the counters each
+// have their own short lock.
+//
 // Thread: anchor() from one thread (the link's worker, through
 // app/console/telemetry_tap.h), commandSent(), view(), errorMedian() and
-// the rest from one other (the console's GUI thread); each copies under the
-// ghost's mutex. The three workers are internal.
+// the rest from one other (the console's GUI thread). The three workers
+// are internal.
 
-#include <condition_variable>
+#include <atomic>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -73,6 +82,7 @@
 #include "app/state/ghost_view.h"
 #include "app/state/robot_frame.h"
 #include "app/ghost/ghost_clock.h"
+#include "app/ghost/ghost_slots.h"
 #include "app/ghost/in_flight.h"
 #include "app/ghost/prediction_record.h"
 #include "sim/command.h"
@@ -196,33 +206,40 @@ class Ghost {
                const std::function<bool()>& abort = {}) const;
   void setProblem(const std::string& problem);
   /// The destructor asked the threads to end (a long run ahead gives up).
-  bool stopping() const {
-    std::lock_guard lock(mutex_);
-    return stop_;
-  }
+  bool stopping() const { return stop_.load(); }
 
   WorldModel model_;  // the full world, as calibrated: the anchor thread's once it runs
   SimParams params_;  // the ghost profile
   Options options_;
   std::vector<int> held_;  // joints the ghost may hold rigid (ghost.hold's subtrees but the drive's), sorted
+  std::atomic<bool> stop_{false};
 
-  mutable std::mutex mutex_;  // guards everything below
-  std::condition_variable anchorWake_, presentWake_, trailWake_;
-  bool stop_ = false;
-  std::optional<RobotFrame> frame_;  // newest telemetry
-  uint64_t frameVersion_ = 0;
+  // Each stage's newest output, taken by the next when it is ready
+  // (ghost_slots.h), and each thread's doorbell.
+  ghost_detail::Slot<RobotFrame> frames_;               // anchor() -> anchor thread (and the held joints drawn)
+  ghost_detail::Slot<Base> bases_;                      // anchor thread -> present thread
+  ghost_detail::Slot<TrailRequest> trailRequests_;      // present thread -> trail thread
+  ghost_detail::Doorbell anchorBell_, presentBell_, trailBell_;
+
+  // The link's timeline: the robot's clock estimate, the commands in
+  // flight and the robot's resets, which every stage reads together.
+  mutable std::mutex timelineMutex_;
   GhostClock clock_;
   InFlightCommands commands_;  // the last 10 s of robot time
   uint64_t epoch_ = 0;  // counts robot resets (its clock went back)
-  std::optional<WorldModel> nextModel_;  // a calibration for the anchor thread to take
   double delay_ = 0;  // [s] calibration.delay: commands act this long after they arrive
-  std::shared_ptr<const Base> base_;
-  uint64_t baseVersion_ = 0;
-  std::shared_ptr<const TrailRequest> trailRequest_;
-  uint64_t trailVersion_ = 0;
+
+  mutable std::mutex calibrationMutex_;
+  std::optional<WorldModel> nextModel_;  // a calibration for the anchor thread to take
+
+  mutable std::mutex recordMutex_;
+  PredictionRecord record_;  // what was shown against what came
+
+  mutable std::mutex viewMutex_;  // what the GUI copies out
   GhostView view_;
   std::string halted_;  // why the ghost does not predict (halt()); "" while it does
-  PredictionRecord record_;  // what was shown against what came
+
+  mutable std::mutex statsMutex_;
   GhostStats stats_;
 
   std::thread anchorThread_, presentThread_, trailThread_;

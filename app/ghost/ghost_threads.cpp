@@ -1,6 +1,7 @@
 // The predictive ghost's three threads (app/ghost/ghost.h): anchor,
-// present, trail. Each owns one World; they meet the GUI thread's calls
-// only under the Ghost's mutex, copying values in and out.
+// present, trail. Each owns one World; each takes its input from a slot
+// and publishes into the next (ghost_slots.h), copying values in and out
+// under short locks, none held while another is taken.
 
 #include <pthread.h>
 #include <sys/resource.h>
@@ -9,6 +10,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <tuple>
 
 #include "app/ghost/ghost_impl.h"
 #include "app/ghost/hold_policy.h"
@@ -52,26 +54,33 @@ void Ghost::anchorLoop() {
   const RobotModel robot = model_.robots[0].model;  // its joints; model_ may be recalibrated
   HoldPolicy policy(held_, robot);
   double lastStart = -1e9;
+  uint64_t rung = 0;
   for (;;) {
     RobotFrame frame;
     std::vector<SentCommand> effective, pending;
     double target = 0;
     bool recalibrated = false;
+    while (frames_.version() == seen)
+      if (!anchorBell_.wait(rung)) return;
+    // At most ghost.anchor_rate re-anchorings a second: the newest frame
+    // when the time comes.
+    if (!anchorBell_.sleepUntil(std::chrono::steady_clock::time_point(steady(lastStart + 1 / params_.ghostAnchorRate))))
+      return;
     {
-      std::unique_lock lock(mutex_);
-      anchorWake_.wait(lock, [&] { return stop_ || frameVersion_ != seen; });
-      // At most ghost.anchor_rate re-anchorings a second: the newest frame
-      // when the time comes.
-      anchorWake_.wait_until(lock, std::chrono::steady_clock::time_point(steady(lastStart + 1 / params_.ghostAnchorRate)),
-                             [&] { return stop_; });
-      if (stop_) return;
-      seen = frameVersion_;
-      frame = *frame_;
+      const auto [version, newest] = frames_.latest();
+      seen = version;
+      frame = *newest;
+    }
+    {
+      std::lock_guard lock(calibrationMutex_);
       if (nextModel_) {  // a calibration: the twin is rebuilt at this anchor's step boundary
         model_ = std::move(*nextModel_);
         nextModel_.reset();
         recalibrated = true;
       }
+    }
+    {
+      std::lock_guard lock(timelineMutex_);
       if (epoch != epoch_) {  // the robot restarted: weld and build anew
         epoch = epoch_;
         world.reset();
@@ -111,7 +120,7 @@ void Ghost::anchorLoop() {
       twin = std::move(next);
       world = std::move(built);
       anchored = world->snapshot();
-      std::lock_guard lock(mutex_);
+      std::lock_guard lock(statsMutex_);
       ++stats_.twins;
       stats_.held = hold;
     }
@@ -163,15 +172,17 @@ void Ghost::anchorLoop() {
       continue;
     }
     {
-      std::lock_guard lock(mutex_);
+      std::lock_guard lock(timelineMutex_);
       if (epoch != epoch_) continue;  // a reset came meanwhile
-      base_ = std::move(base);
-      ++baseVersion_;
+      bases_.publish(std::move(base));
+    }
+    {
+      std::lock_guard lock(statsMutex_);
       ++stats_.anchors;
       stats_.anchorMs = (now() - lastStart) * 1000;
       stats_.anchorSpan = t - frame.time;
     }
-    presentWake_.notify_one();
+    presentBell_.ring();
   }
 }
 
@@ -180,33 +191,32 @@ void Ghost::presentLoop() {
   std::shared_ptr<const Twin> twin;
   std::unique_ptr<World> world;
   std::shared_ptr<const Base> base;
-  uint64_t seenBase = 0, seenCommands = 0, next = 0;
+  uint64_t seenBase = 0, seenCommands = 0, next = 0, rung = 0;
   double t = 0, lastTrail = -1e9;
   const auto period = steady(options_.frameInterval);
   for (;;) {
     std::vector<SentCommand> commands;
-    double target = 0, ahead = 0;
+    double target = 0, ahead = 0, newest = 0;
     bool newBase = false, newCommands = false, capped = false;
+    if (!presentBell_.waitUntil(rung, std::chrono::steady_clock::now() + period)) return;
+    if (const auto [version, latest] = bases_.latest(); version != seenBase) {
+      seenBase = version;
+      base = latest;
+      newBase = true;
+      next = base->nextSeq;
+    }
     {
-      std::unique_lock lock(mutex_);
-      presentWake_.wait_for(lock, period,
-                            [&] { return stop_ || baseVersion_ != seenBase || commands_.sent() != seenCommands; });
-      if (stop_) return;
-      if (baseVersion_ != seenBase) {
-        seenBase = baseVersion_;
-        base = base_;
-        newBase = true;
-        next = base->nextSeq;
-      }
+      std::lock_guard lock(timelineMutex_);
       newCommands = commands_.sent() != seenCommands;
       seenCommands = commands_.sent();
       if (!base) continue;
       if (!base->latched && options_.inFlight) commands = commands_.from(next);
       target = options_.runAhead ? clock_.ghostTime(now()) : clock_.newest();
+      newest = clock_.newest();
       // From the newest telemetry, or from the base it runs on when that
       // is older: a base the anchor thread has not yet replaced after a
       // leap in the robot's time is not run up to it.
-      const double from = std::min(base->time, clock_.newest());
+      const double from = std::min(base->time, newest);
       capped = !(target <= from + options_.maxAhead);
       if (capped) {
         ahead = target - from;
@@ -241,27 +251,33 @@ void Ghost::presentLoop() {
       trail = std::make_shared<TrailRequest>(TrailRequest{twin, w.snapshot(), t, next, base->latched, newCommands});
       lastTrail = wall;
     }
+    const std::shared_ptr<const RobotFrame> reported = frames_.latest().second;
     {
-      std::lock_guard lock(mutex_);
+      std::lock_guard lock(viewMutex_);
       if (!halted_.empty()) continue;  // the robot's twin diverged: nothing to predict until it reports again
       GhostView& v = view_;
       ++v.version;
       v.time = t;
-      v.span = t - clock_.newest();
+      v.span = t - newest;
       v.base = r.base;
-      v.jointPositions = fullPositions(*twin, r.jointPositions, frame_ ? &frame_->jointPositions : nullptr);
+      v.jointPositions = fullPositions(*twin, r.jointPositions, reported ? &reported->jointPositions : nullptr);
       v.objects = r.objects;
       if (capped) v.problem = aheadProblem(ahead);
       else v.problem.clear();
       v.commands = next;
-      ++stats_.views;
-      record_.shown(t, base->made, r.base);
-      if (trail) {
-        trailRequest_ = trail;
-        ++trailVersion_;
-      }
     }
-    if (trail) trailWake_.notify_one();
+    {
+      std::lock_guard lock(recordMutex_);
+      record_.shown(t, base->made, r.base);
+    }
+    {
+      std::lock_guard lock(statsMutex_);
+      ++stats_.views;
+    }
+    if (trail) {
+      trailRequests_.publish(std::move(trail));
+      trailBell_.ring();
+    }
   }
 }
 
@@ -270,17 +286,16 @@ void Ghost::trailLoop() {
   yieldToOthers();
   std::shared_ptr<const Twin> twin;
   std::unique_ptr<World> world;
-  uint64_t seen = 0;
+  uint64_t seen = 0, rung = 0;
   for (;;) {
+    while (trailRequests_.version() == seen)
+      if (!trailBell_.wait(rung)) return;
     std::shared_ptr<const TrailRequest> request;
+    std::tie(seen, request) = trailRequests_.latest();
     std::vector<SentCommand> commands;
-    {
-      std::unique_lock lock(mutex_);
-      trailWake_.wait(lock, [&] { return stop_ || trailVersion_ != seen; });
-      if (stop_) return;
-      seen = trailVersion_;
-      request = trailRequest_;
-      if (!request->latched && options_.inFlight) commands = commands_.from(request->nextSeq);
+    if (!request->latched && options_.inFlight) {
+      std::lock_guard lock(timelineMutex_);
+      commands = commands_.from(request->nextSeq);
     }
     const double start = now();
     if (request->twin != twin) {
@@ -302,8 +317,9 @@ void Ghost::trailLoop() {
     // Given up when the commands changed meanwhile; a newer request that
     // only starts from a fresher state waits for this one to finish.
     const auto superseded = [&] {
-      std::lock_guard lock(mutex_);
-      return stop_ || (trailVersion_ != seen && trailRequest_->urgent);
+      if (stopping()) return true;
+      const auto [version, newer] = trailRequests_.latest();
+      return version != seen && newer->urgent;
     };
     const int count = static_cast<int>(std::floor(params_.ghostHorizon / options_.trailSpacing + 1e-9));
     bool complete = true;
@@ -312,10 +328,13 @@ void Ghost::trailLoop() {
       if (complete) points.push_back(groundPoint());
     }
     if (!complete && superseded()) continue;
-    std::lock_guard lock(mutex_);
-    view_.trail = std::move(points);  // up to where it diverged, if it did
-    view_.trailTime = request->time;
-    ++view_.version;
+    {
+      std::lock_guard lock(viewMutex_);
+      view_.trail = std::move(points);  // up to where it diverged, if it did
+      view_.trailTime = request->time;
+      ++view_.version;
+    }
+    std::lock_guard lock(statsMutex_);
     ++stats_.trails;
     stats_.trailMs = (now() - start) * 1000;
   }
