@@ -169,6 +169,8 @@ class Ghost {
  private:
   struct Base;  // a published anchored state
   struct TrailRequest;
+  struct AnchorRun;
+  struct AnchorInput;
   /// What the ghost's worlds are built from: the world with its robot's
   /// ghost.hold joints welded at the pose of the first telemetry (or the
   /// full robot without any).
@@ -196,6 +198,13 @@ class Ghost {
   /// Runs `loop` on the calling thread until it returns; restarts it when it throws.
   void guarded(const char* name, void (Ghost::*loop)());
   void anchorLoop();
+  // The anchor loop's parts: the next frame and the commands around it
+  // (false: the ghost ends); the twin rebuilt for a new weld or
+  // calibration; the frame's state set, with the commands in effect. Each
+  // "" or the problem the view shows.
+  bool takeAnchorInput(AnchorRun& run, AnchorInput& in);
+  std::string rebuildTwin(AnchorRun& run, const RobotFrame& frame, bool hold);
+  std::string setAnchorState(AnchorRun& run, AnchorInput& in, bool latched);
   void presentLoop();
   void trailLoop();
   /// Steps `world` (through sim::Runner) from robot time `t` to `target`,

@@ -1,13 +1,14 @@
 #pragma once
 // The ghost's private parts shared by its two files: what the anchor thread
-// publishes for the present thread (Base) and what the present thread asks
-// of the trail thread (TrailRequest). app/ghost/ghost.cpp holds the Ghost's
+// publishes for the present thread (Base), what the present thread asks
+// of the trail thread (TrailRequest), and the anchor thread's own state. app/ghost/ghost.cpp holds the Ghost's
 // interface and its twins; app/ghost/ghost_threads.cpp its three threads.
 
 #include <cstdint>
 #include <memory>
 
 #include "app/ghost/ghost.h"
+#include "app/ghost/hold_policy.h"
 
 namespace sp {
 
@@ -27,6 +28,26 @@ struct Ghost::TrailRequest {
   uint64_t nextSeq = 0;
   bool latched = false;
   bool urgent = false;  // commands changed: the trail running now is wrong
+};
+
+// What the anchor thread keeps from one re-anchoring to the next.
+struct Ghost::AnchorRun {
+  AnchorRun(const std::vector<int>& held, const RobotModel& model) : robot(model), policy(held, robot) {}
+  const RobotModel robot;  // its joints (model_ may be recalibrated)
+  HoldPolicy policy;
+  std::shared_ptr<const Twin> twin;
+  std::unique_ptr<World> world;
+  Snapshot anchored;  // the last anchored state, commands in effect included
+  uint64_t seen = 0, applied = 0, epoch = 0, rung = 0;
+  double lastStart = -1e9;
+};
+
+// One re-anchoring's input: the newest frame and the commands around it.
+struct Ghost::AnchorInput {
+  RobotFrame frame;
+  std::vector<SentCommand> effective, pending;  // in effect by the frame's time; still in flight
+  double target = 0;  // robot time to run to
+  bool recalibrated = false;
 };
 
 }  // namespace sp

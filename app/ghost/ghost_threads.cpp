@@ -44,58 +44,103 @@ void nameThread(const char* name) { pthread_setname_np(pthread_self(), name); }
 
 }  // namespace
 
+bool Ghost::takeAnchorInput(AnchorRun& run, AnchorInput& in) {
+  while (frames_.version() == run.seen)
+    if (!anchorBell_.wait(run.rung)) return false;
+  // At most ghost.anchor_rate re-anchorings a second: the newest frame
+  // when the time comes.
+  if (!anchorBell_.sleepUntil(std::chrono::steady_clock::time_point(steady(run.lastStart + 1 / params_.ghostAnchorRate))))
+    return false;
+  {
+    const auto [version, newest] = frames_.latest();
+    run.seen = version;
+    in.frame = *newest;
+  }
+  {
+    std::lock_guard lock(calibrationMutex_);
+    if (nextModel_) {  // a calibration: the twin is rebuilt at this anchor's step boundary
+      model_ = std::move(*nextModel_);
+      nextModel_.reset();
+      in.recalibrated = true;
+    }
+  }
+  std::lock_guard lock(timelineMutex_);
+  if (run.epoch != epoch_) {  // the robot restarted: weld and build anew
+    run.epoch = epoch_;
+    run.world.reset();
+    run.policy.reset();
+    run.applied = commands_.sent();
+  }
+  for (SentCommand& c : commands_.from(run.applied))
+    (c.time <= in.frame.time ? in.effective : in.pending).push_back(std::move(c));
+  in.target = options_.runAhead ? clock_.ghostTime(now()) : in.frame.time;
+  return true;
+}
+
+std::string Ghost::rebuildTwin(AnchorRun& run, const RobotFrame& frame, bool hold) {
+  std::string error;
+  std::shared_ptr<const Twin> next = makeTwin(frame.jointPositions, hold, error);
+  std::unique_ptr<World> built = next ? buildWorld(*next, &error) : nullptr;
+  if (!built) return error;
+  // The set-points of the commands in effect carry over.
+  if (run.world) carryControl(*run.world, *run.twin, *built, *next, frame.jointPositions);
+  run.twin = std::move(next);
+  run.world = std::move(built);
+  run.anchored = run.world->snapshot();
+  std::lock_guard lock(statsMutex_);
+  ++stats_.twins;
+  stats_.held = hold;
+  return {};
+}
+
+std::string Ghost::setAnchorState(AnchorRun& run, AnchorInput& in, bool latched) {
+  World& w = *run.world;
+  const RobotFrame& frame = in.frame;
+  if (!in.effective.empty()) run.applied = in.effective.back().seq + 1;
+  if (latched) {
+    // The robot holds still and refuses what it is sent meanwhile.
+    if (!in.pending.empty()) run.applied = in.pending.back().seq + 1;
+    in.effective.assign(1, SentCommand{0, frame.time, StopCmd{}});
+    in.pending.clear();
+  }
+  if (!options_.inFlight) in.pending.clear();
+  for (const SentCommand& c : in.effective) w.submit(c.command);
+  if (!in.effective.empty() && !w.step()) {
+    w.restore(run.anchored);
+    return "the ghost diverged applying the commands in effect: " + w.health().message();
+  }
+  std::vector<std::pair<std::string, Pose>> objects;
+  for (const ObjectReadout& o : frame.objects) objects.emplace_back(o.name, o.pose);
+  const RigidRobot* rigid = run.twin->rigid ? &*run.twin->rigid : nullptr;
+  const std::vector<double> positions = rigid ? rigidJoints(*rigid, frame.jointPositions) : frame.jointPositions;
+  const std::vector<double> rates = rigid ? rigidJoints(*rigid, frame.jointRates) : frame.jointRates;
+  const std::string error = w.setRobotMotion(
+      0,
+      linkMotions(w.robotModel(0), frame.base, frame.hasBaseVelocity ? frame.baseLinearVelocity : Vec3{},
+                  frame.hasBaseVelocity ? frame.baseAngularVelocity : Vec3{}, positions, rates),
+      objects);
+  if (!error.empty()) {
+    w.restore(run.anchored);
+    return "telemetry at " + std::to_string(frame.time) + " s does not fit the robot: " + error;
+  }
+  run.anchored = w.snapshot();
+  return {};
+}
+
 void Ghost::anchorLoop() {
   nameThread("ghost-anchor");
   yieldToOthers();
-  std::shared_ptr<const Twin> twin;
-  std::unique_ptr<World> world;
-  Snapshot anchored;  // the last anchored state, commands in effect included
-  uint64_t seen = 0, applied = 0, epoch = 0;
-  const RobotModel robot = model_.robots[0].model;  // its joints; model_ may be recalibrated
-  HoldPolicy policy(held_, robot);
-  double lastStart = -1e9;
-  uint64_t rung = 0;
+  AnchorRun run(held_, model_.robots[0].model);
   for (;;) {
-    RobotFrame frame;
-    std::vector<SentCommand> effective, pending;
-    double target = 0;
-    bool recalibrated = false;
-    while (frames_.version() == seen)
-      if (!anchorBell_.wait(rung)) return;
-    // At most ghost.anchor_rate re-anchorings a second: the newest frame
-    // when the time comes.
-    if (!anchorBell_.sleepUntil(std::chrono::steady_clock::time_point(steady(lastStart + 1 / params_.ghostAnchorRate))))
-      return;
-    {
-      const auto [version, newest] = frames_.latest();
-      seen = version;
-      frame = *newest;
+    AnchorInput in;
+    if (!takeAnchorInput(run, in)) return;
+    const RobotFrame& frame = in.frame;
+    if (!(in.target <= frame.time + options_.maxAhead)) {  // NaN too
+      setProblem(aheadProblem(in.target - frame.time));
+      in.target = frame.time + options_.maxAhead;
     }
-    {
-      std::lock_guard lock(calibrationMutex_);
-      if (nextModel_) {  // a calibration: the twin is rebuilt at this anchor's step boundary
-        model_ = std::move(*nextModel_);
-        nextModel_.reset();
-        recalibrated = true;
-      }
-    }
-    {
-      std::lock_guard lock(timelineMutex_);
-      if (epoch != epoch_) {  // the robot restarted: weld and build anew
-        epoch = epoch_;
-        world.reset();
-        policy.reset();
-        applied = commands_.sent();
-      }
-      for (SentCommand& c : commands_.from(applied)) (c.time <= frame.time ? effective : pending).push_back(std::move(c));
-      target = options_.runAhead ? clock_.ghostTime(now()) : frame.time;
-    }
-    if (!(target <= frame.time + options_.maxAhead)) {  // NaN too
-      setProblem(aheadProblem(target - frame.time));
-      target = frame.time + options_.maxAhead;
-    }
-    lastStart = now();
-    const size_t joints = robot.joints.size();
+    run.lastStart = now();
+    const size_t joints = run.robot.joints.size();
     if (frame.jointPositions.size() != joints || frame.jointRates.size() != joints) {
       setProblem("telemetry at " + std::to_string(frame.time) + " s has " +
                  std::to_string(frame.jointPositions.size()) + " joint positions and " +
@@ -104,82 +149,46 @@ void Ghost::anchorLoop() {
       continue;
     }
     const bool latched = frame.estop || frame.failsafe;
-    const HoldDecision decision =
-        policy.decide(frame, effective, pending, world && twin->rigid ? &*twin->rigid : nullptr, world != nullptr);
-    const bool hold = decision.hold;
-    if (decision.rebuild || (recalibrated && world)) {
-      std::string error;
-      std::shared_ptr<const Twin> next = makeTwin(frame.jointPositions, hold, error);
-      std::unique_ptr<World> built = next ? buildWorld(*next, &error) : nullptr;
-      if (!built) {
-        setProblem(error);
+    const HoldDecision decision = run.policy.decide(frame, in.effective, in.pending,
+                                                    run.world && run.twin->rigid ? &*run.twin->rigid : nullptr,
+                                                    run.world != nullptr);
+    if (decision.rebuild || (in.recalibrated && run.world))
+      if (std::string problem = rebuildTwin(run, frame, decision.hold); !problem.empty()) {
+        setProblem(problem);
         continue;
       }
-      // The set-points of the commands in effect carry over.
-      if (world) carryControl(*world, *twin, *built, *next, frame.jointPositions);
-      twin = std::move(next);
-      world = std::move(built);
-      anchored = world->snapshot();
-      std::lock_guard lock(statsMutex_);
-      ++stats_.twins;
-      stats_.held = hold;
-    }
-    World& w = *world;
-    if (!effective.empty()) applied = effective.back().seq + 1;
-    if (latched) {
-      // The robot holds still and refuses what it is sent meanwhile.
-      if (!pending.empty()) applied = pending.back().seq + 1;
-      effective.assign(1, SentCommand{0, frame.time, StopCmd{}});
-      pending.clear();
-    }
-    if (!options_.inFlight) pending.clear();
-    for (const SentCommand& c : effective) w.submit(c.command);
-    if (!effective.empty() && !w.step()) {
-      w.restore(anchored);
-      setProblem("the ghost diverged applying the commands in effect: " + w.health().message());
+    if (std::string problem = setAnchorState(run, in, latched); !problem.empty()) {
+      setProblem(problem);
       continue;
     }
-    std::vector<std::pair<std::string, Pose>> objects;
-    for (const ObjectReadout& o : frame.objects) objects.emplace_back(o.name, o.pose);
-    const std::vector<double> positions = twin->rigid ? rigidJoints(*twin->rigid, frame.jointPositions) : frame.jointPositions;
-    const std::vector<double> rates = twin->rigid ? rigidJoints(*twin->rigid, frame.jointRates) : frame.jointRates;
-    const std::string error = w.setRobotMotion(
-        0,
-        linkMotions(w.robotModel(0), frame.base, frame.hasBaseVelocity ? frame.baseLinearVelocity : Vec3{},
-                    frame.hasBaseVelocity ? frame.baseAngularVelocity : Vec3{}, positions, rates),
-        objects);
-    if (!error.empty()) {
-      w.restore(anchored);
-      setProblem("telemetry at " + std::to_string(frame.time) + " s does not fit the robot: " + error);
-      continue;
-    }
-    anchored = w.snapshot();
+    World& w = *run.world;
     double t = frame.time;
     size_t next = 0;
-    const bool ok = advance(w, t, target, pending, next, [this] { return stopping(); });
+    const bool ok = advance(w, t, in.target, in.pending, next, [this] { return stopping(); });
     if (stopping()) return;
     auto base = std::make_shared<Base>();
-    base->twin = twin;
+    base->twin = run.twin;
     base->time = t;
-    base->nextSeq = next < pending.size() ? pending[next].seq : (pending.empty() ? applied : pending.back().seq + 1);
+    base->nextSeq = next < in.pending.size() ? in.pending[next].seq
+                                             : (in.pending.empty() ? run.applied : in.pending.back().seq + 1);
     base->made = frame.time;
     base->latched = latched;
     if (ok) base->snapshot = w.snapshot();
     const std::string health = ok ? "" : w.health().message();
-    w.restore(anchored);
+    w.restore(run.anchored);
     if (!ok) {
       setProblem("the ghost diverged predicting from " + std::to_string(frame.time) + " s: " + health);
       continue;
     }
     {
       std::lock_guard lock(timelineMutex_);
-      if (epoch != epoch_) continue;  // a reset came meanwhile
+      if (run.epoch != epoch_) continue;  // a reset came meanwhile
       bases_.publish(std::move(base));
     }
     {
       std::lock_guard lock(statsMutex_);
       ++stats_.anchors;
-      stats_.anchorMs = (now() - lastStart) * 1000;
+      stats_.anchorMs = (now() - run.lastStart) * 1000;
       stats_.anchorSpan = t - frame.time;
     }
     presentBell_.ring();
