@@ -16,19 +16,13 @@
 #include "app/rehearse/sequence_relay.h"
 #include "sim/command_file.h"
 #include "sim/model_loader.h"
+#include "tests/app/load_world.h"
 #include "sim/rigid.h"
 #include "tests/test_files.h"
 
 using namespace sp;
 
 namespace {
-
-WorldModel loadOrFail(const char* file) {
-  Diagnostics diag;
-  std::optional<WorldModel> w = loadWorld(file, diag);
-  if (!w) qFatal("%s", diag.format().c_str());
-  return *w;
-}
 
 std::vector<TimedCommand> parseOrFail(const char* text, const RobotModel& robot) {
   Diagnostics diag;

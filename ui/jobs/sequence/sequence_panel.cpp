@@ -1,58 +1,26 @@
 #include "ui/jobs/sequence/sequence_panel.h"
 
 #include <QBoxLayout>
-#include <QCoreApplication>
 #include <QDateTime>
-#include <QFile>
 #include <QFileDialog>
-#include <QFontDatabase>
 #include <QLabel>
-#include <QListWidget>
-#include <QMenu>
-#include <QMessageBox>
-#include <QPlainTextEdit>
 #include <QProgressBar>
-#include <QStandardPaths>
 #include <QPushButton>
 #include <QResizeEvent>
-#include <QSlider>
-#include <QTabWidget>
-#include <QTextBlock>
-#include <QTimer>
-#include <QToolButton>
-#include <QTreeWidget>
-#include <QtCharts/QChart>
-#include <QtCharts/QChartView>
-#include <QtCharts/QLineSeries>
-#include <QtCharts/QValueAxis>
+#include <QStandardPaths>
 
 #include <cmath>
 
 #include "app/sweep/sweep.h"
-#include "sim/command_file.h"
-#include "sim/terrain_brush.h"
+#include "ui/jobs/sequence/rehearsal_results.h"
+#include "ui/jobs/sequence/relay_buttons.h"
+#include "ui/jobs/sequence/sequence_editor.h"
 
 namespace sp {
 namespace {
 
-// One line per command of docs/formats.md, with what its numbers mean.
-struct Template {
-  const char* label;
-  const char* text;  // after the time
-};
-constexpr Template kTemplates[] = {
-    {"drive: roll with the hinge at an angle", "drive 0.5 0        # speed [m/s], articulation [deg]"},
-    {"turn: roll at a yaw rate", "turn 0.5 10        # speed [m/s], yaw rate [deg/s], > 0 left"},
-    {"wheels: four wheel speeds", "wheels 2 2 2 2     # FL FR RL RR [rad/s]"},
-    {"target: a joint to an angle", "target waist_yaw 0 # joint, angle [deg] (slider: [m])"},
-    {"velocity: a joint at a speed", "velocity waist_yaw 10  # joint, [deg/s] (slider: [m/s])"},
-    {"torque: a joint's torque", "torque waist_yaw 0 # joint, [N m] (slider: [N])"},
-    {"mode: switch a joint's mode", "mode waist_yaw position  # velocity, position, torque, free"},
-    {"gait: caterpillar, rolking or off", "gait caterpillar"},
-    {"stop: brake and hold", "stop"},
-};
-
 QString seconds(double t) { return QString::number(t, 'f', 2) + " s"; }
+QString qs(const std::string& s) { return QString::fromStdString(s); }
 
 // A word-wrapped label that does not ask for height for its width: one
 // that does makes the dock's scroll area size the whole panel by its
@@ -92,48 +60,10 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   layout->setContentsMargins(4, 4, 4, 4);
   layout->setSpacing(3);  // at 1280x800 every row must fit the tab's ~340 px
 
-  auto* fileRow = new QHBoxLayout;
-  auto* open = new QPushButton(tr("Open…"), this);
-  auto* save = new QPushButton(tr("Save…"), this);
-  auto* insert = new QToolButton(this);
-  insert->setText(tr("Insert"));
-  insert->setToolTip(tr("Insert a command at the cursor, with what its numbers mean"));
-  buildTemplateMenu(insert);
-  fileRow->addWidget(open);
-  fileRow->addWidget(save);
-  fileRow->addWidget(insert);
-  fileRow->addStretch();
-  layout->addLayout(fileRow);
-  connect(open, &QPushButton::clicked, this, &SequencePanel::openFile);
-  connect(save, &QPushButton::clicked, this, &SequencePanel::saveFile);
-
-  editor_ = new QPlainTextEdit(this);
-  editor_->setFont(QFontDatabase::systemFont(QFontDatabase::FixedFont));
-  editor_->setPlaceholderText(tr("# time [s]  command  arguments\n1.0  drive 0.5 0\n5.0  stop"));
-  editor_->setLineWrapMode(QPlainTextEdit::NoWrap);
-  editor_->setMinimumHeight(48);
+  editor_ = new SequenceEditor(this);
   layout->addWidget(editor_, 2);
-  errorList_ = new QListWidget(this);
-  errorList_->setMaximumHeight(70);
-  errorList_->hide();
-  layout->addWidget(errorList_);
-  // Checked 150 ms after the last key, not on every key.
-  checkTimer_ = new QTimer(this);
-  checkTimer_->setSingleShot(true);
-  checkTimer_->setInterval(150);
-  connect(checkTimer_, &QTimer::timeout, this, &SequencePanel::checkNow);
-  connect(editor_, &QPlainTextEdit::textChanged, this, [this] {
-    checkTimer_->start();
-    updateButtons();
-  });
-  connect(errorList_, &QListWidget::itemActivated, this, [this](QListWidgetItem* item) {
-    const int line = item->data(Qt::UserRole).toInt();
-    const QTextBlock block = editor_->document()->findBlockByNumber(line - 1);
-    if (!block.isValid()) return;
-    QTextCursor c(block);
-    editor_->setTextCursor(c);
-    editor_->setFocus();
-  });
+  connect(editor_, &SequenceEditor::checkDue, this, &SequencePanel::checkNow);
+  connect(editor_, &SequenceEditor::edited, this, &SequencePanel::updateButtons);
 
   auto* startRow = new QHBoxLayout;
   startLabel_ = new WrappedLabel(this);
@@ -145,6 +75,25 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   layout->addLayout(startRow);
   connect(unpinButton_, &QPushButton::clicked, this, &SequencePanel::unpinStart);
 
+  buildRunRows(layout);
+
+  results_ = new RehearsalResults(this);
+  layout->addWidget(results_, 1);
+  connect(results_, &RehearsalResults::scrubbed, this, &SequencePanel::scrubbed);
+  // Send and Abort on the Watch row: on a row of their own they fell below
+  // the fold of a 1280x800 window (issue 59).
+  relayButtons_ = new RelayButtons(this);
+  results_->addToWatchRow(relayButtons_);
+  connect(relayButtons_, &RelayButtons::sendClicked, this, &SequencePanel::send);
+  connect(relayButtons_, &RelayButtons::abortClicked, this, [this] { abort(tr("the operator pressed Abort")); });
+
+  status_ = new WrappedLabel(this);
+  status_->hide();
+  layout->addWidget(status_);
+  updateButtons();
+}
+
+void SequencePanel::buildRunRows(QVBoxLayout* layout) {
   auto* runRow = new QHBoxLayout;
   rehearseButton_ = new QPushButton(tr("Rehearse"), this);
   rehearseButton_->setToolTip(tr("Run the sequence on the console's twin from the robot's state now"));
@@ -187,75 +136,16 @@ SequencePanel::SequencePanel(QWidget* parent) : QWidget(parent) {
   // samples up to there), so the panel keeps its own flag rather than the
   // runner's, which would drop the result.
   connect(cancelButton_, &QPushButton::clicked, this, [this] { *cancel_ = true; });
-
-  verdicts_ = new QTreeWidget(this);
-  verdicts_->setColumnCount(2);
-  verdicts_->setHeaderLabels({tr("Rule"), tr("Verdict")});
-  verdicts_->setRootIsDecorated(false);
-  verdicts_->setMinimumHeight(60);
-  // A failed rule's explanation wraps in its row rather than being elided
-  // (issue 59: clipped top and bottom); failed rules come first.
-  verdicts_->setWordWrap(true);
-  verdicts_->setUniformRowHeights(false);
-  verdicts_->setTextElideMode(Qt::ElideNone);
-  // The verdicts and the margins' plot share one place, as tabs: stacked,
-  // they pushed Watch and Send below the fold of a 1280x800 window.
-  results_ = new QTabWidget(this);
-  results_->addTab(verdicts_, tr("Verdicts"));
-  layout->addWidget(results_, 1);
-  connect(verdicts_, &QTreeWidget::itemClicked, this, [this](QTreeWidgetItem* item) {
-    const QVariant t = item->data(0, Qt::UserRole);
-    if (t.isValid()) scrubTo(t.toDouble());
-  });
-
-  auto* scrubRow = new QHBoxLayout;
-  scrubber_ = new QSlider(Qt::Horizontal, this);
-  scrubber_->setRange(0, 0);
-  scrubLabel_ = new QLabel(this);
-  scrubLabel_->setMinimumWidth(60);
-  scrubRow->addWidget(new QLabel(tr("Watch"), this));
-  scrubRow->addWidget(scrubber_, 1);
-  scrubRow->addWidget(scrubLabel_);
-  layout->addLayout(scrubRow);
-  // Send and Abort on the Watch row: on a row of their own they fell below
-  // the fold of a 1280x800 window (issue 59).
-  connect(scrubber_, &QSlider::valueChanged, this, &SequencePanel::showScrub);
-
-  auto* chart = new QChart;
-  chart->setAnimationOptions(QChart::NoAnimation);
-  chart->setMargins({2, 2, 2, 2});
-  marginSeries_ = new QLineSeries;
-  marginSeries_->setName(tr("stability margin [cm]"));
-  rollSeries_ = new QLineSeries;
-  rollSeries_->setName(tr("roll [deg]"));
-  pitchSeries_ = new QLineSeries;
-  pitchSeries_->setName(tr("pitch [deg]"));
-  cursor_ = new QLineSeries;
-  cursor_->setName(tr("watched"));
-  for (QLineSeries* s : {marginSeries_, rollSeries_, pitchSeries_, cursor_}) chart->addSeries(s);
-  chart->createDefaultAxes();
-  chart_ = new QChartView(chart, this);
-  chart_->setMinimumHeight(60);
-  results_->addTab(chart_, tr("Margins"));
-
-  sendButton_ = new QPushButton(tr("Send to robot"), this);
-  sendButton_->setToolTip(tr("Only a sequence that passed its rehearsal, unchanged since"));
-  abortButton_ = new QPushButton(tr("Abort"), this);
-  abortButton_->setToolTip(tr("Stop the sequence on the robot (the robot stops)"));
-  scrubRow->addWidget(sendButton_);
-  scrubRow->addWidget(abortButton_);
-  connect(sendButton_, &QPushButton::clicked, this, &SequencePanel::send);
-  connect(abortButton_, &QPushButton::clicked, this, [this] { abort(tr("the operator pressed Abort")); });
-
-  status_ = new WrappedLabel(this);
-  status_->hide();
-  layout->addWidget(status_);
-  updateButtons();
 }
 
 SequencePanel::~SequencePanel() {
   *cancel_ = true;  // a task still running stops; its result goes nowhere
 }
+
+QPushButton* SequencePanel::sendButton() const { return relayButtons_->sendButton(); }
+QPushButton* SequencePanel::abortButton() const { return relayButtons_->abortButton(); }
+QTreeWidget* SequencePanel::verdictList() const { return results_->verdictList(); }
+QStringList SequencePanel::errors() const { return editor_->problemTexts(); }
 
 void SequencePanel::setBackground(BackgroundJobs* jobs) {
   if (busy_ || !jobs || jobs == jobs_) return;
@@ -266,37 +156,11 @@ void SequencePanel::setBackground(BackgroundJobs* jobs) {
   });
 }
 
-void SequencePanel::buildTemplateMenu(QToolButton* button) {
-  auto* menu = new QMenu(button);
-  for (const Template& t : kTemplates) {
-    menu->addAction(QString::fromUtf8(t.label), this, [this, text = QString::fromUtf8(t.text)] {
-      // At the line after the cursor's, a second after the last time above it.
-      double last = -1;
-      const int here = editor_->textCursor().blockNumber();
-      for (QTextBlock b = editor_->document()->begin(); b.isValid() && b.blockNumber() <= here; b = b.next()) {
-        bool ok = false;
-        const double t0 = b.text().section(' ', 0, 0, QString::SectionSkipEmpty).toDouble(&ok);
-        if (ok) last = t0;
-      }
-      QTextCursor c = editor_->textCursor();
-      c.movePosition(QTextCursor::EndOfBlock);
-      const QString line = QString::number(last < 0 ? 0.0 : last + 1.0, 'f', 1) + "  " + text;
-      c.insertText(editor_->document()->isEmpty() ? line : "\n" + line);
-      editor_->setTextCursor(c);
-    });
-  }
-  button->setMenu(menu);
-  button->setPopupMode(QToolButton::InstantPopup);
-}
-
 void SequencePanel::setWorld(std::function<const WorldModel*()> world, std::function<SimParams()> params) {
   world_ = std::move(world);
   params_ = std::move(params);
-  plan_.reset();
-  result_.reset();
-  robust_.reset();
-  showVerdicts();
-  emit pathChanged({}, {});
+  workflow_.forget();
+  showResult();
   checkNow();
 }
 
@@ -311,12 +175,12 @@ void SequencePanel::setStartProvider(std::function<std::optional<RehearsalStart>
 
 void SequencePanel::pinStart(const RehearsalStart& start, const WorldModel& world, const SimParams& params,
                              const QString& label) {
-  pinned_ = Pinned{start, world, params, label};
+  workflow_.pin({start, world, params, label.toStdString()});
   updateButtons();
 }
 
 void SequencePanel::unpinStart() {
-  pinned_.reset();
+  workflow_.unpin();
   updateButtons();
 }
 
@@ -326,62 +190,25 @@ void SequencePanel::setLinkReady(bool ready) {
 }
 
 void SequencePanel::setText(const QString& text) {
-  editor_->setPlainText(text);
+  editor_->setText(text);
   checkNow();
 }
 
-QString SequencePanel::text() const { return editor_->toPlainText(); }
+QString SequencePanel::text() const { return editor_->text(); }
 
-QList<int> SequencePanel::markedLines() const { return marked_; }
+QList<int> SequencePanel::markedLines() const { return editor_->markedLines(); }
 
 void SequencePanel::checkNow() {
-  checkTimer_->stop();
-  errors_.clear();
-  marked_.clear();
-  errorList_->clear();
-  QList<QTextEdit::ExtraSelection> marks;
-  if (const WorldModel* world = world_ ? world_() : nullptr; world && !world->robots.empty()) {
-    const RobotModel& robot = world->robots[0].model;
-    const std::string text = editor_->toPlainText().toStdString();
-    Diagnostics diag;
-    const auto commands = parseCommandSequence(text, "sequence", diag, &robot);
-    if (commands) checkCommands(*commands, *world, "sequence", diag);  // terrain edits against its grid
-    for (const Diagnostic& d : diag.items()) {
-      if (d.severity != Severity::Error) continue;
-      const QString message = QString::fromStdString(d.message);
-      errors_ << QStringLiteral("line %1: %2").arg(d.line).arg(message);
-      auto* item = new QListWidgetItem(errors_.back(), errorList_);
-      item->setData(Qt::UserRole, d.line);
-      item->setForeground(QColor(170, 0, 0));
-      if (d.line <= 0 || marked_.contains(d.line)) continue;
-      marked_ << d.line;
-      QTextEdit::ExtraSelection mark;
-      mark.cursor = QTextCursor(editor_->document()->findBlockByNumber(d.line - 1));
-      mark.format.setBackground(QColor(255, 225, 225));
-      mark.format.setUnderlineStyle(QTextCharFormat::WaveUnderline);
-      mark.format.setUnderlineColor(Qt::red);
-      mark.format.setProperty(QTextFormat::FullWidthSelection, true);
-      mark.format.setToolTip(message);
-      marks << mark;
-    }
-  }
-  editor_->setExtraSelections(marks);
-  errorList_->setVisible(!errors_.isEmpty());
-  // As tall as its lines, three at most: 70 px for one error squeezed the
-  // editor to two lines (issue 59).
-  if (errorList_->count() > 0)
-    errorList_->setFixedHeight(std::min(3, errorList_->count()) * errorList_->sizeHintForRow(0) +
-                               2 * errorList_->frameWidth());
+  editor_->checkStarted();
+  workflow_.check(text().toStdString(), world_ ? world_() : nullptr);
+  editor_->showProblems(workflow_.problems());
   updateButtons();
 }
 
-bool SequencePanel::rehearsalCurrent() const {
-  return result_ && rehearsedText_ == editor_->toPlainText() && !terrainEditedSince_;
-}
+bool SequencePanel::rehearsalCurrent() const { return workflow_.current(text().toStdString()); }
 
 void SequencePanel::terrainEdited() {
-  if (result_ && !terrainEditedSince_) {
-    terrainEditedSince_ = true;
+  if (workflow_.terrainEdited()) {
     setStatus(tr("The terrain was edited since the rehearsal: rehearse again before sending."));
     updateButtons();
   }
@@ -402,32 +229,26 @@ void SequencePanel::runTask(const QString& what, BackgroundJobs::Work work) {
 bool SequencePanel::rehearse() {
   checkNow();
   if (busy_) return false;
-  const WorldModel* world = pinned_ ? &pinned_->world : world_ ? world_() : nullptr;
-  if (!world || world->robots.empty()) {
-    setStatus(tr("No world with a robot to rehearse on."));
+  if (!errors().isEmpty()) {
+    setStatus(tr("Fix the sequence first: %1").arg(errors().front()));
     return false;
   }
-  if (!errors_.isEmpty()) {
-    setStatus(tr("Fix the sequence first: %1").arg(errors_.front()));
+  std::string why;
+  std::optional<RehearsalPlan> plan = workflow_.plan(text().toStdString(), world_ ? world_() : nullptr,
+                                                     params_ ? params_() : SimParams{}, rules_,
+                                                     startProvider_ ? startProvider_() : std::nullopt, why);
+  if (!plan) {
+    QString said = qs(why);
+    said[0] = said[0].toUpper();
+    setStatus(said + ".");
     return false;
   }
-  Diagnostics diag;
-  const RobotModel& robot = world->robots[0].model;
-  auto commands = parseCommandSequence(editor_->toPlainText().toStdString(), "sequence", diag, &robot);
-  if (!commands || commands->empty()) {
-    setStatus(tr("The sequence has no command."));
-    return false;
-  }
-  RehearsalPlan plan{*world, pinned_ ? pinned_->params : params_ ? params_() : SimParams{}, rules_, std::move(*commands),
-                     pinned_                ? std::optional(pinned_->start)
-                     : startProvider_ ? startProvider_()
-                                      : std::nullopt};
-  const QString text = editor_->toPlainText();
-  const bool pinned = pinned_.has_value();
-  setStatus(pinned       ? tr("Rehearsing from %1…").arg(pinned_->label)
-            : plan.start ? tr("Rehearsing from the robot's state now…")
-                         : tr("Rehearsing from the world's start…"));
-  runTask(tr("Rehearsing"), [this, plan = std::move(plan), text, pinned, cancel = freshCancel()](
+  const QString text = this->text();
+  const bool pinned = workflow_.pinned().has_value();
+  setStatus(pinned       ? tr("Rehearsing from %1…").arg(pinnedStart())
+            : plan->start ? tr("Rehearsing from the robot's state now…")
+                          : tr("Rehearsing from the world's start…"));
+  runTask(tr("Rehearsing"), [this, plan = std::move(*plan), text, pinned, cancel = freshCancel()](
                                 const BackgroundJobs::Progress& progress) mutable -> std::function<void()> {
     // First the fast profile, stopped at its first failure: its verdicts
     // show within a fraction of the time while the full-fidelity rehearsal,
@@ -443,70 +264,55 @@ bool SequencePanel::rehearse() {
     auto r = std::make_shared<RehearsalResult>(
         sp::rehearse(plan, [&](double f) { return progress(0.25 + 0.75 * f) && !cancel->load(); }));
     auto done = std::make_shared<RehearsalPlan>(std::move(plan));
-    return [this, done, r, text, pinned] {
-      rehearsedText_ = text;
-      planPinned_ = pinned;
-      terrainEditedSince_ = false;
-      rehearsalDone(std::move(*done), std::move(*r));
-    };
+    return [this, done, r, text, pinned] { rehearsalDone(std::move(*done), std::move(*r), text, pinned); };
   });
   return true;
 }
 
 void SequencePanel::showResult() {
-  showVerdicts();
-  std::vector<Vec3> path;
-  for (const RehearsalSample& s : result_->path) path.push_back(s.base.p);
-  emit pathChanged(path, {});
+  results_->showResult(workflow_.result() ? &*workflow_.result() : nullptr);
+  emit pathChanged(workflow_.path(), workflow_.envelope());
   updateButtons();
 }
 
 void SequencePanel::previewDone(RehearsalPlan plan, RehearsalResult result) {
   if (!busy_) return;  // the full rehearsal came first (or was cancelled): nothing to preview
-  plan_ = std::move(plan);
-  result_ = std::move(result);
-  robust_.reset();
-  preview_ = QString::fromStdString(result_->summary());
+  workflow_.previewed(std::move(plan), std::move(result));
+  const RehearsalResult& r = *workflow_.result();
+  preview_ = qs(r.summary());
   setStatus(tr("Preview (fast profile, %1 s): %2. The full-fidelity rehearsal, the one Send relays, is running…")
-                .arg(result_->wallSeconds, 0, 'f', 2)
-                .arg(result_->passed ? tr("passed") : preview_));
+                .arg(r.wallSeconds, 0, 'f', 2)
+                .arg(r.passed ? tr("passed") : preview_));
   showResult();
-  emit previewed(result_->passed);
+  emit previewed(r.passed);
 }
 
-void SequencePanel::rehearsalDone(RehearsalPlan plan, RehearsalResult result) {
+void SequencePanel::rehearsalDone(RehearsalPlan plan, RehearsalResult result, const QString& text, bool pinned) {
   busy_ = false;
   progress_->setValue(1000);
-  plan_ = std::move(plan);
-  result_ = std::move(result);
-  robust_.reset();
-  const RobotModel& robot = plan_->world.robots[0].model;
-  const QString hash = QString::fromStdString(sequenceHash(sequenceText(plan_->commands, &robot)));
-  const QString verdict = QString::fromStdString(result_->summary());
+  workflow_.rehearsed(std::move(plan), std::move(result), text.toStdString(), pinned);
+  const RehearsalResult& r = *workflow_.result();
+  const QString verdict = qs(r.summary());
   // Said when the preview told otherwise: the operator looked at it.
   const QString differs = !preview_.isEmpty() && preview_ != verdict
                               ? tr(" (the fast preview had: %1)").arg(preview_)
                               : QString();
   preview_.clear();
   setStatus(tr("Rehearsal %1 (%2 simulated in %3 s): %4%5")
-                .arg(result_->passed ? tr("passed") : tr("failed"), seconds(result_->duration))
-                .arg(result_->wallSeconds, 0, 'f', 2)
+                .arg(r.passed ? tr("passed") : tr("failed"), seconds(r.duration))
+                .arg(r.wallSeconds, 0, 'f', 2)
                 .arg(verdict, differs));
-  emit logEvent("rehearsal", QStringLiteral("%1 %2 (%3 commands, %4 s simulated): %5")
-                                 .arg(hash, result_->passed ? "passed" : "failed")
-                                 .arg(plan_->commands.size())
-                                 .arg(result_->duration)
-                                 .arg(verdict));
+  emit logEvent("rehearsal", qs(workflow_.rehearsalLogLine()));
   showResult();
-  emit rehearsed(result_->passed);
+  emit rehearsed(r.passed);
 }
 
 bool SequencePanel::checkRobustness() {
-  if (busy_ || !plan_ || !rehearsalCurrent()) {
+  if (busy_ || !rehearsalCurrent()) {
     setStatus(tr("Rehearse the sequence first."));
     return false;
   }
-  RehearsalPlan plan = *plan_;
+  RehearsalPlan plan = *workflow_.rehearsedPlan();
   plan.fast = plan.stopAtFirstFailure = true;  // a statistical check: its gate is the full rehearsal (issue 32)
   setStatus(tr("Robustness: %1 perturbed rehearsals on 2 threads (fast profile)…").arg(plan.rules.robustSamples));
   runTask(tr("Robustness"), [this, plan, cancel = freshCancel()](const BackgroundJobs::Progress& progress) -> std::function<void()> {
@@ -519,16 +325,17 @@ bool SequencePanel::checkRobustness() {
 }
 
 bool SequencePanel::robustnessOnCluster(const QString& dir) {
-  if (busy_ || !plan_ || !rehearsalCurrent()) {
+  if (busy_ || !rehearsalCurrent()) {
     setStatus(tr("Rehearse the sequence first."));
     return false;
   }
+  const RehearsalPlan& plan = *workflow_.rehearsedPlan();
   std::string error;
-  if (!createSweepFromPlan(dir.toStdString(), *plan_, 1, error)) {
+  if (!createSweepFromPlan(dir.toStdString(), plan, 1, error)) {
     setStatus(tr("Robustness on cluster: %1").arg(QString::fromStdString(error)));
     return false;
   }
-  const int samples = plan_->rules.robustSamples;
+  const int samples = plan.rules.robustSamples;
   const QString later = QStringLiteral("simpartner-sim collect %1").arg(dir);
   if (QStandardPaths::findExecutable("sbatch").isEmpty()) {
     setStatus(tr("Robustness on cluster: %1 samples written to %2 (no sbatch here); on a machine of the cluster that "
@@ -561,132 +368,45 @@ bool SequencePanel::robustnessOnCluster(const QString& dir) {
   return true;
 }
 
-void SequencePanel::robustnessFinished(RobustnessResult r) {
+void SequencePanel::robustnessFinished(RobustnessResult result) {
   busy_ = false;
   progress_->setValue(1000);
-  robust_ = std::move(r);
+  workflow_.robustnessDone(std::move(result));
+  const RobustnessResult& r = *workflow_.robustness();
   QString worst;
-  for (int i = 0; i < robust_->samples && worst.isEmpty(); ++i)
-    if (!robust_->samplePassed[i]) worst = QString::fromStdString(robust_->failures[i]);
+  for (int i = 0; i < r.samples && worst.isEmpty(); ++i)
+    if (!r.samplePassed[i]) worst = qs(r.failures[i]);
   setStatus(tr("Robustness: %1 of %2 passed (%3 %), end positions within %4 m of their mean%5%6")
-                .arg(robust_->passed)
-                .arg(robust_->samples)
-                .arg(100 * robust_->probability(), 0, 'f', 0)
-                .arg(robust_->spread, 0, 'f', 3)
+                .arg(r.passed)
+                .arg(r.samples)
+                .arg(100 * r.probability(), 0, 'f', 0)
+                .arg(r.spread, 0, 'f', 3)
                 .arg(worst.isEmpty() ? QString() : tr("; e.g. %1").arg(worst))
-                .arg(robust_->refined ? tr("; %1 near a limit or failing run again at full fidelity").arg(robust_->refined)
-                                      : QString()));
-  emit logEvent("rehearsal", QStringLiteral("robustness: %1 of %2 passed, end spread %3 m")
-                                 .arg(robust_->passed)
-                                 .arg(robust_->samples)
-                                 .arg(robust_->spread));
-  std::vector<Vec3> ends;
-  for (const Pose& p : robust_->endPoses) ends.push_back(p.p);
-  std::vector<Vec3> hull = convexHullXY(ends);
-  if (!hull.empty()) hull.push_back(hull.front());  // closed
-  std::vector<Vec3> path;
-  for (const RehearsalSample& s : result_->path) path.push_back(s.base.p);
-  emit pathChanged(path, hull);
+                .arg(r.refined ? tr("; %1 near a limit or failing run again at full fidelity").arg(r.refined)
+                               : QString()));
+  emit logEvent("rehearsal", qs(workflow_.robustnessLogLine()));
+  emit pathChanged(workflow_.path(), workflow_.envelope());
   updateButtons();
   emit robustnessDone();
 }
 
-void SequencePanel::showVerdicts() {
-  verdicts_->clear();
-  marginSeries_->clear();
-  rollSeries_->clear();
-  pitchSeries_->clear();
-  cursor_->clear();
-  if (!result_) {
-    scrubber_->setRange(0, 0);
-    return;
-  }
-  if (!result_->error.empty()) new QTreeWidgetItem(verdicts_, {tr("rehearsal"), QString::fromStdString(result_->error)});
-  std::vector<const RuleVerdict*> ordered;
-  for (const RuleVerdict& v : result_->verdicts) ordered.push_back(&v);
-  std::stable_partition(ordered.begin(), ordered.end(), [](const RuleVerdict* v) { return !v->passed; });
-  for (const RuleVerdict* p : ordered) {
-    const RuleVerdict& v = *p;
-    // The message without its leading "rule: ", which the first column shows.
-    QString text = QString::fromStdString(v.message());
-    const QString prefix = QString::fromUtf8(toString(v.rule)) + QStringLiteral(": ");
-    if (text.startsWith(prefix)) text.remove(0, prefix.size());
-    auto* item = new QTreeWidgetItem(verdicts_, {QString::fromUtf8(toString(v.rule)), text});
-    item->setForeground(0, v.passed ? QColor(0, 120, 0) : QColor(190, 0, 0));
-    item->setToolTip(1, item->text(1));
-    item->setData(0, Qt::UserRole, v.passed ? v.worstTime : v.time);
-  }
-  verdicts_->resizeColumnToContents(0);
-  // Each row as tall as its explanation wraps to in the verdict column
-  // (the view does not measure wrapped rows against the column's width).
-  const int textWidth = std::max(80, verdicts_->viewport()->width() - verdicts_->columnWidth(0) - 10);
-  for (int i = 0; i < verdicts_->topLevelItemCount(); ++i) {
-    QTreeWidgetItem* item = verdicts_->topLevelItem(i);
-    const int h = verdicts_->fontMetrics().boundingRect(QRect(0, 0, textWidth, 10000), Qt::TextWordWrap, item->text(1)).height();
-    item->setSizeHint(1, QSize(textWidth, h + 4));
-  }
-  double top = 0, bottom = 0;
-  for (const RehearsalSample& s : result_->path) {
-    const double margin = std::isfinite(s.margin) ? std::clamp(s.margin * 100, -100.0, 100.0) : -100.0;
-    marginSeries_->append(s.time, margin);
-    rollSeries_->append(s.time, radToDeg(s.roll));
-    pitchSeries_->append(s.time, radToDeg(s.pitch));
-    top = std::max({top, margin, radToDeg(s.roll), radToDeg(s.pitch)});
-    bottom = std::min({bottom, margin, radToDeg(s.roll), radToDeg(s.pitch)});
-  }
-  const auto axes = chart_->chart()->axes();
-  if (axes.size() >= 2) {
-    axes[0]->setRange(0, std::max(1.0, result_->duration));
-    axes[1]->setRange(bottom - 1, top + 1);
-  }
-  scrubber_->setRange(0, std::max(0, static_cast<int>(result_->path.size()) - 1));
-  showScrub(scrubber_->value());
-}
+void SequencePanel::scrubTo(double time) { results_->scrubTo(time); }
 
-void SequencePanel::scrubTo(double time) {
-  if (!result_ || result_->path.empty()) return;
-  scrubber_->setValue(static_cast<int>(std::lround(time / RehearsalResult::kSampleInterval)));
-}
-
-double SequencePanel::scrubTime() const {
-  if (!result_ || result_->path.empty()) return 0;
-  return result_->path[std::min<size_t>(static_cast<size_t>(scrubber_->value()), result_->path.size() - 1)].time;
-}
-
-void SequencePanel::showScrub(int index) {
-  if (!result_ || result_->path.empty()) {
-    scrubLabel_->clear();
-    return;
-  }
-  const RehearsalSample& s = result_->path[std::min<size_t>(static_cast<size_t>(std::max(0, index)), result_->path.size() - 1)];
-  scrubLabel_->setText(seconds(s.time));
-  cursor_->clear();
-  const auto axes = chart_->chart()->axes();
-  if (axes.size() >= 2) {
-    const auto* y = static_cast<QValueAxis*>(axes[1]);
-    cursor_->append(s.time, y->min());
-    cursor_->append(s.time, y->max());
-  }
-  emit scrubbed(s.base, s.jointPositions);
-}
+double SequencePanel::scrubTime() const { return results_->scrubTime(); }
 
 bool SequencePanel::send() {
-  std::string why;
-  if (!plan_ || !result_) why = "rehearse the sequence first";
-  else if (!rehearsalCurrent()) why = "the sequence changed since its rehearsal: rehearse it again";
-  else if (terrainEditedSince_) why = "the terrain was edited since the rehearsal: rehearse it again";
-  else if (planPinned_) why = "it was rehearsed from a logged moment, not from the robot's state: rehearse it from the robot";
-  else if (!linkReady_) why = "the robot cannot take a sequence now (not connected, no lease, or latched)";
+  std::string why = workflow_.sendRefusal(text().toStdString(), linkReady_);
   std::optional<net::SequenceMsg> msg;
-  if (why.empty()) msg = sequenceMessage(*plan_, *result_, why);
+  if (why.empty()) msg = workflow_.message(why);
   if (!msg) {
-    setStatus(tr("Not sent: %1").arg(QString::fromStdString(why)));
+    setStatus(tr("Not sent: %1").arg(qs(why)));
     return false;
   }
-  guard_->relayed(*msg, *result_, plan_->rules, plan_->world.robots[0].model);
-  emit logEvent("relay", QStringLiteral("sent %1 (%2 commands)").arg(QString::fromStdString(msg->hash)).arg(relay().count()));
+  const RehearsalPlan& plan = *workflow_.rehearsedPlan();
+  guard_->relayed(*msg, *workflow_.result(), plan.rules, plan.world.robots[0].model);
+  emit logEvent("relay", QStringLiteral("sent %1 (%2 commands)").arg(qs(msg->hash)).arg(relay().count()));
   emit sendRequested(*msg);
-  setStatus(tr("Sent %1 to the robot; waiting for its answer…").arg(QString::fromStdString(msg->hash)));
+  setStatus(tr("Sent %1 to the robot; waiting for its answer…").arg(qs(msg->hash)));
   updateButtons();
   return true;
 }
@@ -699,8 +419,8 @@ void SequencePanel::setGuard(std::shared_ptr<SequenceGuard> guard) {
 void SequencePanel::abort(const QString& reason) {
   const SequenceGuard::Status r = relay();
   if (r.phase() != SequenceRelay::Phase::Running && r.phase() != SequenceRelay::Phase::Sent) return;
-  emit abortRequested(QString::fromStdString(r.hash()), reason);
-  emit logEvent("relay", QStringLiteral("abort %1: %2").arg(QString::fromStdString(r.hash()), reason));
+  emit abortRequested(qs(r.hash()), reason);
+  emit logEvent("relay", QStringLiteral("abort %1: %2").arg(qs(r.hash()), reason));
   setStatus(tr("Abort sent: %1").arg(reason));
 }
 
@@ -755,47 +475,28 @@ void SequencePanel::updateButtons() {
   const SequenceRelay::Phase phase = relay().phase();
   const bool running = phase == SequenceRelay::Phase::Running || phase == SequenceRelay::Phase::Sent;
   const bool current = rehearsalCurrent();
-  rehearseButton_->setEnabled(!busy_ && errors_.isEmpty());
+  const bool fine = errors().isEmpty();
+  const std::optional<RehearsalResult>& result = workflow_.result();
+  rehearseButton_->setEnabled(!busy_ && fine);
   robustButton_->setEnabled(!busy_ && current);
   clusterButton_->setEnabled(!busy_ && current);
   cancelButton_->setEnabled(busy_);
-  sendButton_->setEnabled(!busy_ && linkReady_ && current && result_->passed && !running && !planPinned_);
+  relayButtons_->setStates(!busy_ && linkReady_ && current && result->passed && !workflow_.rehearsedFromPin(), running);
   QString why;
   if (busy_) why.clear();
-  else if (!errors_.isEmpty()) why = tr("Rehearse waits for the sequence to be fixed: %1").arg(errors_.front());
-  else if (editor_->toPlainText().trimmed().isEmpty()) why = tr("Write or open a sequence to rehearse.");
-  else if (!current) why = tr("Send needs a rehearsal of this text%1.").arg(terrainEditedSince_ ? tr(" since the terrain edit") : QString());
-  else if (!result_->passed) why = tr("Send: the rehearsal failed (%1).").arg(QString::fromStdString(result_->summary()));
-  else if (planPinned_) why = tr("Send: a what-if from a pinned start cannot be sent.");
+  else if (!fine) why = tr("Rehearse waits for the sequence to be fixed: %1").arg(errors().front());
+  else if (text().trimmed().isEmpty()) why = tr("Write or open a sequence to rehearse.");
+  else if (!current)
+    why = tr("Send needs a rehearsal of this text%1.").arg(workflow_.terrainEditedSince() ? tr(" since the terrain edit") : QString());
+  else if (!result->passed) why = tr("Send: the rehearsal failed (%1).").arg(qs(result->summary()));
+  else if (workflow_.rehearsedFromPin()) why = tr("Send: a what-if from a pinned start cannot be sent.");
   else if (!linkReady_) why = tr("Send: take control of the robot first.");
   whyLabel_->setText(why);
   whyLabel_->setVisible(!why.isEmpty());
   progressRow_->setVisible(busy_);
-  startLabel_->setText(pinned_ ? tr("Start: %1 (a what-if: it cannot be sent)").arg(pinned_->label)
-                               : tr("Start: the robot's state when Rehearse is pressed"));
-  unpinButton_->setVisible(pinned_.has_value());
-  abortButton_->setEnabled(running);
-}
-
-void SequencePanel::openFile() {
-  const QString path = QFileDialog::getOpenFileName(this, tr("Open sequence"), QString(), tr("Sequences (*.seq);;All files (*)"));
-  if (path.isEmpty()) return;
-  QFile f(path);
-  if (!f.open(QIODevice::ReadOnly) || f.size() > 1 << 20) {
-    QMessageBox::warning(this, tr("Open sequence"), tr("%1: cannot read (or larger than 1 MiB)").arg(path));
-    return;
-  }
-  setText(QString::fromUtf8(f.readAll()));
-}
-
-void SequencePanel::saveFile() {
-  const QString path = QFileDialog::getSaveFileName(this, tr("Save sequence"), QString(), tr("Sequences (*.seq)"));
-  if (path.isEmpty()) return;
-  QFile f(path);
-  if (!f.open(QIODevice::WriteOnly | QIODevice::Truncate) || f.write(editor_->toPlainText().toUtf8()) < 0 ||
-      !f.flush()) {
-    QMessageBox::warning(this, tr("Save sequence"), tr("%1: %2").arg(path, f.errorString()));
-  }
+  startLabel_->setText(workflow_.pinned() ? tr("Start: %1 (a what-if: it cannot be sent)").arg(pinnedStart())
+                                          : tr("Start: the robot's state when Rehearse is pressed"));
+  unpinButton_->setVisible(workflow_.pinned().has_value());
 }
 
 }  // namespace sp

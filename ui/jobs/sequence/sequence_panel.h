@@ -23,7 +23,10 @@
 //
 // The panel holds no link: it asks for the start state and sends through
 // the callbacks and signals MainWindow connects (app/rehearse/sequence_relay.h does
-// the protocol's side).
+// the protocol's side). Its parts: the editor (sequence_editor.h), the
+// results (rehearsal_results.h) and the relay's buttons (relay_buttons.h);
+// what may be rehearsed, checked or sent, and why not, is the Qt-free
+// SequenceWorkflow's (app/rehearse/sequence_workflow.h).
 //
 // Thread: GUI thread. Rehearsals, robustness checks and submissions run on
 // a BackgroundJobs runner (the console's, ui/background_jobs.h), one at a
@@ -42,23 +45,21 @@
 
 #include "app/rehearse/rehearsal.h"
 #include "app/rehearse/sequence_guard.h"
+#include "app/rehearse/sequence_workflow.h"
 #include "net/message.h"
 #include "ui/background_jobs.h"
 
 class QLabel;
-class QListWidget;
-class QPlainTextEdit;
 class QProgressBar;
 class QPushButton;
-class QSlider;
-class QTimer;
-class QTabWidget;
 class QTreeWidget;
-class QToolButton;
-QT_FORWARD_DECLARE_CLASS(QChartView)
-QT_FORWARD_DECLARE_CLASS(QLineSeries)
+class QVBoxLayout;
 
 namespace sp {
+
+class RehearsalResults;
+class RelayButtons;
+class SequenceEditor;
 
 class SequencePanel : public QWidget {
   Q_OBJECT
@@ -86,7 +87,9 @@ class SequencePanel : public QWidget {
   void pinStart(const RehearsalStart& start, const WorldModel& world, const SimParams& params, const QString& label);
   void unpinStart();
   /// "" while rehearsals start from the robot; else where they start.
-  QString pinnedStart() const { return pinned_ ? pinned_->label : QString(); }
+  QString pinnedStart() const {
+    return workflow_.pinned() ? QString::fromStdString(workflow_.pinned()->label) : QString();
+  }
   /// The terrain was edited: the next rehearsal runs on the edited heights
   /// (the world's), and the last one (on the old heights) cannot be sent
   /// until rehearsed again.
@@ -99,11 +102,13 @@ class SequencePanel : public QWidget {
   QString text() const;
   /// The text's problems, "line N: message" each; empty when it parses and
   /// passes the robot's limits. Up to date after checkNow().
-  QStringList errors() const { return errors_; }
+  QStringList errors() const;
   /// Checks the text now (typing checks it 150 ms after the last key).
   void checkNow();
   /// The lines marked in the editor.
   QList<int> markedLines() const;
+  /// The sequence's way from text to robot (what the panel shows).
+  const SequenceWorkflow& workflow() const { return workflow_; }
 
   /// Starts a rehearsal of the text (false, and the reason in status(), if
   /// it has errors or one runs). `rehearsed` is emitted when it ends.
@@ -121,8 +126,8 @@ class SequencePanel : public QWidget {
   /// panel) instead of a runner of its own. Not while one runs.
   void setBackground(BackgroundJobs* jobs);
   /// The last rehearsal, if any (and whether the text is still what it rehearsed).
-  const std::optional<RehearsalResult>& result() const { return result_; }
-  const std::optional<RobustnessResult>& robustnessResult() const { return robust_; }
+  const std::optional<RehearsalResult>& result() const { return workflow_.result(); }
+  const std::optional<RobustnessResult>& robustnessResult() const { return workflow_.robustness(); }
   bool rehearsalCurrent() const;
   /// Sends the rehearsed sequence (false and status() says why if it
   /// cannot go: not passed, edited since, link not ready).
@@ -140,9 +145,9 @@ class SequencePanel : public QWidget {
   double scrubTime() const;
 
   QPushButton* rehearseButton() const { return rehearseButton_; }
-  QPushButton* sendButton() const { return sendButton_; }
-  QPushButton* abortButton() const { return abortButton_; }
-  QTreeWidget* verdictList() const { return verdicts_; }
+  QPushButton* sendButton() const;
+  QPushButton* abortButton() const;
+  QTreeWidget* verdictList() const;
 
  public slots:
   /// The robot's SEQUENCE_STATE (after the guard has taken it).
@@ -174,20 +179,16 @@ class SequencePanel : public QWidget {
   void alert(const QString& text);
 
  private:
-  void buildTemplateMenu(QToolButton* button);
-  void openFile();
-  void saveFile();
+  void buildRunRows(QVBoxLayout* layout);
   /// A new Cancel flag for the next task (the last one's stays with it).
   std::shared_ptr<std::atomic<bool>> freshCancel();
   /// Runs `work` on the runner: busy, progress, Cancel until its result runs.
   void runTask(const QString& what, BackgroundJobs::Work work);
-  void rehearsalDone(RehearsalPlan plan, RehearsalResult result);
+  void rehearsalDone(RehearsalPlan plan, RehearsalResult result, const QString& text, bool pinned);
   void previewDone(RehearsalPlan plan, RehearsalResult result);
-  /// The verdicts, the path in the view and the buttons for result_.
+  /// The verdicts, the path in the view and the buttons for the workflow's result.
   void showResult();
   void robustnessFinished(RobustnessResult result);
-  void showVerdicts();
-  void showScrub(int index);
   void updateButtons();
   void setStatus(const QString& text);
 
@@ -197,52 +198,27 @@ class SequencePanel : public QWidget {
   std::function<std::optional<RehearsalStart>()> startProvider_;
   bool linkReady_ = false;
   QString preview_;  // the last preview's verdict, to say when the full one differs
+  SequenceWorkflow workflow_;
 
-  QPlainTextEdit* editor_ = nullptr;
-  QListWidget* errorList_ = nullptr;
-  QTimer* checkTimer_ = nullptr;
-  QStringList errors_;
-  QList<int> marked_;
+  SequenceEditor* editor_ = nullptr;
+  RehearsalResults* results_ = nullptr;
+  RelayButtons* relayButtons_ = nullptr;
   QPushButton* rehearseButton_ = nullptr;
   QPushButton* robustButton_ = nullptr;
   QPushButton* clusterButton_ = nullptr;
   QString simBinary_ = QCoreApplication::applicationDirPath() + "/simpartner-sim";
   QPushButton* cancelButton_ = nullptr;
   QProgressBar* progress_ = nullptr;
-  QTreeWidget* verdicts_ = nullptr;
-  QSlider* scrubber_ = nullptr;
-  QLabel* scrubLabel_ = nullptr;
-  QChartView* chart_ = nullptr;
-  QLineSeries* marginSeries_ = nullptr;
-  QLineSeries* rollSeries_ = nullptr;
-  QLineSeries* pitchSeries_ = nullptr;
-  QLineSeries* cursor_ = nullptr;
-  QPushButton* sendButton_ = nullptr;
-  QPushButton* abortButton_ = nullptr;
   QLabel* status_ = nullptr;
   QLabel* whyLabel_ = nullptr;       // why Rehearse or Send is disabled, beside them
-  QTabWidget* results_ = nullptr;    // the verdicts and the margins' plot
   QWidget* progressRow_ = nullptr;   // the progress and Cancel, shown while busy
+  QLabel* startLabel_ = nullptr;
+  QPushButton* unpinButton_ = nullptr;
 
   bool busy_ = false;
   BackgroundJobs* jobs_ = nullptr;  // the console's runner, or the panel's own
   int job_ = 0;                     // the task running (for its progress)
   std::shared_ptr<std::atomic<bool>> cancel_ = std::make_shared<std::atomic<bool>>(false);  // the task's
-  std::optional<RehearsalPlan> plan_;  // of result_
-  struct Pinned {
-    RehearsalStart start;
-    WorldModel world;
-    SimParams params;
-    QString label;
-  };
-  std::optional<Pinned> pinned_;
-  bool planPinned_ = false;
-  bool terrainEditedSince_ = false;  // the terrain changed after result_  // plan_ started from pinned_, not the robot
-  QLabel* startLabel_ = nullptr;
-  QPushButton* unpinButton_ = nullptr;
-  std::optional<RehearsalResult> result_;
-  QString rehearsedText_;              // the text result_ rehearsed
-  std::optional<RobustnessResult> robust_;
   std::shared_ptr<SequenceGuard> guard_ = std::make_shared<SequenceGuard>();
   SequenceRelay::Phase shownPhase_ = SequenceRelay::Phase::Idle;
 };
