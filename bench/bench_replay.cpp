@@ -32,6 +32,7 @@
 #include "app/log/log_player.h"
 #include "ui/jobs/jobs.h"
 #include "ui/main_window.h"
+#include "ui/jobs/replay/replay_job.h"
 #include "ui/jobs/replay/replay_panel.h"
 #include "ui/scene_view.h"
 
@@ -82,7 +83,8 @@ int main(int argc, char** argv) {
   }
   window.resize(1280, 800);
   window.show();
-  sp::ReplayPanel* replay = window.replayPanel();
+  sp::ReplayJob* replayJob = window.job<sp::ReplayJob>();
+  sp::ReplayPanel* replay = replayJob->panel();
 
   // 1. Opening.
   double longestGap = 0;
@@ -100,7 +102,7 @@ int main(int argc, char** argv) {
   opening.start();
   sinceTick.start();
   ticker.start();
-  window.openLogInBackground(log);
+  replayJob->openLogInBackground(log);
   while (replay->busy()) app.processEvents(QEventLoop::AllEvents, 50);
   ticker.stop();
   const double openMs = ms(opening);

@@ -1,6 +1,5 @@
 #include "ui/console_context.h"
 
-#include <QMainWindow>
 #include <QMessageBox>
 #include <QPushButton>
 
@@ -43,7 +42,7 @@ void ConsoleContext::logEvent(const QString& kind, const QString& text) const {
 
 bool ConsoleContext::confirm(QMessageBox::Icon icon, const QString& title, const QString& text,
                              const QString& objectName, const QString& yes, QMessageBox::ButtonRole role) const {
-  QMessageBox box(icon, title, text, QMessageBox::NoButton, parts_.window);
+  QMessageBox box(icon, title, text, QMessageBox::NoButton, dialogParent());
   box.setObjectName(objectName);
   QPushButton* accept = box.addButton(yes, role);
   box.setDefaultButton(box.addButton(tr("Cancel"), QMessageBox::RejectRole));
@@ -53,7 +52,7 @@ bool ConsoleContext::confirm(QMessageBox::Icon icon, const QString& title, const
 
 void ConsoleContext::showError(const QString& title, const QString& text) const {
   QMessageBox box(QMessageBox::Warning, title, title + tr(". The running session is unchanged."), QMessageBox::Ok,
-                  parts_.window);
+                  dialogParent());
   box.setDetailedText(text);
   box.setInformativeText(text.section(QLatin1Char('\n'), 0, 4));
   box.exec();

@@ -10,12 +10,12 @@
 //   scene(), the plots: the views, to draw into
 //   status(), event(), logEvent(): the status bar, the event list, the log
 //   background(): one worker with progress and Cancel for long work
-//   addDock(), menu(): a place in the window
+//   host(): a place in the window (addDock(), menu(), growDock()), a parent
+//                for dialogs; the window itself is not handed out
 //
 // Thread: GUI thread only, as every job.
 
 #include <QCommandLineOption>
-#include <QMainWindow>
 #include <QMessageBox>
 #include <QObject>
 #include <QString>
@@ -80,6 +80,11 @@ class ConsoleHost {
   /// Puts `action` into menu `title` among the jobs' items (in the File
   /// menu: after the window's Open items, before the log and Quit items).
   virtual void addMenuAction(const QString& title, QAction* action) = 0;
+  /// Makes `dock` at least `height` pixels tall, but no more than `share`
+  /// of the window's height (after the window has laid out its docks).
+  virtual void growDock(QDockWidget* dock, int height, double share) = 0;
+  /// What a job's dialogs and menus are parented to (the console's window).
+  virtual QWidget* dialogParent() = 0;
 };
 
 /// Everything a job may use; the window owns it and outlives every job.
@@ -89,7 +94,6 @@ class ConsoleContext : public QObject {
  public:
   struct Parts {
     ConsoleHost* host = nullptr;
-    QMainWindow* window = nullptr;
     ConsoleSession* session = nullptr;
     RobotConnection* connection = nullptr;
     FeedSwitch* feeds = nullptr;
@@ -115,7 +119,8 @@ class ConsoleContext : public QObject {
   LaserPlot& laserPlot() const { return *parts_.laserPlot; }
   PredictionErrorPlot& errorPlot() const { return *parts_.errorPlot; }
   BackgroundJobs& background() const { return *parts_.background; }
-  QMainWindow* window() const { return parts_.window; }
+  /// What a job's dialogs, menus and actions are parented to.
+  QWidget* dialogParent() const { return parts_.host->dialogParent(); }
   ConsoleHost& host() const { return *parts_.host; }
 
   /// The live robot's joint positions as last reported (model order).
@@ -166,6 +171,9 @@ class ConsoleContext : public QObject {
   void terrainEdited(const sp::TerrainPatchCmd& patch);
   /// The default layout was put back: a job shows or hides its docks.
   void layoutReset();
+  /// The operator asked to put the robot back at its start (the banner's
+  /// button): the link job resets the stand-in.
+  void resetRequested();
   /// Rehearse from a logged moment (the Replay job asks, the Sequence job does).
   void rehearseFrom(const sp::RehearsalStart& start, const sp::WorldModel& world, const sp::SimParams& params,
                     const QString& label);

@@ -34,13 +34,6 @@
 #include "ui/connect_dialog.h"
 #include "ui/console_monitor.h"
 #include "ui/icons.h"
-#include "ui/jobs/drive/drive_job.h"
-#include "ui/jobs/jobs.h"
-#include "ui/jobs/link/link_job.h"
-#include "ui/jobs/replay/replay_job.h"
-#include "ui/jobs/replay/replay_panel.h"
-#include "ui/jobs/sequence/sequence_job.h"
-#include "ui/jobs/terrain/terrain_job.h"
 #include "ui/limit_spin_box.h"
 #include "ui/link_panel.h"
 #include "ui/live_plots.h"
@@ -123,7 +116,7 @@ void MainWindow::buildCentral() {
   bannerReset_->setObjectName(QStringLiteral("bannerReset"));
   bannerReset_->setToolTip(tr("Robot ▸ Reset to the start: the stand-in restarts with the robot where the world puts it"));
   bannerReset_->setFocusPolicy(Qt::NoFocus);
-  connect(bannerReset_, &QPushButton::clicked, this, [this] { resetRobot(); });
+  connect(bannerReset_, &QPushButton::clicked, this, [this] { emit context_->resetRequested(); });
   bannerRow_ = new QWidget;
   auto* bannerLayout = new QHBoxLayout(bannerRow_);
   bannerLayout->setContentsMargins(0, 0, 0, 0);
@@ -193,7 +186,6 @@ void MainWindow::buildPlots() {
 void MainWindow::buildContext() {
   ConsoleContext::Parts parts;
   parts.host = this;
-  parts.window = this;
   parts.session = session_.get();
   parts.connection = connection_;
   parts.feeds = feeds_;
@@ -228,7 +220,6 @@ void MainWindow::startPanelTimer() {
       if (session_->standIn())
         monitor_->state().realTime(session_->realTimeFactor(), session_->targetRealTimeFactor(), monitor_->wallSeconds());
       refreshStatus();
-      linkPanel()->showOdometry(qs(state().poseText()), qs(state().motionText()));
     }
     scene_->update();
   });
@@ -267,6 +258,11 @@ MainWindow::~MainWindow() {
   session_.reset();
 }
 
+void MainWindow::growDock(QDockWidget* dock, int height, double share) {
+  const int wanted = std::min(height, static_cast<int>(this->height() * share));
+  if (dock->height() < wanted) resizeDocks({dock}, {wanted}, Qt::Vertical);
+}
+
 ConsoleJob* MainWindow::installJob(std::unique_ptr<ConsoleJob> job) {
   job->setObjectName(job->name());
   job->install(*context_);
@@ -274,15 +270,6 @@ ConsoleJob* MainWindow::installJob(std::unique_ptr<ConsoleJob> job) {
   return jobs_.back().get();
 }
 
-ControlPanel* MainWindow::controlPanel() const { return job<DriveJob>() ? job<DriveJob>()->panel() : nullptr; }
-SequencePanel* MainWindow::sequencePanel() const { return job<SequenceJob>() ? job<SequenceJob>()->panel() : nullptr; }
-TerrainPanel* MainWindow::terrainPanel() const { return job<TerrainJob>() ? job<TerrainJob>()->panel() : nullptr; }
-ReplayPanel* MainWindow::replayPanel() const { return job<ReplayJob>() ? job<ReplayJob>()->panel() : nullptr; }
-int64_t MainWindow::terrainEdits() const { return job<TerrainJob>() ? job<TerrainJob>()->edits() : 0; }
-QString MainWindow::openLog(const QString& path, bool quiet) { return job<ReplayJob>()->openLog(path, quiet); }
-void MainWindow::openLogInBackground(const QString& path) { job<ReplayJob>()->openLogInBackground(path); }
-void MainWindow::showSessionLogs() { job<ReplayJob>()->showSessionLogs(); }
-QStringList MainWindow::recentLogs() const { return job<ReplayJob>()->recentLogs(); }
 
 QDockWidget* MainWindow::addDock(const QString& title, const QString& objectName, QWidget* panel, DockPlace place,
                                  bool scrolled) {
@@ -701,10 +688,6 @@ int64_t MainWindow::telemetryReceived() const { return liveFeed_->telemetryCount
 int64_t MainWindow::laserReceived() const { return liveFeed_->laserCount(); }
 double MainWindow::realTimeFactor() const { return session_->realTimeFactor(); }
 
-LinkPanel* MainWindow::linkPanel() const { return job<LinkJob>()->panel(); }
 void MainWindow::emergencyStop() { context_->emergencyStop(); }
-void MainWindow::rearm() { job<LinkJob>()->rearm(); }
-void MainWindow::openConnectDialog() { job<LinkJob>()->openConnectDialog(); }
-void MainWindow::resetRobot() { job<LinkJob>()->resetRobot(); }
 
 }  // namespace sp

@@ -48,19 +48,14 @@ class ConsoleMonitor;
 class StatusFields;
 struct BranchPoint;
 class ConsoleSession;
-class ControlPanel;
 class FeedSwitch;
 class GhostFeed;
 class LiveLinkFeed;
 class RobotFeed;
 class LaserPlot;
-class LinkPanel;
 class PredictionErrorPlot;
 class RobotConnection;
-class ReplayPanel;
 class SceneView;
-class SequencePanel;
-class TerrainPanel;
 class WheelForcePlot;
 
 /// What the console starts with (the `simpartner` command line).
@@ -108,23 +103,6 @@ class MainWindow : public QMainWindow, public ConsoleHost {
 
   // For tests and the status of the session.
   SceneView* sceneView() const { return scene_; }
-  LinkPanel* linkPanel() const;
-  ControlPanel* controlPanel() const;
-  SequencePanel* sequencePanel() const;
-  TerrainPanel* terrainPanel() const;
-  ReplayPanel* replayPanel() const;
-  /// Terrain edits applied since the start (each dab, undo or redo).
-  int64_t terrainEdits() const;
-  /// File ▸ Open session log: the views show the log at the replay cursor
-  /// (the live link goes on unseen) until the replay is closed. "" or why
-  /// not (shown in a dialog unless `quiet`).
-  QString openLog(const QString& path, bool quiet = false);
-  /// Opens a log for replay on the Replay dock's worker, with progress.
-  void openLogInBackground(const QString& path);
-  /// File ▸ Session logs: the log folder's logs with sizes; replay or delete.
-  void showSessionLogs();
-  /// File ▸ Recent session logs: the last logs replayed that still exist.
-  QStringList recentLogs() const;
   /// A replay is shown instead of the live robot.
   bool replaying() const { return state().replaying(); }
   WheelForcePlot* wheelForcePlot() const { return wheelPlot_; }
@@ -170,6 +148,8 @@ class MainWindow : public QMainWindow, public ConsoleHost {
                        bool scrolled) override;
   QMenu* menu(const QString& title) override;
   void addMenuAction(const QString& title, QAction* action) override;
+  void growDock(QDockWidget* dock, int height, double share) override;
+  QWidget* dialogParent() override { return this; }
 
  public slots:
   /// Sends the e-stop to the live robot (whatever the views show).
@@ -183,13 +163,6 @@ class MainWindow : public QMainWindow, public ConsoleHost {
   void showStatus(const QString& text, int ms);
   /// The live robot's ground speed [m/s] by its newest telemetry (0 without one).
   double robotSpeed() const;
-  /// Asks the operator to confirm, then re-arms (clears a latched failsafe
-  /// or e-stop) and zeroes the controls.
-  void rearm();
-  /// Robot > Connect to…: a robot's HOST:PORT and token, or the stand-in.
-  void openConnectDialog();
-  /// Robot > Reset to the start: restarts the stand-in (logged).
-  void resetRobot();
 
  protected:
   bool eventFilter(QObject* watched, QEvent* event) override;

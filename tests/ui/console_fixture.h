@@ -12,7 +12,12 @@
 
 #include <memory>
 
+#include "ui/jobs/drive/drive_job.h"
 #include "ui/jobs/jobs.h"
+#include "ui/jobs/link/link_job.h"
+#include "ui/jobs/replay/replay_job.h"
+#include "ui/jobs/sequence/sequence_job.h"
+#include "ui/jobs/terrain/terrain_job.h"
 #include "ui/main_window.h"
 #include "ui/scene_view.h"
 
@@ -64,5 +69,37 @@ int glTestMain(int argc, char** argv) {
   Test test;
   return QTest::qExec(&test, argc, argv);
 }
+
+// The built-in jobs' panels and doings, as the tests reach them: through
+// the jobs installed in the window (MainWindow knows no job).
+inline LinkPanel* linkPanel(const MainWindow& w) { return w.job<LinkJob>()->panel(); }
+inline ControlPanel* controlPanel(const MainWindow& w) {
+  DriveJob* j = w.job<DriveJob>();
+  return j ? j->panel() : nullptr;
+}
+inline SequencePanel* sequencePanel(const MainWindow& w) {
+  SequenceJob* j = w.job<SequenceJob>();
+  return j ? j->panel() : nullptr;
+}
+inline TerrainPanel* terrainPanel(const MainWindow& w) {
+  TerrainJob* j = w.job<TerrainJob>();
+  return j ? j->panel() : nullptr;
+}
+inline ReplayPanel* replayPanel(const MainWindow& w) {
+  ReplayJob* j = w.job<ReplayJob>();
+  return j ? j->panel() : nullptr;
+}
+/// Terrain edits applied since the start (each dab, undo or redo).
+inline int64_t terrainEdits(const MainWindow& w) { return w.job<TerrainJob>()->edits(); }
+/// File ▸ Open session log: "" or why not (in a dialog unless `quiet`).
+inline QString openLog(const MainWindow& w, const QString& path, bool quiet = false) {
+  return w.job<ReplayJob>()->openLog(path, quiet);
+}
+inline void openLogInBackground(const MainWindow& w, const QString& path) { w.job<ReplayJob>()->openLogInBackground(path); }
+inline void showSessionLogs(const MainWindow& w) { w.job<ReplayJob>()->showSessionLogs(); }
+inline QStringList recentLogs(const MainWindow& w) { return w.job<ReplayJob>()->recentLogs(); }
+inline void rearm(const MainWindow& w) { w.job<LinkJob>()->rearm(); }
+inline void openConnectDialog(const MainWindow& w) { w.job<LinkJob>()->openConnectDialog(); }
+inline void resetRobot(const MainWindow& w) { w.job<LinkJob>()->resetRobot(); }
 
 }  // namespace sp::test

@@ -107,7 +107,7 @@ class TestCalibrationDock : public QObject {
     dock->show();
     dock->raise();
     QTRY_VERIFY_WITH_TIMEOUT(w.consoleState().leaseHeld(), 10000);
-    w.controlPanel()->setDrive(0.5, 0);
+    test::controlPanel(w)->setDrive(0.5, 0);
     LiveCalibrator* calibrator = w.context().session().calibrator();
     QVERIFY(calibrator);
 

@@ -133,7 +133,7 @@ class TestConsole : public QObject {
   // holding control, telemetry flowing, the session logged to a file.
   void windowOpensOnDefaultWorld() {
     MainWindow& w = *window_;
-    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld(), 5000);
+    QTRY_VERIFY_WITH_TIMEOUT(test::linkPanel(w)->leaseHeld(), 5000);
     QTRY_VERIFY_WITH_TIMEOUT(w.telemetryReceived() > 20, 5000);
     QVERIFY(!w.logPath().isEmpty());
     QVERIFY(QFileInfo::exists(w.logPath()));
@@ -191,7 +191,7 @@ class TestConsole : public QObject {
                                                       });
     scene->setFocus();
     for (int i = 0; i < 10; ++i) QTest::keyClick(scene, Qt::Key_Up);  // 10 x 0.05 m/s
-    QCOMPARE(w.controlPanel()->speed(), 0.5);
+    QCOMPARE(test::controlPanel(w)->speed(), 0.5);
     QTRY_VERIFY_WITH_TIMEOUT(std::hypot(w.lastTelemetry()->pose.p.x - start.p.x,
                                         w.lastTelemetry()->pose.p.y - start.p.y) > 0.5, 6000);
     // The drawn robot is where a recent telemetry frame says, exactly: one
@@ -232,7 +232,7 @@ class TestConsole : public QObject {
       for (int i = 0; i < 10; ++i) QTest::keyClick(w.sceneView(), Qt::Key_Up);
       QTRY_VERIFY_WITH_TIMEOUT(planarSpeedOver(w, 300) > 0.3, 6000);
     }
-    auto* spin = w.controlPanel()->findChild<QDoubleSpinBox*>();
+    auto* spin = test::controlPanel(w)->findChild<QDoubleSpinBox*>();
     QVERIFY(spin);
     spin->setFocus();
     QTest::keyClick(spin, Qt::Key_Escape);
@@ -240,7 +240,7 @@ class TestConsole : public QObject {
     QTRY_VERIFY_WITH_TIMEOUT(w.bannerText().contains(QLatin1String("E-STOP")), 3000);
     QTest::qWait(1000);  // braking
     QVERIFY2(planarSpeedOver(w, 500) < 0.02, "still moving after the e-stop");
-    answerRearm([&] { w.linkPanel()->rearmRequested(); }, true);
+    answerRearm([&] { test::linkPanel(w)->rearmRequested(); }, true);
     QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->estop, 3000);
     QTRY_VERIFY(w.bannerText().isEmpty());
     // Re-arming does not restart the motion.
@@ -266,7 +266,7 @@ class TestConsole : public QObject {
     QTest::qWait(200);
     QVERIFY(!QApplication::activeModalWidget());
     QVERIFY(!QApplication::activePopupWidget());
-    answerRearm([&] { w.linkPanel()->rearmRequested(); }, true);
+    answerRearm([&] { test::linkPanel(w)->rearmRequested(); }, true);
     QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->estop, 3000);
   }
 
@@ -275,14 +275,14 @@ class TestConsole : public QObject {
   // control again and re-arming clears it.
   void lostLinkShowsTheFailsafe() {
     MainWindow& w = *window_;
-    QVERIFY(w.linkPanel()->leaseHeld());
+    QVERIFY(test::linkPanel(w)->leaseHeld());
     w.connection()->dropConnection();
-    QTRY_VERIFY_WITH_TIMEOUT(!w.linkPanel()->leaseHeld(), 3000);
+    QTRY_VERIFY_WITH_TIMEOUT(!test::linkPanel(w)->leaseHeld(), 3000);
     QTRY_VERIFY_WITH_TIMEOUT(w.bannerText().contains(QLatin1String("FAILSAFE")), 5000);
     QVERIFY(w.lastTelemetry()->failsafe);
-    w.linkPanel()->takeControlRequested();
-    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld(), 3000);
-    answerRearm([&] { w.linkPanel()->rearmRequested(); }, true);
+    test::linkPanel(w)->takeControlRequested();
+    QTRY_VERIFY_WITH_TIMEOUT(test::linkPanel(w)->leaseHeld(), 3000);
+    answerRearm([&] { test::linkPanel(w)->rearmRequested(); }, true);
     QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->failsafe, 3000);
     QTRY_VERIFY(w.bannerText().isEmpty());
   }
@@ -293,8 +293,8 @@ class TestConsole : public QObject {
   // one Up press after it asks for 0.05 m/s, not the old speed plus 0.05.
   void controlsMirrorTheRobot() {
     MainWindow& w = *window_;
-    ControlPanel* controls = w.controlPanel();
-    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld() && controls->controlsEnabled(), 3000);
+    ControlPanel* controls = test::controlPanel(w);
+    QTRY_VERIFY_WITH_TIMEOUT(test::linkPanel(w)->leaseHeld() && controls->controlsEnabled(), 3000);
     w.sceneView()->setFocus();
     for (int i = 0; i < 6; ++i) QTest::keyClick(w.sceneView(), Qt::Key_Up);
     QCOMPARE(controls->speed(), 0.3);
@@ -303,7 +303,7 @@ class TestConsole : public QObject {
     QTRY_COMPARE(controls->speed(), 0.0);
     QTRY_VERIFY(!controls->controlsEnabled());
     // Focus on a button, then Space and Up: nothing is clicked, nothing driven.
-    auto* rearmButton = w.linkPanel()->findChild<QPushButton*>(QStringLiteral("rearmButton"));
+    auto* rearmButton = test::linkPanel(w)->findChild<QPushButton*>(QStringLiteral("rearmButton"));
     QVERIFY(rearmButton);
     QCOMPARE(rearmButton->focusPolicy(), Qt::NoFocus);
     rearmButton->setFocus();
@@ -313,14 +313,14 @@ class TestConsole : public QObject {
     QVERIFY(w.lastTelemetry()->estop);
     QCOMPARE(controls->speed(), 0.0);
     // Cancel leaves it latched; confirming re-arms.
-    answerRearm([&] { w.rearm(); }, false);
+    answerRearm([&] { test::rearm(w); }, false);
     QTest::qWait(500);
     QVERIFY(w.lastTelemetry()->estop);
-    answerRearm([&] { w.rearm(); }, true);
+    answerRearm([&] { test::rearm(w); }, true);
     QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->estop, 3000);
     QTRY_VERIFY(controls->controlsEnabled());
     // Drive keys work wherever the focus is (here the link's event list).
-    auto* events = w.linkPanel()->findChild<QPlainTextEdit*>();
+    auto* events = test::linkPanel(w)->findChild<QPlainTextEdit*>();
     QVERIFY(events);
     events->setFocus();
     QTest::keyClick(events, Qt::Key_Up);
@@ -355,7 +355,7 @@ class TestConsole : public QObject {
       for (QPushButton* b : dialog->findChildren<QPushButton*>())
         if (b->text() == QStringLiteral("Connect")) b->click();
     });
-    w.openConnectDialog();
+    test::openConnectDialog(w);
     QVERIFY2(shownError.contains(QLatin1String("32 hex digits")), qPrintable(shownError));
     QVERIFY(w.session()->remote());
     QCOMPARE(w.session()->endpoint().port, port.toUShort());
@@ -373,10 +373,10 @@ class TestConsole : public QObject {
     QVERIFY(take && release);
     QTRY_VERIFY(take->isEnabled() && !release->isEnabled());
     take->trigger();
-    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld(), 3000);
+    QTRY_VERIFY_WITH_TIMEOUT(test::linkPanel(w)->leaseHeld(), 3000);
     QTRY_VERIFY(!take->isEnabled() && release->isEnabled());
     release->trigger();
-    QTRY_VERIFY_WITH_TIMEOUT(!w.linkPanel()->leaseHeld(), 3000);
+    QTRY_VERIFY_WITH_TIMEOUT(!test::linkPanel(w)->leaseHeld(), 3000);
     w.close();
     robot.terminate();
     QVERIFY(robot.waitForFinished(5000));
@@ -433,7 +433,7 @@ class TestConsole : public QObject {
     w.resize(1280, 800);
     w.show();
     QVERIFY(QTest::qWaitForWindowExposed(&w));
-    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld(), 20000);
+    QTRY_VERIFY_WITH_TIMEOUT(test::linkPanel(w)->leaseHeld(), 20000);
     const Ghost* ghost = w.session()->ghost();
     QVERIFY(ghost);
     QTRY_VERIFY_WITH_TIMEOUT(ghost->viewVersion() > 0 && w.telemetryReceived() > 50, 10000);
@@ -497,11 +497,11 @@ class TestConsole : public QObject {
     // robot, a one-way trip away, does not know yet; the ghost stops where
     // the robot will, so that when the robot reports its stop the two
     // stand together (the ghost used to drive on: 45-125 cm apart).
-    QVERIFY(w.controlPanel()->speed() > 0.3);
+    QVERIFY(test::controlPanel(w)->speed() > 0.3);
     QTest::keyClick(scene, Qt::Key_Escape);
     QTRY_VERIFY_WITH_TIMEOUT(w.bannerText().contains(QLatin1String("E-STOP in flight: lands in ~1.0 s")), 300);
-    QCOMPARE(w.controlPanel()->speed(), 0.0);
-    QVERIFY(!w.controlPanel()->controlsEnabled());
+    QCOMPARE(test::controlPanel(w)->speed(), 0.0);
+    QVERIFY(!test::controlPanel(w)->controlsEnabled());
     QVERIFY(!w.lastTelemetry()->estop);
     const auto still = [&](const std::function<Pose()>& pose) {
       const Pose a = pose();
@@ -578,7 +578,7 @@ class TestConsole : public QObject {
       QVERIFY(logFile.startsWith(o.logDir));
       QTRY_VERIFY_WITH_TIMEOUT(remote.telemetryReceived() > 25, 5000);
       QTRY_VERIFY_WITH_TIMEOUT(remote.laserReceived() > 1, 5000);
-      QVERIFY(!remote.linkPanel()->leaseHeld());
+      QVERIFY(!test::linkPanel(remote)->leaseHeld());
       remote.addNote(QStringLiteral("seen from afar"));
     }
     std::string error;
@@ -677,7 +677,7 @@ class TestConsole : public QObject {
     auto* reset = w.findChild<QPushButton*>(QStringLiteral("bannerReset"));
     QVERIFY(reset && !reset->isVisible());
     const QString firstLog = w.logPath();
-    w.resetRobot();
+    test::resetRobot(w);
     QVERIFY(w.logPath() != firstLog);
     const int64_t before = w.telemetryReceived();
     QTRY_VERIFY_WITH_TIMEOUT(w.telemetryReceived() > before + 5, 5000);

@@ -119,7 +119,7 @@ class TestJobs : public QObject {
     QVERIFY(toy);
     QCOMPARE(toy->label_->text(), QStringLiteral("hello"));
     QTRY_VERIFY_WITH_TIMEOUT(toy->frames_ > 25, 10000);
-    QVERIFY(!w->linkPanel()->leaseHeld());
+    QVERIFY(!test::linkPanel(*w)->leaseHeld());
   }
 
   // A toy job installed into the running console through the context
@@ -142,7 +142,7 @@ class TestJobs : public QObject {
       }
     }
     QVERIFY(inView && inTools);
-    QTRY_VERIFY_WITH_TIMEOUT(toy->frames_ > 10 && w->linkPanel()->leaseHeld(), 10000);
+    QTRY_VERIFY_WITH_TIMEOUT(toy->frames_ > 10 && test::linkPanel(*w)->leaseHeld(), 10000);
     const double x0 = toy->lastX_;
     toy->action_->trigger();
     QCOMPARE(toy->refusal_, QString());
@@ -188,10 +188,10 @@ class TestJobs : public QObject {
     ConsoleOptions o;
     std::unique_ptr<MainWindow> w;
     QCOMPARE(test::startConsole(dir_, QStringLiteral("terrains/flat.world.xml"), o, w), QString());
-    QTRY_VERIFY_WITH_TIMEOUT(w->telemetryReceived() > 10 && w->linkPanel()->leaseHeld(), 10000);
-    QCOMPARE(w->openLog(QString::fromStdString(log), true), QString());
+    QTRY_VERIFY_WITH_TIMEOUT(w->telemetryReceived() > 10 && test::linkPanel(*w)->leaseHeld(), 10000);
+    QCOMPARE(test::openLog(*w, QString::fromStdString(log), true), QString());
     QVERIFY(w->replaying());
-    QVERIFY(!w->controlPanel()->controlsEnabled());
+    QVERIFY(!test::controlPanel(*w)->controlsEnabled());
     QVERIFY(w->bannerText().contains(QStringLiteral("Replay of demo.splog")));
 
     const uint64_t sent = w->connection()->stats().commandsSent;
@@ -200,7 +200,7 @@ class TestJobs : public QObject {
     for (Qt::Key key : {Qt::Key_Up, Qt::Key_Up, Qt::Key_W, Qt::Key_Space}) QTest::keyClick(w->sceneView(), key);
     QVERIFY(!w->context().sendCommand(DriveCmd{0.1, 0}).isEmpty());
     // Esc that closes an open list (the replay's signal list) is not an e-stop.
-    auto* signalList = w->replayPanel()->findChild<QComboBox*>();
+    auto* signalList = test::replayPanel(*w)->findChild<QComboBox*>();
     QVERIFY(signalList);
     signalList->showPopup();
     QTRY_VERIFY(QApplication::activePopupWidget());
@@ -218,9 +218,9 @@ class TestJobs : public QObject {
           static_cast<long long>(w->telemetryReceived() - frames));
 
     // Control: the replay closed, the same key drives the live robot.
-    w->replayPanel()->close();
+    test::replayPanel(*w)->close();
     QVERIFY(!w->replaying());
-    QTRY_VERIFY(w->controlPanel()->controlsEnabled());
+    QTRY_VERIFY(test::controlPanel(*w)->controlsEnabled());
     QTest::keyClick(w->sceneView(), Qt::Key_Up);
     QTRY_VERIFY_WITH_TIMEOUT(w->connection()->stats().commandsSent > sent, 3000);
     w->close();

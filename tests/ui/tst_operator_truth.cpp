@@ -47,7 +47,7 @@ void rearmConfirmed(MainWindow& w) {
       for (QAbstractButton* b : box->buttons())
         if (b->text() == QStringLiteral("Re-arm")) b->click();
   });
-  w.rearm();
+  test::rearm(w);
 }
 
 bool anyEventHas(const LinkPanel& panel, const QString& text) {
@@ -68,7 +68,7 @@ class TestOperatorTruth : public QObject {
     const QString error =
         test::startConsole(dir_, QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml"), options_, window_);
     QVERIFY2(error.isEmpty(), qPrintable(error));
-    QTRY_VERIFY_WITH_TIMEOUT(window_->linkPanel()->leaseHeld() && window_->lastTelemetry(), 10000);
+    QTRY_VERIFY_WITH_TIMEOUT(test::linkPanel(*window_)->leaseHeld() && window_->lastTelemetry(), 10000);
   }
   void cleanupTestCase() { window_.reset(); }
 
@@ -80,7 +80,7 @@ class TestOperatorTruth : public QObject {
     QVERIFY(!w.lastTelemetry()->failsafe);
     modalAndBlocked(std::chrono::milliseconds(1000));
     QTest::qWait(500);  // frames from after the block
-    QVERIFY(w.linkPanel()->leaseHeld());
+    QVERIFY(test::linkPanel(w)->leaseHeld());
     QVERIFY(!w.lastTelemetry()->failsafe);
     QVERIFY(!w.context().state().failsafe());
   }
@@ -121,8 +121,8 @@ class TestOperatorTruth : public QObject {
   // robot's deadman latches the failsafe.
   void keepalivesOnTheGuiThreadFail() {
     MainWindow& w = *window_;
-    w.linkPanel()->releaseControlRequested();
-    QTRY_VERIFY_WITH_TIMEOUT(!w.linkPanel()->leaseHeld(), 3000);
+    test::linkPanel(w)->releaseControlRequested();
+    QTRY_VERIFY_WITH_TIMEOUT(!test::linkPanel(w)->leaseHeld(), 3000);
     const RobotEndpoint& e = w.session()->endpoint();
     test::RawClient raw(e.port);
     raw.send(net::HelloMsg{"gui-thread keep-alives", e.token, net::Role::Control, ""});
@@ -138,8 +138,8 @@ class TestOperatorTruth : public QObject {
     keepalives.stop();
     raw.send(net::LeaseReleaseMsg{});
     // Back in control, re-armed, for the tests that follow.
-    w.linkPanel()->takeControlRequested();
-    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld(), 3000);
+    test::linkPanel(w)->takeControlRequested();
+    QTRY_VERIFY_WITH_TIMEOUT(test::linkPanel(w)->leaseHeld(), 3000);
     rearmConfirmed(w);
     QTRY_VERIFY_WITH_TIMEOUT(!w.lastTelemetry()->failsafe, 3000);
   }
@@ -149,12 +149,12 @@ class TestOperatorTruth : public QObject {
   // while connected: "E-STOP sent" (the control of the next test).
   void rearmOnlyWhenLatched() {
     MainWindow& w = *window_;
-    auto* rearm = w.linkPanel()->findChild<QPushButton*>(QStringLiteral("rearmButton"));
+    auto* rearm = test::linkPanel(w)->findChild<QPushButton*>(QStringLiteral("rearmButton"));
     QVERIFY(rearm);
     QTRY_VERIFY(w.context().state().connected() && !w.context().state().latched());
     QVERIFY(!rearm->isEnabled());
     w.emergencyStop();
-    QVERIFY(anyEventHas(*w.linkPanel(), QStringLiteral("E-STOP sent")));
+    QVERIFY(anyEventHas(*test::linkPanel(w), QStringLiteral("E-STOP sent")));
     QTRY_VERIFY_WITH_TIMEOUT(w.lastTelemetry()->estop, 3000);
     QTRY_VERIFY(rearm->isEnabled());
     rearmConfirmed(w);
@@ -166,8 +166,8 @@ class TestOperatorTruth : public QObject {
   // default; with the robot standing (the control) it quits at once.
   void quitAsksWhileDriving() {
     MainWindow& w = *window_;
-    QTRY_VERIFY_WITH_TIMEOUT(w.linkPanel()->leaseHeld(), 3000);
-    w.controlPanel()->setDrive(0.5, 0.0);
+    QTRY_VERIFY_WITH_TIMEOUT(test::linkPanel(w)->leaseHeld(), 3000);
+    test::controlPanel(w)->setDrive(0.5, 0.0);
     QTRY_VERIFY_WITH_TIMEOUT(w.robotSpeed() > 0.2, 5000);
     QString asked;
     QTimer::singleShot(100, [&asked] {
@@ -180,7 +180,7 @@ class TestOperatorTruth : public QObject {
     w.requestQuit();
     QVERIFY2(asked.contains(QLatin1String("You hold control of a robot moving at")), qPrintable(asked));
     QVERIFY(w.isVisible());
-    w.controlPanel()->setDrive(0.0, 0.0);
+    test::controlPanel(w)->setDrive(0.0, 0.0);
     QTRY_VERIFY_WITH_TIMEOUT(w.robotSpeed() < 0.05, 5000);
   }
 
@@ -199,22 +199,22 @@ class TestOperatorTruth : public QObject {
         "the robot was sent a stop, and the sequence can be rehearsed again from where the robot stands");
     QStringList bad = test::unreadable(w.statusBar());
     QVERIFY2(bad.isEmpty(), qPrintable("the fields alone:\n" + bad.join('\n')));
-    bad = test::unreadable(w.linkPanel());
+    bad = test::unreadable(test::linkPanel(w));
     QVERIFY2(bad.isEmpty(), qPrintable("the Link dock:\n" + bad.join('\n')));
     w.statusBar()->showMessage(text);
     QVERIFY2(!test::unreadable(w.statusBar()).isEmpty(), "the control: the whole text must not fit");
-    const qsizetype before = w.linkPanel()->events().size();
+    const qsizetype before = test::linkPanel(w)->events().size();
     w.context().status(text);
     bad = test::unreadable(w.statusBar());
     QVERIFY2(bad.isEmpty(), qPrintable(bad.join('\n')));
     QVERIFY(w.statusBar()->currentMessage().endsWith(QChar(0x2026)));
     QCOMPARE(w.statusBar()->toolTip(), text);
-    QVERIFY(w.linkPanel()->events().mid(before).join('\n').contains(text));
+    QVERIFY(test::linkPanel(w)->events().mid(before).join('\n').contains(text));
     // A short one is shown whole and not repeated in the event list.
-    const qsizetype listed = w.linkPanel()->events().size();
+    const qsizetype listed = test::linkPanel(w)->events().size();
     w.context().status(QStringLiteral("Saved."));
     QCOMPARE(w.statusBar()->currentMessage(), QStringLiteral("Saved."));
-    QCOMPARE(w.linkPanel()->events().size(), listed);
+    QCOMPARE(test::linkPanel(w)->events().size(), listed);
   }
 
   // Esc after a disconnect: the event list and the status bar say the
@@ -224,9 +224,9 @@ class TestOperatorTruth : public QObject {
     MainWindow& w = *window_;
     w.connection()->close();
     QTRY_VERIFY(!w.context().state().connected());
-    const qsizetype before = w.linkPanel()->events().size();
+    const qsizetype before = test::linkPanel(w)->events().size();
     w.emergencyStop();
-    const QStringList events = w.linkPanel()->events().mid(before);
+    const QStringList events = test::linkPanel(w)->events().mid(before);
     bool notSent = false, claimedSent = false;
     for (const QString& e : events) {
       notSent |= e.contains(QLatin1String("E-STOP NOT sent: not connected to the robot"));

@@ -55,21 +55,21 @@ class TestReplay : public QObject {
   // it); at 2x the cursor moves 1.6-2.4 s in 1 s of wall time.
   void seekToAnEventAndPlayAtTwice() {
     MainWindow& w = *window_;
-    QTRY_VERIFY_WITH_TIMEOUT(w.controlPanel()->controlsEnabled(), 20000);
-    w.controlPanel()->setDrive(0.5, 0.0);
+    QTRY_VERIFY_WITH_TIMEOUT(test::controlPanel(w)->controlsEnabled(), 20000);
+    test::controlPanel(w)->setDrive(0.5, 0.0);
     QTest::qWait(1500);
     w.addNote(QStringLiteral("mark"));
     QTest::qWait(1500);
-    w.controlPanel()->setDrive(0.0, 0.0);
+    test::controlPanel(w)->setDrive(0.0, 0.0);
     QTest::qWait(1500);
     const QString log = w.logPath();
-    w.resetRobot();  // the old log is complete now
+    test::resetRobot(w);  // the old log is complete now
     QTRY_VERIFY_WITH_TIMEOUT(w.logPath() != log, 20000);
 
     w.resize(1280, 800);
-    QCOMPARE(w.openLog(log, true), QString());
+    QCOMPARE(test::openLog(w, log, true), QString());
     QVERIFY(w.replaying());
-    ReplayPanel* r = w.replayPanel();
+    ReplayPanel* r = test::replayPanel(w);
     // At 1280x800 the plot gets a third of the dock or more, and nothing
     // scrolls (issue 31: it got 15 px, the rest below the fold).
     auto* dock = w.findChild<QDockWidget*>(QStringLiteral("replayDock"));
@@ -152,7 +152,7 @@ class TestReplay : public QObject {
     // is where the parent log has the robot at that time, bit for bit (the
     // twin is deterministic; tst_log_player checks the state hash itself).
     // Opened and branched as the operator does: on the dock's worker.
-    w.openLogInBackground(log);
+    test::openLogInBackground(w, log);
     QTRY_VERIFY_WITH_TIMEOUT(r->isOpen() && !r->busy(), 20000);
     const double at = std::round(noteTime * 1000) / 1000;
     r->seek(at);
@@ -183,9 +183,9 @@ class TestReplay : public QObject {
   void verifyReSimulatesTheLog() {
     QVERIFY(!log_.isEmpty());
     MainWindow& w = *window_;
-    ReplayPanel* r = w.replayPanel();
+    ReplayPanel* r = test::replayPanel(w);
     QSignalSpy verified(r, &ReplayPanel::verified);
-    w.openLogInBackground(log_);
+    test::openLogInBackground(w, log_);
     QVERIFY(r->busy() && r->progressText().startsWith(QStringLiteral("Opening")));  // shown while it opens
     QTRY_VERIFY_WITH_TIMEOUT(r->isOpen() && !r->busy(), 20000);
     r->verify();
@@ -202,7 +202,7 @@ class TestReplay : public QObject {
     const int changed = sqlite3_changes(db);
     sqlite3_close(db);
     QVERIFY(changed >= 1);
-    w.openLogInBackground(altered);
+    test::openLogInBackground(w, altered);
     QTRY_VERIFY_WITH_TIMEOUT(r->isOpen() && !r->busy() && r->player()->path() == altered.toStdString(), 20000);
     r->verify();
     QTRY_VERIFY_WITH_TIMEOUT(verified.count() == 2, 60000);
@@ -212,11 +212,11 @@ class TestReplay : public QObject {
 
     // File ▸ Recent session logs: newest first; a log deleted since is left out.
     const QString absolute = QFileInfo(altered).absoluteFilePath();
-    QCOMPARE(w.recentLogs().value(0), absolute);
-    QVERIFY(w.recentLogs().contains(QFileInfo(log_).absoluteFilePath()));
+    QCOMPARE(test::recentLogs(w).value(0), absolute);
+    QVERIFY(test::recentLogs(w).contains(QFileInfo(log_).absoluteFilePath()));
     r->close();
     QVERIFY(QFile::remove(altered));
-    QVERIFY(!w.recentLogs().contains(absolute));
+    QVERIFY(!test::recentLogs(w).contains(absolute));
   }
 
   // File ▸ Session logs: the dialog lists the log folder (the scripted
@@ -244,11 +244,11 @@ class TestReplay : public QObject {
         }
       if (!clicked) dialog->reject();
     });
-    w.showSessionLogs();
+    test::showSessionLogs(w);
     qInfo("the dialog listed %d logs", rows);
     QVERIFY(rows >= 2 && marked && clicked);
-    QTRY_VERIFY_WITH_TIMEOUT(w.replayPanel()->isOpen() && w.replayPanel()->player()->path() == log_.toStdString(), 20000);
-    w.replayPanel()->close();
+    QTRY_VERIFY_WITH_TIMEOUT(test::replayPanel(w)->isOpen() && test::replayPanel(w)->player()->path() == log_.toStdString(), 20000);
+    test::replayPanel(w)->close();
   }
 
   // Rehearse from here: the Sequence dock rehearses from the logged state
@@ -258,13 +258,13 @@ class TestReplay : public QObject {
   void rehearseFromALoggedMoment() {
     QVERIFY(!log_.isEmpty());
     MainWindow& w = *window_;
-    ReplayPanel* r = w.replayPanel();
-    w.openLogInBackground(log_);
+    ReplayPanel* r = test::replayPanel(w);
+    test::openLogInBackground(w, log_);
     QTRY_VERIFY_WITH_TIMEOUT(r->isOpen() && !r->busy() && r->player()->path() == log_.toStdString(), 20000);
     r->seek(noteTime_);
     const Pose logged = r->player()->frameAt(noteTime_)->base;
     QVERIFY(r->rehearseHere());
-    SequencePanel* s = w.sequencePanel();
+    SequencePanel* s = test::sequencePanel(w);
     QVERIFY(s->pinnedStart().contains(QFileInfo(log_).fileName()));
     s->setText(QStringLiteral("0 drive 0.3 0\n1.5 stop\n"));
     QVERIFY(s->rehearse());

@@ -52,7 +52,7 @@ class TestSequencePanel : public QObject {
     const QString error = test::startConsole(dir_, QStringLiteral(SP_SOURCE_DIR "/terrains/flat.world.xml"), options_, window_);
     QVERIFY2(error.isEmpty(), qPrintable(error));
     QTRY_VERIFY_WITH_TIMEOUT(window_->lastTelemetry().has_value(), 20000);
-    QTRY_VERIFY_WITH_TIMEOUT(window_->sequencePanel()->sendButton() != nullptr, 1000);
+    QTRY_VERIFY_WITH_TIMEOUT(test::sequencePanel(*window_)->sendButton() != nullptr, 1000);
   }
   void cleanupTestCase() { window_.reset(); }
 
@@ -168,7 +168,7 @@ class TestSequencePanel : public QObject {
   // with a failed rule its verdict's row shows whole, failed rules first.
   void fitsAt1280x800() {
     QCOMPARE(window_->size(), QSize(1280, 800));
-    SequencePanel* p = window_->sequencePanel();
+    SequencePanel* p = test::sequencePanel(*window_);
     window_->findChild<QDockWidget*>(QStringLiteral("sequenceDock"))->raise();
     p->setText(QStringLiteral("1.0 drive 0.5 0\n2.0 drvie 0.5 0\n6.0 stop\n"));
     QTRY_VERIFY(!p->errors().isEmpty());
@@ -200,7 +200,7 @@ class TestSequencePanel : public QObject {
   // A typing error is marked on its line as soon as the text is checked;
   // Rehearse refuses it and says which line.
   void typoMarkedInline() {
-    SequencePanel* p = window_->sequencePanel();
+    SequencePanel* p = test::sequencePanel(*window_);
     p->setText(QStringLiteral("1.0 drive 0.5 0\n2.0 drvie 0.5 0\n3.0 target knee_fl 120\n"));
     QCOMPARE(p->markedLines(), (QList<int>{2}));
     QVERIFY2(p->errors().size() == 1 && p->errors()[0].startsWith("line 2: unknown command 'drvie'"),
@@ -226,7 +226,7 @@ class TestSequencePanel : public QObject {
   // Send; sent unchanged, the robot runs it to done with the guard quiet,
   // and the session log holds the rehearsal and the relay.
   void rehearseScrubAndSend() {
-    SequencePanel* p = window_->sequencePanel();
+    SequencePanel* p = test::sequencePanel(*window_);
     p->setText(QStringLiteral("0.2 drive 0.5 10\n3.0 stop\n"));
     QVERIFY(p->errors().isEmpty());
     QSignalSpy rehearsed(p, &SequencePanel::rehearsed);

@@ -47,7 +47,7 @@ class TestTerrainPanel : public QObject {
     const QString error =
         test::startConsole(dir_, QStringLiteral(SP_SOURCE_DIR "/terrains/test_track.world.xml"), options_, window_);
     QVERIFY2(error.isEmpty(), qPrintable(error));
-    QTRY_VERIFY_WITH_TIMEOUT(window_->lastTelemetry().has_value() && window_->controlPanel()->controlsEnabled(), 20000);
+    QTRY_VERIFY_WITH_TIMEOUT(window_->lastTelemetry().has_value() && test::controlPanel(*window_)->controlsEnabled(), 20000);
     QTRY_VERIFY_WITH_TIMEOUT(window_->lastTelemetry()->time > 2.0, 20000);  // settled on the track
   }
   void cleanupTestCase() { window_.reset(); }
@@ -61,7 +61,7 @@ class TestTerrainPanel : public QObject {
   // 1 cm of where it stood.
   void paintUndoAndSave() {
     MainWindow& w = *window_;
-    TerrainPanel* t = w.terrainPanel();
+    TerrainPanel* t = test::terrainPanel(w);
     SceneView* view = w.sceneView();
     QVERIFY(t->editable());
     Diagnostics diag;
@@ -93,7 +93,7 @@ class TestTerrainPanel : public QObject {
       QTest::qWait(16);
     }
     mouse(view, QEvent::MouseButtonRelease, centre + QPointF(80, 0), Qt::NoButton);
-    QVERIFY(w.terrainEdits() >= 2);
+    QVERIFY(test::terrainEdits(w) >= 2);
     QCOMPARE(t->editor()->undoLevels(), size_t{1});
     const HeightGrid& edited = t->editor()->grid();
     QVERIFY(edited.heights != loaded.heights);
@@ -148,7 +148,7 @@ class TestTerrainPanel : public QObject {
   // with a gentle brush (2 m, 0.005 m) shows no warning (riskChanged(false)).
   void hoverPreviewsAndWarns() {
     MainWindow& w = *window_;
-    TerrainPanel* t = w.terrainPanel();
+    TerrainPanel* t = test::terrainPanel(w);
     SceneView* view = w.sceneView();
     const HeightGrid before = t->editor()->grid();
     QSignalSpy risk(t, &TerrainPanel::riskChanged);
@@ -190,7 +190,7 @@ class TestTerrainPanel : public QObject {
   // profile imported is the test track's grid; a file that is not there is
   // named in the error and nothing is written.
   void newAndImport() {
-    TerrainPanel* t = window_->terrainPanel();
+    TerrainPanel* t = test::terrainPanel(*window_);
     Diagnostics diag;
     const QString csv = dir_.filePath(QStringLiteral("new.asc")), world = dir_.filePath(QStringLiteral("new.world.xml"));
     QCOMPARE(t->createNew(4, 2, 0.1, 0.3, csv, world), QString());

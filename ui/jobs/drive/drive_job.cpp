@@ -6,7 +6,6 @@
 #include <QDockWidget>
 #include <QKeyEvent>
 #include <QLineEdit>
-#include <QMainWindow>
 #include <QMessageBox>
 #include <QAction>
 #include <QPlainTextEdit>
@@ -83,9 +82,9 @@ void DriveJob::install(ConsoleContext& context) {
     panel_->showMeasured(context_->measuredPositions());
     measuredDirty_ = false;
   });
-  auto* keys = new QAction(tr("&Keys"), context.window());
+  auto* keys = new QAction(tr("&Keys"), context.dialogParent());
   connect(keys, &QAction::triggered, this, [this] {
-    QMessageBox::information(context_->window(), tr("Keys"),
+    QMessageBox::information(context_->dialogParent(), tr("Keys"),
                              tr("Esc\temergency stop (anywhere; an open menu closes too, an open list only closes)\n"
                                 "Up/Down, W/S\tspeed ± 0.05 m/s (held: faster)\n"
                                 "Left/Right, A/D\tarticulation ± 2°\n"
@@ -112,7 +111,7 @@ bool DriveJob::eventFilter(QObject* watched, QEvent* event) {
   const auto* rich = qobject_cast<QTextEdit*>(watched);
   const bool typing = qobject_cast<QAbstractSpinBox*>(watched) || (line && !line->isReadOnly()) ||
                       (plain && !plain->isReadOnly()) || (rich && !rich->isReadOnly());
-  if (!widget || widget->window() != context_->window() || typing || QApplication::activePopupWidget()) return false;
+  if (!widget || widget->window() != context_->dialogParent() || typing || QApplication::activePopupWidget()) return false;
   if (panel_->controlsEnabled()) panel_->handleKey(key->key(), key->isAutoRepeat());
   else if (!key->isAutoRepeat()) context_->status(panel_->toolTipWhenDisabled(), 3000);
   return true;

@@ -50,7 +50,13 @@ void LinkJob::install(ConsoleContext& context) {
     if (kind == QLatin1String("refused") || kind == QLatin1String("error")) context_->status(text, 5000);
   });
   connect(&context, &ConsoleContext::eventShown, panel_, &LinkPanel::appendEvent);
-  connect(&context, &ConsoleContext::panelTick, this, [this] { panel_->showStats(context_->connection().stats()); });
+  connect(&context, &ConsoleContext::panelTick, this, [this] {
+    panel_->showStats(context_->connection().stats());
+    // Where the robot is, read at a glance: 3 times a second.
+    if (++ticks_ % 3 == 0)
+      panel_->showOdometry(qs(context_->state().poseText()), qs(context_->state().motionText()));
+  });
+  connect(&context, &ConsoleContext::resetRequested, this, &LinkJob::resetRobot);
   connect(&context, &ConsoleContext::sessionChanged, this, [this] {
     panel_->setEndpoint(qs(context_->session().endpoint().label));
     connectToRobot();
@@ -68,13 +74,13 @@ void LinkJob::install(ConsoleContext& context) {
 
   const QString robot = tr("&Robot");
   const auto add = [&](const QString& text, auto* receiver, auto slot) {
-    auto* action = new QAction(text, context.window());  // the window owns its menus
+    auto* action = new QAction(text, context.dialogParent());  // the window owns its menus
     connect(action, &QAction::triggered, receiver, slot);
     context.host().addMenuAction(robot, action);
     return action;
   };
   const auto separator = [&] {
-    auto* s = new QAction(context.window());
+    auto* s = new QAction(context.dialogParent());
     s->setSeparator(true);
     context.host().addMenuAction(robot, s);
   };
@@ -104,7 +110,7 @@ void LinkJob::connectToRobot() {
 }
 
 void LinkJob::openConnectDialog() {
-  ConnectDialog dialog(context_->window(), [](const QString& hostPort, const QString& token) {
+  ConnectDialog dialog(context_->dialogParent(), [](const QString& hostPort, const QString& token) {
     std::string error;
     return parseEndpoint(hostPort.toStdString(), token.toStdString(), error) ? QString() : qs(error);
   });

@@ -49,6 +49,7 @@ class LinkJob : public ConsoleJob {
   QAction* release_ = nullptr;
   QAction* rearm_ = nullptr;
   QAction* reset_ = nullptr;
+  int ticks_ = 0;  // panel ticks seen
 };
 
 }  // namespace sp

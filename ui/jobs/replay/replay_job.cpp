@@ -9,7 +9,6 @@
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QKeySequence>
-#include <QMainWindow>
 #include <QMenu>
 #include <QSettings>
 #include <QTimer>
@@ -67,16 +66,16 @@ void ReplayJob::install(ConsoleContext& context) {
     if (panel_->isOpen()) dock_->raise();
   });
 
-  QAction* open = new QAction(tr("Open session &log…"), context.window());
+  QAction* open = new QAction(tr("Open session &log…"), context.dialogParent());
   open->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_L));
   connect(open, &QAction::triggered, this, [this] {
-    const QString path = QFileDialog::getOpenFileName(context_->window(), tr("Open session log"), logDir_,
+    const QString path = QFileDialog::getOpenFileName(context_->dialogParent(), tr("Open session log"), logDir_,
                                                       tr("Session logs (*.splog);;All files (*)"));
     if (!path.isEmpty()) openLogInBackground(path);
   });
   // The last logs replayed, newest first (settings "replay/recent"); a
   // file gone since is left out when the menu opens.
-  auto* recent = new QMenu(tr("&Recent session logs"), context.window());
+  auto* recent = new QMenu(tr("&Recent session logs"), context.dialogParent());
   connect(recent, &QMenu::aboutToShow, this, [this, recent] {
     recent->clear();
     for (const QString& path : recentLogs())
@@ -84,9 +83,9 @@ void ReplayJob::install(ConsoleContext& context) {
     if (recent->isEmpty()) recent->addAction(tr("(none yet)"))->setEnabled(false);
   });
   recent->setToolTipsVisible(true);
-  QAction* logs = new QAction(tr("Session &logs…"), context.window());
+  QAction* logs = new QAction(tr("Session &logs…"), context.dialogParent());
   connect(logs, &QAction::triggered, this, &ReplayJob::showSessionLogs);
-  QAction* close = new QAction(tr("Close replay"), context.window());
+  QAction* close = new QAction(tr("Close replay"), context.dialogParent());
   connect(close, &QAction::triggered, panel_, &ReplayPanel::close);
   for (QAction* a : {open, recent->menuAction(), logs, close}) context.host().addMenuAction(tr("&File"), a);
 }
@@ -105,9 +104,9 @@ void ReplayJob::opened() {
   // (After the window has laid out its docks: a log opened at start-up
   // would be laid out again.)
   QTimer::singleShot(0, dock_, [this] {
-    QMainWindow* window = context_->window();
-    const int wanted = std::max(panel_->minimumSizeHint().height() + 40, window->height() * 2 / 5);
-    window->resizeDocks({dock_}, {wanted}, Qt::Vertical);
+    // At least two fifths of the window, more if the panel needs it.
+    context_->host().growDock(
+        dock_, std::max(panel_->minimumSizeHint().height() + 40, context_->dialogParent()->height() * 2 / 5), 1.0);
   });
   context_->status(tr("Replaying %1: the live robot goes on unseen; close the replay to see it again")
                        .arg(QFileInfo(path).fileName()),
@@ -138,7 +137,7 @@ void ReplayJob::openLogInBackground(const QString& path) {
 }
 
 void ReplayJob::showSessionLogs() {
-  SessionLogsDialog dialog(logDir_, QString::fromStdString(context_->session().logPath()), context_->window());
+  SessionLogsDialog dialog(logDir_, QString::fromStdString(context_->session().logPath()), context_->dialogParent());
   connect(&dialog, &SessionLogsDialog::replayRequested, this, &ReplayJob::openLogInBackground);
   dialog.exec();
 }

@@ -10,7 +10,6 @@
 
 #include <QDockWidget>
 #include <QFile>
-#include <QMainWindow>
 #include <QTimer>
 
 #include "app/console/console_session.h"
@@ -114,11 +113,9 @@ void SequenceJob::install(ConsoleContext& context) {
 
 void SequenceJob::fitDock() {
   if (!dock_->isVisible() || dock_->isFloating()) return;
-  QMainWindow* window = context_->window();
   // The panel's least height, its dock's title and the scroll area's frame.
-  const int wanted = std::min(panel_->minimumSizeHint().height() + dock_->height() - dock_->widget()->height() + 4,
-                              window->height() * 7 / 10);
-  if (dock_->height() < wanted) window->resizeDocks({dock_}, {wanted}, Qt::Vertical);
+  context_->host().growDock(dock_, panel_->minimumSizeHint().height() + dock_->height() - dock_->widget()->height() + 4,
+                            0.7);
 }
 
 QString SequenceJob::start() {
