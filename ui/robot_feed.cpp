@@ -4,7 +4,6 @@
 
 #include "app/console/console_session.h"
 #include "app/state/robot_shapes.h"
-#include "ui/jobs/replay/replay_panel.h"
 #include "ui/robot_connection.h"
 
 namespace sp {
@@ -69,30 +68,6 @@ const WorldModel* LiveLinkFeed::shownWorld() const { return session_->world(); }
 
 void LiveLinkFeed::announceWorld() {
   if (const WorldModel* w = session_->world()) emit worldChanged(*w);
-}
-
-ReplayFeed::ReplayFeed(ReplayPanel* panel, QObject* parent) : RobotFeed(parent), panel_(panel) {
-  connect(panel, &ReplayPanel::frame, this, &RobotFeed::frame);
-  connect(panel, &ReplayPanel::laser, this, &RobotFeed::laser);
-  connect(panel, &ReplayPanel::terrain, this, &RobotFeed::terrain);
-  connect(panel, &ReplayPanel::opened, this, &RobotFeed::worldChanged);
-}
-
-const WorldModel* ReplayFeed::shownWorld() const {
-  const LogPlayer* player = panel_->player();
-  return player ? &player->world() : nullptr;
-}
-
-void ReplayFeed::seek(double time) { panel_->seek(time); }
-
-QString ReplayFeed::label() const {
-  const LogPlayer* player = panel_->player();
-  return player ? QFileInfo(QString::fromStdString(player->path())).fileName() : sourceName();
-}
-
-QString ReplayFeed::logPath() const {
-  const LogPlayer* player = panel_->player();
-  return player ? QString::fromStdString(player->path()) : QString();
 }
 
 GhostFeed::GhostFeed(ConsoleSession* session, QObject* parent) : RobotFeed(parent), session_(session) {}

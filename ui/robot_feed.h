@@ -102,26 +102,6 @@ class LiveLinkFeed : public RobotFeed {
   int64_t telemetryCount_ = 0, laserCount_ = 0;
 };
 
-/// A session log at the replay cursor (ui/jobs/replay/replay_panel.h) as a
-/// feed: seeking moves the cursor, and the frames follow.
-class ReplayFeed : public RobotFeed {
-  Q_OBJECT
-
- public:
-  /// `panel` must outlive the feed.
-  explicit ReplayFeed(ReplayPanel* panel, QObject* parent = nullptr);
-  QString sourceName() const override { return tr("replay"); }
-  /// The log's file name ("replay" before one is open).
-  QString label() const override;
-  QString logPath() const override;
-  const WorldModel* shownWorld() const override;
-  /// Moves the replay's cursor to `time` [s]; the frame there follows.
-  void seek(double time);
-
- private:
-  ReplayPanel* panel_;
-};
-
 /// The predictive ghost (app/ghost/ghost.h) as a feed: poll() emits its
 /// newest predicted frame and trail when they changed (the ghost runs on
 /// threads of its own; the 3D view polls it once per drawn frame).

@@ -14,6 +14,7 @@
 #include <QTimer>
 
 #include "app/console/console_session.h"
+#include "ui/jobs/replay/replay_feed.h"
 #include "ui/jobs/replay/replay_panel.h"
 #include "ui/jobs/replay/session_logs_dialog.h"
 #include "ui/robot_feed.h"
@@ -34,7 +35,7 @@ void ReplayJob::install(ConsoleContext& context) {
   logDir_ = QString::fromStdString(context.session().logDir());
   panel_ = new ReplayPanel;
   panel_->setBackground(&context.background());
-  feed_ = new ReplayFeed(panel_, this);
+  feed_ = panel_->feed();
   dock_ = context.host().addDock(tr("Replay"), QStringLiteral("replayDock"), panel_, DockPlace::Bottom, true);
   dock_->hide();  // until a log is opened
 

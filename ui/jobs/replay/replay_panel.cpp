@@ -86,7 +86,7 @@ class JumpToClick : public QProxyStyle {
   }
 };
 
-ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
+ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent), feed_(new ReplayFeed(this)) {
   setBackground(new BackgroundJobs(this));  // until given the console's
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(4, 4, 4, 4);
@@ -99,6 +99,9 @@ ReplayPanel::ReplayPanel(QWidget* parent) : QWidget(parent) {
   connect(timer_, &QTimer::timeout, this, &ReplayPanel::tick);
   connect(slider_, &QSlider::valueChanged, this, [this](int ms) { show(ms / 1000.0); });
   connect(events_, &QListWidget::itemClicked, this, [this](QListWidgetItem* item) { seekToEvent(events_->row(item)); });
+  // The timeline, the time and the plot's cursor follow the feed's cursor,
+  // whoever moved it.
+  connect(feed_, &ReplayFeed::moved, this, &ReplayPanel::showCursor);
   setEnabled(false);  // until a log is open (or opening: Cancel)
 }
 
@@ -266,46 +269,44 @@ void ReplayPanel::openInBackground(const QString& path) {
                   });
 }
 
-void ReplayPanel::adopt(std::unique_ptr<LogPlayer> player, const QString& path,
+void ReplayPanel::adopt(std::unique_ptr<LogPlayer> log, const QString& path,
                         std::optional<std::vector<std::pair<double, double>>> firstPlot) {
   pause();
-  player_ = std::move(player);
+  feed_->adopt(std::move(log));
   lastResult_.clear();
   setEnabled(true);
   title_->setText(tr("%1: %2 s, %3 events%4")
                       .arg(QFileInfo(path).fileName())
-                      .arg(player_->endTime() - player_->startTime(), 0, 'f', 1)
-                      .arg(player_->events().size())
-                      .arg(player_->hasSnapshots() ? QString() : tr(" (telemetry only)")));
+                      .arg(player()->endTime() - player()->startTime(), 0, 'f', 1)
+                      .arg(player()->events().size())
+                      .arg(player()->hasSnapshots() ? QString() : tr(" (telemetry only)")));
   events_->clear();
-  for (const LogEvent& e : player_->events())
+  for (const LogEvent& e : player()->events())
     events_->addItem(QStringLiteral("%1 s  %2: %3")
                          .arg(e.time, 0, 'f', 2)
                          .arg(QString::fromStdString(e.kind), QString::fromStdString(e.text)));
   {
     const QSignalBlocker block(slider_);
-    slider_->setRange(static_cast<int>(std::floor(player_->startTime() * 1000)),
-                      static_cast<int>(std::ceil(player_->endTime() * 1000)));
+    slider_->setRange(static_cast<int>(std::floor(player()->startTime() * 1000)),
+                      static_cast<int>(std::ceil(player()->endTime() * 1000)));
   }
-  emit opened(player_->world());
+  emit opened(player()->world());
   {
     const QSignalBlocker block(signalBox_);
     signalBox_->clear();
-    for (const std::string& name : player_->signalNames()) signalBox_->addItem(QString::fromStdString(name));
+    for (const std::string& name : player()->signalNames()) signalBox_->addItem(QString::fromStdString(name));
     signalBox_->setCurrentIndex(kFirstSignal);
   }
-  cursor_ = player_->startTime();
-  terrainShown_ = 0;  // opened() drew the terrain as loaded
   if (firstPlot) {
     {
       const QSignalBlocker block(chart_->chart()->axes(Qt::Horizontal).front());  // no re-read: the points are here
-      setVisibleRange(player_->startTime(), player_->endTime());
+      setVisibleRange(player()->startTime(), player()->endTime());
     }
     plot(*firstPlot);
   } else {
     setSignal(signalBox_->currentIndex());
   }
-  show(cursor_);
+  show(cursor());
   marks_->update();
 }
 
@@ -327,7 +328,7 @@ void ReplayPanel::finishBackground() {
   job_ = 0;
   progressRow_->hide();
   progressLabel_->clear();
-  setEnabled(player_ != nullptr);
+  setEnabled(player() != nullptr);
 }
 
 void ReplayPanel::cancel() {
@@ -337,14 +338,14 @@ void ReplayPanel::cancel() {
 QString ReplayPanel::progressText() const { return job_ ? progressLabel_->text() : QString(); }
 
 void ReplayPanel::branchHere() {
-  if (!player_) return;
+  if (!player()) return;
   pause();
-  const QString path = QString::fromStdString(player_->path());
-  const double at = cursor_;
-  if (!player_->hasSnapshots()) {
+  const QString path = QString::fromStdString(player()->path());
+  const double at = cursor();
+  if (!player()->hasSnapshots()) {
     // Reconstructed from one sample: no re-simulation, nothing to wait for.
     std::string error;
-    std::optional<BranchPoint> b = player_->branchAt(at, error);
+    std::optional<BranchPoint> b = player()->branchAt(at, error);
     if (!b) emit failed(QString::fromStdString(error));
     else emit branchReady(path, std::make_shared<const BranchPoint>(std::move(*b)));
     return;
@@ -360,28 +361,28 @@ void ReplayPanel::branchHere() {
 }
 
 bool ReplayPanel::rehearseHere() {
-  if (!player_) return false;
+  if (!player()) return false;
   pause();
-  const std::optional<RehearsalStart> start = player_->startAt(cursor_);
+  const std::optional<RehearsalStart> start = player()->startAt(cursor());
   if (!start) {
-    emit failed(tr("No sample at t = %1 s to rehearse from").arg(cursor_, 0, 'f', 3));
+    emit failed(tr("No sample at t = %1 s to rehearse from").arg(cursor(), 0, 'f', 3));
     return false;
   }
-  emit rehearsalStart(*start, player_->world(), player_->params(),
-                      tr("%1 at t = %2 s").arg(QFileInfo(QString::fromStdString(player_->path())).fileName())
-                          .arg(cursor_, 0, 'f', 2));
+  emit rehearsalStart(*start, player()->world(), player()->params(),
+                      tr("%1 at t = %2 s").arg(QFileInfo(QString::fromStdString(player()->path())).fileName())
+                          .arg(cursor(), 0, 'f', 2));
   return true;
 }
 
 void ReplayPanel::verify() {
-  if (!player_) return;
-  if (!player_->hasSnapshots()) {
+  if (!player()) return;
+  if (!player()->hasSnapshots()) {
     lastResult_ = tr("A telemetry-only log holds no snapshots or hashes: there is nothing to re-simulate.");
     readout_->setText(lastResult_);
     emit verified(false, lastResult_);
     return;
   }
-  const QString path = QString::fromStdString(player_->path());
+  const QString path = QString::fromStdString(player()->path());
   runInBackground(tr("Verifying %1 (re-simulating it)").arg(QFileInfo(path).fileName()),
                   [this, path](const std::function<bool(double)>& progress) -> std::function<void()> {
                     std::string error;
@@ -413,7 +414,7 @@ void ReplayPanel::verify() {
 
 void ReplayPanel::close() {
   pause();
-  player_.reset();
+  feed_->adopt(nullptr);
   events_->clear();
   series_->clear();
   cursorLine_->clear();
@@ -430,8 +431,8 @@ void ReplayPanel::close() {
 void ReplayPanel::seek(double time) { show(time); }
 
 void ReplayPanel::play() {
-  if (!player_) return;
-  if (cursor_ >= player_->endTime()) show(player_->startTime());  // from the start again
+  if (!player()) return;
+  if (cursor() >= player()->endTime()) show(player()->startTime());  // from the start again
   playing_ = true;
   playButton_->setIcon(actionIcon(QStringLiteral("pause")));
   playButton_->setToolTip(tr("Pause"));
@@ -457,22 +458,22 @@ void ReplayPanel::setSpeed(double factor) {
 
 void ReplayPanel::step(int direction) {
   pause();
-  show(cursor_ + direction * kStep);
+  show(cursor() + direction * kStep);
 }
 
 void ReplayPanel::seekToEvent(int index) {
-  if (!player_ || index < 0 || index >= static_cast<int>(player_->events().size())) return;
+  if (!player() || index < 0 || index >= static_cast<int>(player()->events().size())) return;
   pause();
-  show(player_->events()[static_cast<size_t>(index)].time);
+  show(player()->events()[static_cast<size_t>(index)].time);
 }
 
 void ReplayPanel::setSignal(int index) {
-  if (!player_ || index < 0 || index >= signalBox_->count()) return;
+  if (!player() || index < 0 || index >= signalBox_->count()) return;
   if (signalBox_->currentIndex() != index) {
     const QSignalBlocker block(signalBox_);
     signalBox_->setCurrentIndex(index);
   }
-  setVisibleRange(player_->startTime(), player_->endTime());
+  setVisibleRange(player()->startTime(), player()->endTime());
   replot();
 }
 
@@ -485,9 +486,9 @@ void ReplayPanel::setVisibleRange(double t0, double t1) {
 
 void ReplayPanel::replot() {
   replotTimer_->stop();
-  if (!player_) return;
+  if (!player()) return;
   auto* x = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Horizontal).front());
-  plot(player_->signal(signalBox_->currentIndex(), x->min(), x->max(), kPlotPoints));
+  plot(player()->signal(signalBox_->currentIndex(), x->min(), x->max(), kPlotPoints));
 }
 
 void ReplayPanel::plot(const std::vector<std::pair<double, double>>& points) {
@@ -509,7 +510,7 @@ void ReplayPanel::plot(const std::vector<std::pair<double, double>>& points) {
 
 void ReplayPanel::moveCursorLine() {
   auto* y = static_cast<QValueAxis*>(chart_->chart()->axes(Qt::Vertical).front());
-  cursorLine_->replace(QList<QPointF>{{cursor_, y->min()}, {cursor_, y->max()}});
+  cursorLine_->replace(QList<QPointF>{{cursor(), y->min()}, {cursor(), y->max()}});
   readout_->setText(readout());
 }
 
@@ -519,9 +520,9 @@ QString ReplayPanel::readout() const {
   const QList<QPointF> p = series_->points();
   if (p.isEmpty()) return {};
   // The plotted point at or before the cursor.
-  auto it = std::upper_bound(p.begin(), p.end(), cursor_, [](double t, const QPointF& q) { return t < q.x(); });
+  auto it = std::upper_bound(p.begin(), p.end(), cursor(), [](double t, const QPointF& q) { return t < q.x(); });
   const QPointF at = it == p.begin() ? p.front() : *(it - 1);
-  return tr("t = %1 s: %2 = %3").arg(cursor_, 0, 'f', 3).arg(signalBox_->currentText()).arg(at.y(), 0, 'g', 6);
+  return tr("t = %1 s: %2 = %3").arg(cursor(), 0, 'f', 3).arg(signalBox_->currentText()).arg(at.y(), 0, 'g', 6);
 }
 
 QString ReplayPanel::exportCsv(const QString& path) const {
@@ -547,25 +548,19 @@ void ReplayPanel::tick() {
   // holds when ticks come late.
   const double dt = static_cast<double>(wall_.nsecsElapsed()) * 1e-9;
   wall_.start();
-  show(cursor_ + dt * speed_);
-  if (cursor_ >= player_->endTime()) pause();
+  show(cursor() + dt * speed_);
+  if (cursor() >= player()->endTime()) pause();
 }
 
-void ReplayPanel::show(double time) {
-  if (!player_) return;
-  cursor_ = std::clamp(time, player_->startTime(), player_->endTime());
+void ReplayPanel::show(double time) { feed_->seek(time); }
+
+void ReplayPanel::showCursor(double at) {
   {
     const QSignalBlocker block(slider_);
-    slider_->setValue(static_cast<int>(std::lround(cursor_ * 1000)));
+    slider_->setValue(static_cast<int>(std::lround(at * 1000)));
   }
-  timeLabel_->setText(tr("%1 / %2 s").arg(cursor_, 0, 'f', 2).arg(player_->endTime(), 0, 'f', 1));
+  timeLabel_->setText(tr("%1 / %2 s").arg(at, 0, 'f', 2).arg(player()->endTime(), 0, 'f', 1));
   moveCursorLine();
-  if (std::optional<RobotFrame> f = player_->frameAt(cursor_)) emit frame(*f);
-  if (std::optional<LaserFrame> l = player_->laserAt(cursor_)) emit laser(*l);
-  if (const size_t edits = player_->terrainEditsAt(cursor_); edits != terrainShown_) {
-    terrainShown_ = edits;
-    emit terrain(player_->terrainAfter(edits));
-  }
 }
 
 }  // namespace sp

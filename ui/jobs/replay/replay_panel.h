@@ -25,6 +25,7 @@
 #include <memory>
 
 #include "app/log/log_player.h"
+#include "ui/jobs/replay/replay_feed.h"
 
 class QComboBox;
 class QLabel;
@@ -74,11 +75,13 @@ class ReplayPanel : public QWidget {
   QString progressText() const;
   QString lastResult() const { return lastResult_; }
   void close();
-  bool isOpen() const { return player_ != nullptr; }
-  const LogPlayer* player() const { return player_.get(); }
+  bool isOpen() const { return player() != nullptr; }
+  const LogPlayer* player() const { return feed_->player(); }
+  /// The log as a feed: it owns the player and the cursor (replay_feed.h).
+  ReplayFeed* feed() const { return feed_; }
 
   /// The cursor [s, log time] and moving it (clamped to the log).
-  double cursor() const { return cursor_; }
+  double cursor() const { return feed_->cursor(); }
   void seek(double time);
   void play();
   void pause();
@@ -119,12 +122,6 @@ class ReplayPanel : public QWidget {
   /// Verify ended: passed = every logged hash reproduced.
   void verified(bool passed, const QString& verdict);
   void closed();
-  /// The robot at the cursor, for the views.
-  void frame(const sp::RobotFrame& frame);
-  void laser(const sp::LaserFrame& scan);
-  /// The ground at the cursor changed (terrain edits made in the session):
-  /// the logged heightfield with the edits up to the cursor.
-  void terrain(const sp::HeightGrid& grid);
 
  private:
   // The constructor's parts: the transport row, the progress row and the
@@ -132,10 +129,13 @@ class ReplayPanel : public QWidget {
   void buildControls(QVBoxLayout* layout);
   void buildPlot(QVBoxLayout* layout);
   void tick();
+  /// Seeks the feed (the frame there follows, then showCursor).
   void show(double time);
+  /// The cursor moved to `at`: the slider, the time and the plot's cursor.
+  void showCursor(double at);
   /// Shows a player opened (on the worker or here); `firstPlot`: the
   /// default signal over the whole log, read already (else read here).
-  void adopt(std::unique_ptr<LogPlayer> player, const QString& path,
+  void adopt(std::unique_ptr<LogPlayer> log, const QString& path,
              std::optional<std::vector<std::pair<double, double>>> firstPlot);
   void plot(const std::vector<std::pair<double, double>>& points);
   static constexpr int kFirstSignal = 6;  // wheel FL normal force
@@ -148,14 +148,12 @@ class ReplayPanel : public QWidget {
 
   BackgroundJobs* jobs_ = nullptr;  // the console's runner, or the panel's own
   int job_ = 0;                     // the task running, 0 = none
-  size_t terrainShown_ = 0;  // terrain edits drawn (those up to the cursor)
   QString lastResult_;
   QWidget* progressRow_ = nullptr;
   QLabel* progressLabel_ = nullptr;
   QProgressBar* progressBar_ = nullptr;
 
-  std::unique_ptr<LogPlayer> player_;
-  double cursor_ = 0;
+  ReplayFeed* feed_ = nullptr;  // the log shown: its player and cursor (a child)
   double speed_ = 1;
   bool playing_ = false;
   QElapsedTimer wall_;  // since the last tick while playing
