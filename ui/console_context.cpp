@@ -4,9 +4,51 @@
 #include <QPushButton>
 
 #include "app/console/console_session.h"
+#include "app/console/terrain_editor.h"
+#include "ui/scene_view.h"
 #include "ui/robot_connection.h"
 
 namespace sp {
+
+namespace {
+
+constexpr size_t kPartHeights = 2000;  // a terrain patch's heights per COMMAND: fits a 64 KiB frame
+
+}  // namespace
+
+ConsoleContext::ConsoleContext(Parts parts, QObject* parent) : QObject(parent), parts_(std::move(parts)) {
+  connect(parts_.connection, &RobotConnection::sequenceState, this, &ConsoleContext::sequenceState);
+  connect(parts_.connection, &RobotConnection::guardTripped, this, &ConsoleContext::guardTripped);
+}
+
+bool ConsoleContext::editTerrain(const TerrainPatchCmd& patch) {
+  if (state().replaying()) return false;  // the view shows the log's world
+  if (!session().terrainEdited(patch)) return false;
+  scene().applyTerrainPatch(patch);
+  emit terrainEdited(patch);
+  if (robotTakesTerrainEdits() && state().leaseHeld())
+    for (const TerrainPatchCmd& part : splitPatch(patch, kPartHeights)) connection().send(part, session().robot());
+  return true;
+}
+
+bool ConsoleContext::robotTakesTerrainEdits() const {
+  if (!state().connected()) return false;
+  const std::string caps = " " + connection().stats().robotCapabilities + " ";
+  return caps.find(" terrain_edit ") != std::string::npos;
+}
+
+QString ConsoleContext::sendSequence(const net::SequenceMsg& message) {
+  const std::string why = state().replaying() ? state().controlsRefusal() : session().commandRefusal(state().leaseHeld());
+  if (!why.empty()) return QString::fromStdString(why);
+  connection().sendSequence(message);
+  return {};
+}
+
+void ConsoleContext::abortSequence(const QString& hash, const QString& reason) {
+  connection().abortSequence(hash, reason);
+}
+
+const std::shared_ptr<SequenceGuard>& ConsoleContext::guard() const { return connection().guard(); }
 
 QString ConsoleContext::sendCommand(const Command& command) {
   // A replay shown is not the robot the operator means: nothing goes out.

@@ -5,7 +5,8 @@
 // reaches into the window (gz-sim's GUI plugins, PlotJuggler's plugins):
 //
 //   feeds()       which robot the views show (live link, replay) and the ghost
-//   sendCommand() the command sink: the lease and the shown feed are checked
+//   sendCommand(), editTerrain(), sendSequence(): the sinks; the lease and
+//                the shown feed are checked inside
 //   state()       what the console knows of the link (app/console/console_state.h)
 //   scene(), the plots: the views, to draw into
 //   status(), event(), logEvent(): the status bar, the event list, the log
@@ -28,6 +29,8 @@ QT_FORWARD_DECLARE_CLASS(QCommandLineParser)
 
 #include "app/console/console_state.h"
 #include "app/rehearse/rehearsal.h"
+#include "app/rehearse/sequence_guard.h"
+#include "net/message.h"
 #include "sim/command.h"
 #include "sim/params.h"
 #include "sim/robot_model.h"
@@ -107,7 +110,7 @@ class ConsoleContext : public QObject {
     /// The status bar: the window's own.
     std::function<void(const QString&, int)> status;
   };
-  explicit ConsoleContext(Parts parts, QObject* parent = nullptr) : QObject(parent), parts_(std::move(parts)) {}
+  ConsoleContext(Parts parts, QObject* parent = nullptr);
 
   ConsoleSession& session() const { return *parts_.session; }
   RobotConnection& connection() const { return *parts_.connection; }
@@ -131,6 +134,21 @@ class ConsoleContext : public QObject {
   /// lease, a replay shown, ...) and says why in the status bar. Returns
   /// "" when sent, else the reason.
   QString sendCommand(const Command& command);
+  /// The terrain sink: `patch` (made by the session's terrain editor, in
+  /// its heights already) goes to the view and the jobs (terrainEdited) and,
+  /// while the console holds the lease of a robot that takes edits (a
+  /// simulator), to the robot's twin in frame-sized parts. False while a
+  /// replay is shown or when the patch does not fit the terrain.
+  bool editTerrain(const TerrainPatchCmd& patch);
+  /// The robot announced it takes terrain edits (WELCOME capability terrain_edit).
+  bool robotTakesTerrainEdits() const;
+  /// The sequence sink: SEQUENCE to the live robot while the console holds
+  /// the lease and shows the live robot; "" when sent, else why not.
+  QString sendSequence(const net::SequenceMsg& message);
+  /// ABORT of the sequence `hash` on the live robot.
+  void abortSequence(const QString& hash, const QString& reason);
+  /// The guard of relayed sequences, fed on the link's worker.
+  const std::shared_ptr<SequenceGuard>& guard() const;
   /// A message in the status bar for `ms` milliseconds (0 = until replaced).
   void status(const QString& text, int ms = 5000) const { parts_.status(text, ms); }
   /// An event of the console's own (`kind`: "note", "estop", "link", ...):
@@ -174,6 +192,10 @@ class ConsoleContext : public QObject {
   /// The operator asked to put the robot back at its start (the banner's
   /// button): the link job resets the stand-in.
   void resetRequested();
+  /// The robot's SEQUENCE_STATE (after the guard took it).
+  void sequenceState(const sp::net::SequenceStateMsg& state);
+  /// The guard tripped; its ABORT has gone out already.
+  void guardTripped(const QString& hash, const sp::GuardDeparture& departure);
   /// Rehearse from a logged moment (the Replay job asks, the Sequence job does).
   void rehearseFrom(const sp::RehearsalStart& start, const sp::WorldModel& world, const sp::SimParams& params,
                     const QString& label);

@@ -15,7 +15,6 @@
 #include "app/console/console_session.h"
 #include "sim/diagnostics.h"
 #include "ui/jobs/sequence/sequence_panel.h"
-#include "ui/robot_connection.h"
 #include "ui/robot_feed.h"
 #include "ui/scene_view.h"
 
@@ -58,12 +57,18 @@ void SequenceJob::install(ConsoleContext& context) {
     return start;
   });
 
-  RobotConnection& link = context.connection();
-  connect(panel_, &SequencePanel::sendRequested, &link, &RobotConnection::sendSequence);
-  connect(panel_, &SequencePanel::abortRequested, &link, &RobotConnection::abortSequence);
-  connect(&link, &RobotConnection::sequenceState, panel_, &SequencePanel::onSequenceState);
-  panel_->setGuard(link.guard());
-  connect(&link, &RobotConnection::guardTripped, panel_, &SequencePanel::onGuardTripped);
+  connect(panel_, &SequencePanel::sendRequested, this, [this](const net::SequenceMsg& m) {
+    // Refused here (a replay shown, the lease lost meanwhile): the guard
+    // the panel armed for it watches nothing.
+    if (const QString why = context_->sendSequence(m); !why.isEmpty()) {
+      context_->guard()->reset();
+      context_->status(tr("Sequence not sent: %1").arg(why), 5000);
+    }
+  });
+  connect(panel_, &SequencePanel::abortRequested, &context, &ConsoleContext::abortSequence);
+  connect(&context, &ConsoleContext::sequenceState, panel_, &SequencePanel::onSequenceState);
+  panel_->setGuard(context.guard());
+  connect(&context, &ConsoleContext::guardTripped, panel_, &SequencePanel::onGuardTripped);
 
   SceneView& scene = context.scene();
   connect(panel_, &SequencePanel::scrubbed, &scene, [&scene](const Pose& base, const std::vector<double>& joints) {

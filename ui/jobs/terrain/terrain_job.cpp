@@ -4,7 +4,6 @@
 #include "sim/terrain_brush.h"
 #include "app/console/terrain_editor.h"
 #include "ui/jobs/terrain/terrain_panel.h"
-#include "ui/robot_connection.h"
 #include "ui/scene_view.h"
 
 namespace sp {
@@ -47,26 +46,11 @@ void TerrainJob::install(ConsoleContext& context) {
 }
 
 void TerrainJob::apply(const TerrainPatchCmd& patch) {
-  if (context_->state().replaying()) return;  // the view shows the log's world
-  if (!context_->session().terrainEdited(patch)) return;  // the editor put it in the console's terrain
-  context_->scene().applyTerrainPatch(patch);
-  emit context_->terrainEdited(patch);
-  // The robot's twin, when it is a simulator that takes edits (WELCOME
-  // capability terrain_edit), in frame-sized parts; it logs them.
-  if (robotTakesEdits() && context_->state().leaseHeld())
-    for (const TerrainPatchCmd& part : splitPatch(patch, kPartHeights))
-      context_->connection().send(part, context_->session().robot());
-  ++edits_;
-}
-
-bool TerrainJob::robotTakesEdits() const {
-  if (!context_->state().connected()) return false;
-  const std::string caps = " " + context_->connection().stats().robotCapabilities + " ";
-  return caps.find(" terrain_edit ") != std::string::npos;
+  if (context_->editTerrain(patch)) ++edits_;
 }
 
 void TerrainJob::updateReach() {
-  if (robotTakesEdits())
+  if (context_->robotTakesTerrainEdits())
     panel_->setReach(context_->state().leaseHeld()
                          ? tr("Edits reach the robot's twin (a simulator) and the console's.")
                          : tr("Take control to edit the robot's twin too; now only the console's twin."));

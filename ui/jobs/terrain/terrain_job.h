@@ -32,13 +32,11 @@ class TerrainJob : public ConsoleJob {
 
  private:
   void apply(const TerrainPatchCmd& patch);
-  bool robotTakesEdits() const;
   void updateReach();
 
   ConsoleContext* context_ = nullptr;
   TerrainPanel* panel_ = nullptr;
   int64_t edits_ = 0;
-  static constexpr size_t kPartHeights = 2000;  // per COMMAND: fits a 64 KiB frame
 };
 
 }  // namespace sp
