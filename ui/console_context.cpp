@@ -21,9 +21,17 @@ ConsoleContext::ConsoleContext(Parts parts, QObject* parent) : QObject(parent), 
   connect(parts_.connection, &RobotConnection::guardTripped, this, &ConsoleContext::guardTripped);
 }
 
+LiveCalibrator* ConsoleContext::calibrator() const { return parts_.session->calibrator(); }
+TerrainEditor* ConsoleContext::terrainEditor() const { return parts_.session->terrainEditor(); }
+std::string ConsoleContext::useStandIn() { return parts_.session->useStandIn(); }
+std::string ConsoleContext::connectTo(const std::string& hostPort, const std::string& token) {
+  return parts_.session->connectTo(hostPort, token);
+}
+std::string ConsoleContext::resetRobot() { return parts_.session->resetRobot(); }
+
 bool ConsoleContext::editTerrain(const TerrainPatchCmd& patch) {
   if (state().replaying()) return false;  // the view shows the log's world
-  if (!session().terrainEdited(patch)) return false;
+  if (!parts_.session->terrainEdited(patch)) return false;
   scene().applyTerrainPatch(patch);
   emit terrainEdited(patch);
   if (robotTakesTerrainEdits() && state().leaseHeld())
@@ -59,12 +67,12 @@ QString ConsoleContext::sendCommand(const Command& command) {
     return text;
   }
   connection().send(command, session().robot());
-  session().commandSent(command);
+  parts_.session->commandSent(command);
   return {};
 }
 
 void ConsoleContext::event(const QString& kind, const QString& text, bool log) {
-  if (log) session().event(kind.toStdString(), text.toStdString());
+  if (log) parts_.session->event(kind.toStdString(), text.toStdString());
   emit eventShown(text);
 }
 
@@ -79,7 +87,7 @@ void ConsoleContext::emergencyStop() {
 }
 
 void ConsoleContext::logEvent(const QString& kind, const QString& text) const {
-  session().logEvent(kind.toStdString(), text.toStdString());
+  parts_.session->logEvent(kind.toStdString(), text.toStdString());
 }
 
 bool ConsoleContext::confirm(QMessageBox::Icon icon, const QString& title, const QString& text,

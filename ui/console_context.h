@@ -46,6 +46,8 @@ namespace sp {
 class BackgroundJobs;
 struct BranchPoint;
 class ConsoleSession;
+class LiveCalibrator;
+class TerrainEditor;
 class FeedSwitch;
 class GhostFeed;
 class LaserPlot;
@@ -112,7 +114,21 @@ class ConsoleContext : public QObject {
   };
   ConsoleContext(Parts parts, QObject* parent = nullptr);
 
-  ConsoleSession& session() const { return *parts_.session; }
+  /// What the session knows (robot, world, endpoint, logs, parameters):
+  /// read-only; what a job may change of it is below.
+  const ConsoleSession& session() const { return *parts_.session; }
+  /// The calibration from telemetry (the calibration job freezes and
+  /// resets it); null without one.
+  LiveCalibrator* calibrator() const;
+  /// The console's terrain editor (the terrain job's brushes and undo);
+  /// null on a plane.
+  TerrainEditor* terrainEditor() const;
+  /// The session's robot switched (the link job): the stand-in again, a
+  /// robot at HOST:PORT, or the stand-in reset to its start. "" or why not
+  /// (nothing changed then).
+  std::string useStandIn();
+  std::string connectTo(const std::string& hostPort, const std::string& token);
+  std::string resetRobot();
   RobotConnection& connection() const { return *parts_.connection; }
   FeedSwitch& feeds() const { return *parts_.feeds; }
   GhostFeed& ghost() const { return *parts_.ghost; }

@@ -49,7 +49,7 @@ class TestCalibrationDock : public QObject {
     int said = 0;
     connect(&w.context(), &ConsoleContext::eventShown, this,
             [&](const QString& text) { said += text.startsWith(QLatin1String("Calibration")); });
-    LiveCalibrator* calibrator = w.context().session().calibrator();
+    LiveCalibrator* calibrator = w.context().calibrator();
     QVERIFY(calibrator);
     QTRY_VERIFY_WITH_TIMEOUT(calibrator->state().refusals >= 3, 30000);
     QTest::qWait(300);  // a panel tick
@@ -108,7 +108,7 @@ class TestCalibrationDock : public QObject {
     dock->raise();
     QTRY_VERIFY_WITH_TIMEOUT(w.consoleState().leaseHeld(), 10000);
     test::controlPanel(w)->setDrive(0.5, 0);
-    LiveCalibrator* calibrator = w.context().session().calibrator();
+    LiveCalibrator* calibrator = w.context().calibrator();
     QVERIFY(calibrator);
 
     // Fits land while driving, and the dock shows them.

@@ -18,13 +18,13 @@ void CalibrationJob::install(ConsoleContext& context) {
   panel_ = new CalibrationPanel;
   context.host().addDock(tr("Calibration"), QStringLiteral("calibrationDock"), panel_, DockPlace::Side, true);
   connect(panel_, &CalibrationPanel::freezeToggled, this, [this](bool frozen) {
-    if (LiveCalibrator* c = context_->session().calibrator()) {
+    if (LiveCalibrator* c = context_->calibrator()) {
       c->freeze(frozen);
       context_->logEvent(QStringLiteral("calibration"), frozen ? tr("frozen") : tr("unfrozen"));
     }
   });
   connect(panel_, &CalibrationPanel::resetRequested, this, [this] {
-    if (LiveCalibrator* c = context_->session().calibrator()) {
+    if (LiveCalibrator* c = context_->calibrator()) {
       c->reset();
       context_->event(QStringLiteral("calibration"), tr("Calibration reset to the files' values"));
     }

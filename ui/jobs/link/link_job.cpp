@@ -116,23 +116,22 @@ void LinkJob::openConnectDialog() {
   });
   if (dialog.exec() != QDialog::Accepted) return;
   context_->connection().close();
-  ConsoleSession& session = context_->session();
-  const std::string error = dialog.standIn() ? session.useStandIn()
-                                             : session.connectTo(dialog.hostPort().toStdString(), dialog.token().toStdString());
+  const std::string error = dialog.standIn() ? context_->useStandIn()
+                                             : context_->connectTo(dialog.hostPort().toStdString(), dialog.token().toStdString());
   if (!error.empty()) {
     context_->showError(tr("Cannot connect"), qs(error));
     connectToRobot();  // back to where the console was
     return;
   }
   if (!dialog.standIn()) ConnectDialog::remember(dialog.hostPort());
-  context_->event(QStringLiteral("link"), tr("connecting to %1").arg(qs(session.endpoint().label)));
+  context_->event(QStringLiteral("link"), tr("connecting to %1").arg(qs(context_->session().endpoint().label)));
   context_->host().restarted(false);
 }
 
 void LinkJob::resetRobot() {
   // The stand-in restarts on the world file's terrain: edits not saved
   // would go without a word (issue 59). Asked first, Cancel the default.
-  if (const TerrainEditor* t = context_->session().terrainEditor(); t && t->unsavedChanges() > 0) {
+  if (const TerrainEditor* t = context_->terrainEditor(); t && t->unsavedChanges() > 0) {
     if (!context_->confirm(QMessageBox::Warning, tr("Reset to the start"),
                            tr("The terrain has %n edit(s) not saved. Reset restarts the robot on the world file's "
                               "terrain: they would be lost.\n\nSave them first with Terrain ▸ Save as…, or reset "
@@ -142,7 +141,7 @@ void LinkJob::resetRobot() {
       return;
   }
   context_->connection().close();
-  if (const std::string error = context_->session().resetRobot(); !error.empty()) {
+  if (const std::string error = context_->resetRobot(); !error.empty()) {
     context_->status(qs(error), 6000);
     connectToRobot();
     return;

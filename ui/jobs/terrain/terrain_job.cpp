@@ -34,7 +34,7 @@ void TerrainJob::install(ConsoleContext& context) {
   // A new world is edited from its file's heights; the same world shown
   // again after a replay keeps the edits and their undo history.
   connect(&context, &ConsoleContext::worldChanged, this, [this](const WorldModel&, bool fresh) {
-    if (fresh) panel_->setTerrain(context_->session().world(), context_->session().terrainEditor());
+    if (fresh) panel_->setTerrain(context_->session().world(), context_->terrainEditor());
   });
   connect(&context, &ConsoleContext::stateChanged, this, [this] {
     // While a replay is shown the view shows the log's ground: no editing the live terrain.
