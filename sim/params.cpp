@@ -173,7 +173,8 @@ std::vector<Entry> calibrationEntries() {
 // not repeated here: they are SimParams' in-class initializers.
 const std::vector<Entry>& table() {
   constexpr double kMaxRate = 10000;
-  static const std::vector<Entry> before = {
+  static const std::vector<Entry> entries = [] {
+    std::vector<Entry> all = {
       // At least 10 us: a finer step simulates nothing in any useful time
       // (1e-300 ran "1 s" as zero steps and exited 0).
       entry("physics.step", "fixed integration step [s], [1e-05, 0.1]",
@@ -250,10 +251,10 @@ const std::vector<Entry>& table() {
             real(&SimParams::ghostAnchorRate, closed(1, 1000))),
       entry("ghost.hold", "ghost: joints whose subtrees it holds rigid while still (the drive's joints turn), comma-separated, or none",
             jointNames(&SimParams::ghostHold)),
-  };
-  // Appended in place: the keys keep the order of config/defaults.params.
-  static const std::vector<Entry> calibration = calibrationEntries();
-  static const std::vector<Entry> after = {
+    };
+    // In place: the keys keep the order of config/defaults.params.
+    for (Entry& e : calibrationEntries()) all.push_back(std::move(e));
+    all.insert(all.end(), {
       entry("gait.caterpillar.hip_swing", "caterpillar: hip swing about the stance pose [deg], (0, 45]",
             real(&SimParams::caterpillarHipSwing, openClosed(0, 45))),
       entry("gait.caterpillar.phase_time", "caterpillar: duration of each half cycle [s], (0, 60]",
@@ -276,11 +277,7 @@ const std::vector<Entry>& table() {
             real(&SimParams::maxJointError, above(0))),
       entry("health.max_penetration", "body below the ground by more than this [m], > 0",
             real(&SimParams::maxPenetration, above(0))),
-  };
-  static const std::vector<Entry> entries = [] {
-    std::vector<Entry> all = before;
-    all.insert(all.end(), calibration.begin(), calibration.end());
-    all.insert(all.end(), after.begin(), after.end());
+    });
     return all;
   }();
   return entries;

@@ -29,6 +29,11 @@ std::string ConsoleContext::connectTo(const std::string& hostPort, const std::st
 }
 std::string ConsoleContext::resetRobot() { return parts_.session->resetRobot(); }
 
+std::string ConsoleContext::sinkRefusal() const {
+  // A replay shown is not the robot the operator means: nothing goes out.
+  return state().replaying() ? state().controlsRefusal() : session().commandRefusal(state().leaseHeld());
+}
+
 bool ConsoleContext::editTerrain(const TerrainPatchCmd& patch) {
   if (state().replaying()) return false;  // the view shows the log's world
   if (!parts_.session->terrainEdited(patch)) return false;
@@ -46,8 +51,7 @@ bool ConsoleContext::robotTakesTerrainEdits() const {
 }
 
 QString ConsoleContext::sendSequence(const net::SequenceMsg& message) {
-  const std::string why = state().replaying() ? state().controlsRefusal() : session().commandRefusal(state().leaseHeld());
-  if (!why.empty()) return QString::fromStdString(why);
+  if (const std::string why = sinkRefusal(); !why.empty()) return QString::fromStdString(why);
   connection().sendSequence(message);
   return {};
 }
@@ -59,9 +63,7 @@ void ConsoleContext::abortSequence(const QString& hash, const QString& reason) {
 const std::shared_ptr<SequenceGuard>& ConsoleContext::guard() const { return connection().guard(); }
 
 QString ConsoleContext::sendCommand(const Command& command) {
-  // A replay shown is not the robot the operator means: nothing goes out.
-  std::string why = state().replaying() ? state().controlsRefusal() : session().commandRefusal(state().leaseHeld());
-  if (!why.empty()) {
+  if (const std::string why = sinkRefusal(); !why.empty()) {
     const QString text = QString::fromStdString(why);
     status(text, 4000);
     return text;

@@ -217,6 +217,9 @@ class ConsoleContext : public QObject {
                     const QString& label);
 
  private:
+  /// Why nothing goes to the robot now (a replay shown, no lease), or "".
+  std::string sinkRefusal() const;
+
   Parts parts_;
   std::vector<double> measured_;
 };

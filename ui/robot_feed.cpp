@@ -28,7 +28,7 @@ LiveLinkFeed::LiveLinkFeed(RobotConnection* connection, ConsoleSession* session,
   });
   connect(connection, &RobotConnection::laser, this, [this](const net::LaserMsg& m) {
     ++laserCount_;
-    emit laser(laserFrame(m));
+    emit laser(laserFromMessage(m));
   });
   connect(connection, &RobotConnection::reply, this, [this](const net::ReplyMsg& m) {
     if (m.status == net::ReplyStatus::Ok) return;

@@ -262,14 +262,12 @@ RobotFrame ConsoleSession::telemetry(const net::TelemetryMsg& t, double wall, do
 
 LaserFrame ConsoleSession::laser(const net::LaserMsg& m) {
   tap_->laser(m);
-  return laserFrame(m);
+  return laserFromMessage(m);
 }
 
 std::optional<GhostError> ConsoleSession::lastPrediction() const { return tap_->lastPrediction(); }
 
 double ConsoleSession::realTimeFactor() const { return tap_->realTimeFactor(); }
-
-LaserFrame laserFrame(const net::LaserMsg& m) { return {m.time, m.angleMin, m.angleStep, m.ranges}; }
 
 std::string ConsoleSession::commandRefusal(bool leaseHeld) const {
   if (!leaseHeld) return "Not sent: take control first (Robot ▸ Take control)";

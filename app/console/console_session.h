@@ -258,7 +258,4 @@ class ConsoleSession {
   std::shared_ptr<TelemetryTap> tap_ = std::make_shared<TelemetryTap>();
 };
 
-/// The frame to draw of laser scan `m`.
-LaserFrame laserFrame(const net::LaserMsg& m);
-
 }  // namespace sp

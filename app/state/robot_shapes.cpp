@@ -117,4 +117,6 @@ RobotFrame frameFromGhost(const GhostView& v) {
   return f;
 }
 
+LaserFrame laserFromMessage(const net::LaserMsg& m) { return {m.time, m.angleMin, m.angleStep, m.ranges}; }
+
 }  // namespace sp

@@ -52,5 +52,7 @@ RobotFrame frameFromSample(const LogSample& s, size_t joints);
 RobotFrame frameFromReadout(const RobotReadout& r);
 /// The frame to draw of the ghost's view.
 RobotFrame frameFromGhost(const GhostView& v);
+/// The scan to draw of laser message `m`.
+LaserFrame laserFromMessage(const net::LaserMsg& m);
 
 }  // namespace sp
