@@ -3,7 +3,8 @@
 
     python3 scripts/gen_terrains.py [output_dir]
 
-Writes bumpy.asc, bumpy_small.pgm and test_track.csv (default output_dir:
+Writes bumpy.asc, bumpy_small.pgm, test_track.csv, rough.asc and
+rough_unmapped.asc (default output_dir:
 terrains/ next to this script's folder). Standard library only; no random
 numbers, so every run writes byte-identical files. terrains/README.md
 documents the shapes; keep it in step with the constants below.
@@ -96,6 +97,7 @@ def write_bumpy_small_pgm(path):
 TRACK_LENGTH = 22.0  # m
 TRACK_STEP = 0.05  # m
 TRACK_FLAT = 1.0  # m of flat track at each end
+TRACK_BEHIND = 2.0  # m of level snow behind the start (distances from -2 m)
 # (start [m], length [m], height [m]) cosine bumps on top of the undulation.
 # Each is pi * height / 0.2 long, so its steepest slope is 0.2 (11 deg): a
 # four-wheel-drive robot climbs that on packed snow (mu 0.3 > 0.2 plus the
@@ -124,11 +126,63 @@ def track_height(d):
 
 
 def write_test_track_csv(path):
-    n = int(round(TRACK_LENGTH / TRACK_STEP)) + 1
+    n = int(round((TRACK_LENGTH + TRACK_BEHIND) / TRACK_STEP)) + 1
     lines = ["distance_m,height_m"]
     for k in range(n):
-        d = k * TRACK_STEP
+        d = k * TRACK_STEP - TRACK_BEHIND
         lines.append(f"{d:.2f},{fmt(track_height(d), 4)}")
+    with open(path, "w", newline="\n") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+# ---------------------------------------------------------------------------
+# Rough field: the bumpy field's waves plus shorter ones (0.8 m .. 1.7 m),
+# 20 m x 20 m at 0.125 m. rough_unmapped.asc is the same ground with what a
+# map lacks (issue 61): a ridge and a hollow across the whole field, for a
+# stand-in whose ground is not the console's.
+
+ROUGH_SIZE = 20.0  # m
+ROUGH_CELL = 0.125  # m
+ROUGH_WAVES = [
+    (0.008, 1.7, 35.0, 0.3),
+    (0.006, 1.1, 100.0, 2.2),
+    (0.005, 0.8, 145.0, 1.1),
+]
+# (centre x [m], height [m] (negative: a hollow), width [m]) cosine ridges
+# across the field (all y), in the unmapped ground only.
+ROUGH_UNMAPPED = [
+    (-2.0, 0.09, 0.6),
+    (2.0, -0.07, 0.8),
+]
+
+
+def rough_height(x, y, unmapped=False):
+    h = bumpy_height(x, y)
+    for amplitude, wavelength, direction, phase in ROUGH_WAVES:
+        a = math.radians(direction)
+        s = x * math.cos(a) + y * math.sin(a)
+        h += amplitude * math.sin(2 * math.pi * s / wavelength + phase)
+    if unmapped:
+        for centre, height, width in ROUGH_UNMAPPED:
+            if abs(x - centre) < width / 2:
+                h += height / 2 * (1 + math.cos(2 * math.pi * (x - centre) / width))
+    return h
+
+
+def write_rough_asc(path, unmapped):
+    n = int(round(ROUGH_SIZE / ROUGH_CELL)) + 1
+    half = ROUGH_SIZE / 2
+    lines = [
+        f"ncols {n}",
+        f"nrows {n}",
+        f"xllcenter {fmt(-half, 2)}",
+        f"yllcenter {fmt(-half, 2)}",
+        f"cellsize {ROUGH_CELL}",
+        "NODATA_value -9999",
+    ]
+    for r in range(n):
+        y = half - r * ROUGH_CELL
+        lines.append(" ".join(fmt(rough_height(-half + c * ROUGH_CELL, y, unmapped), 4) for c in range(n)))
     with open(path, "w", newline="\n") as f:
         f.write("\n".join(lines) + "\n")
 
@@ -140,6 +194,8 @@ def main():
     write_bumpy_asc(os.path.join(out, "bumpy.asc"))
     write_bumpy_small_pgm(os.path.join(out, "bumpy_small.pgm"))
     write_test_track_csv(os.path.join(out, "test_track.csv"))
+    write_rough_asc(os.path.join(out, "rough.asc"), unmapped=False)
+    write_rough_asc(os.path.join(out, "rough_unmapped.asc"), unmapped=True)
 
 
 if __name__ == "__main__":

@@ -786,6 +786,9 @@ void readTerrain(const XMLElement* e, WorldModel& world, std::string_view file, 
     materialRefs.emplace_back(*m, t.line);
   }
   t.pose = r.pose();
+  t.heightUncertainty = r.number("height_uncertainty", -1);
+  r.nonNegative("height_uncertainty");
+  if (t.heightUncertainty < 0) t.heightUncertainty = -1;  // refused above when stated
   const Vec3 rpy = rpyFromQuat(t.pose.q);
   if (std::abs(rpy.x) > 1e-9 || std::abs(rpy.y) > 1e-9) r.error("rpy: terrain may only be turned about z (yaw)");
   if (kind == 0) {

@@ -50,6 +50,7 @@ Range above(double lo) { return {lo, std::nullopt, true, false}; }
 Range closed(double lo, double hi) { return {lo, hi, false, false}; }
 Range openClosed(double lo, double hi) { return {lo, hi, true, false}; }
 Range closedOpen(double lo, double hi) { return {lo, hi, false, true}; }
+Range open(double lo, double hi) { return {lo, hi, true, true}; }
 
 /// The violated bound as "must be > 0", or "" when `value` is in range.
 std::string rangeError(const Range& range, double value) {
@@ -251,6 +252,18 @@ const std::vector<Entry>& table() {
             real(&SimParams::ghostAnchorRate, closed(1, 1000))),
       entry("ghost.hold", "ghost: joints whose subtrees it holds rigid while still (the drive's joints turn), comma-separated, or none",
             jointNames(&SimParams::ghostHold)),
+      entry("ghost.region.inner", "ghost: the inner region's level, the share of predictions it holds, (0, 1)",
+            real(&SimParams::ghostRegionInner, open(0, 1))),
+      entry("ghost.region.outer", "ghost: the outer region's level (the trail's band, the status bar's radius), (0, 1)",
+            real(&SimParams::ghostRegionOuter, open(0, 1))),
+      entry("ghost.region.departure", "ghost: telemetry outside the region of this level for ghost.region.hold s is a departure, (0, 1)",
+            real(&SimParams::ghostRegionDeparture, open(0, 1))),
+      entry("ghost.region.hold", "ghost: how long telemetry stays outside before a departure is said [s], [0.02, 60]",
+            real(&SimParams::ghostRegionHold, closed(0.02, 60))),
+      entry("ghost.region.window", "ghost: robot time the conformal quantiles are over [s], [1, 600]",
+            real(&SimParams::ghostRegionWindow, closed(1, 600))),
+      entry("ghost.region.gamma", "ghost: adaptive conformal inference's step per judged prediction (0: off), [0, 0.1]",
+            real(&SimParams::ghostRegionGamma, closed(0, 0.1))),
     };
     // In place: the keys keep the order of config/defaults.params.
     for (Entry& e : calibrationEntries()) all.push_back(std::move(e));

@@ -82,6 +82,14 @@ struct SimParams {
   /// still (comma-separated names, or "none"; the wheels and articulation
   /// keep turning): fewer bodies, faster predictions (sim/rigid.h).
   std::string ghostHold = "waist_yaw,hip_fl,hip_fr,hip_rl,hip_rr";
+  // How sure the ghost is (app/ghost/ghost_region.h): its regions' levels,
+  // a departure's, and the conformal layer's window and step.
+  double ghostRegionInner = 0.5;
+  double ghostRegionOuter = 0.9;
+  double ghostRegionDeparture = 0.99;
+  double ghostRegionHold = 0.5;      ///< [s]
+  double ghostRegionWindow = 20;     ///< [s]
+  double ghostRegionGamma = 0.005;
   // The twin calibrated to a robot (app/calibration/calibration.h): what
   // the twins the console starts (ghost, rehearsals, sweeps, run) differ
   // from the files by. Factors on the files' values; identity by default.

@@ -1,6 +1,7 @@
 #include "sim/robot_model.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace sp {
 
@@ -79,6 +80,25 @@ const ContactSpec& WorldModel::contactFor(std::string_view a, std::string_view b
   for (const ContactSpec& c : contacts)
     if ((c.a == a && c.b == b) || (c.a == b && c.b == a)) return c;
   return defaultContact;
+}
+
+double terrainUncertainty(const TerrainSpec& terrain) {
+  if (terrain.heightUncertainty >= 0) return terrain.heightUncertainty;
+  if (terrain.kind == TerrainSpec::Kind::Plane) return 0;
+  const HeightGrid& g = terrain.grid;
+  double sum = 0;
+  size_t n = 0;
+  // Bilinear interpolation of a smooth surface misses by up to an eighth of
+  // its second difference over a cell: the grid's own curvature bounds how
+  // well it can know the ground between its samples.
+  for (int j = 1; j + 1 < g.rows; ++j)
+    for (int i = 1; i + 1 < g.columns; ++i) {
+      const double dx = (g.at(i - 1, j) + g.at(i + 1, j) - 2 * g.at(i, j)) / 8;
+      const double dy = (g.at(i, j - 1) + g.at(i, j + 1) - 2 * g.at(i, j)) / 8;
+      sum += dx * dx + dy * dy;
+      n += 2;
+    }
+  return n ? std::sqrt(sum / static_cast<double>(n)) : 0;
 }
 
 }  // namespace sp

@@ -178,8 +178,18 @@ struct TerrainSpec {
   std::string file;    ///< heightfield source file ("" for a plane)
   Pose pose;           ///< grid centre (x, y, z offset added to heights); yaw only
   HeightGrid grid;     ///< heightfield only
+  /// [m] one deviation of the real ground's height about these heights,
+  /// as the world file states it (height_uncertainty); < 0: not stated,
+  /// terrainUncertainty() derives it.
+  double heightUncertainty = -1;
   int line = 0;
 };
+
+/// [m] how well `terrain` is known: what its world file states, else what
+/// its grid implies (a plane: 0; a grid: the root mean square of what
+/// interpolating between its samples misses, an eighth of its second
+/// differences, along both axes).
+double terrainUncertainty(const TerrainSpec& terrain);
 
 /// A static or dynamic object of the world.
 struct ObjectSpec {

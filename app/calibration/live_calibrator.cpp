@@ -1,5 +1,7 @@
 #include "app/calibration/live_calibrator.h"
 
+#include <cstdio>
+
 #include <pthread.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
@@ -41,13 +43,20 @@ LiveCalibrator::~LiveCalibrator() {
   if (checker_.joinable()) checker_.join();
 }
 
-void LiveCalibrator::frame(const RobotFrame& f) {
+void LiveCalibrator::frame(const RobotFrame& f, bool suspect) {
   {
     std::lock_guard lock(mutex_);
     if (!frames_.empty() && f.time < frames_.back().time) {  // the robot restarted
       frames_.clear();
       commands_.clear();
-      lastFitAt_ = -1e300;
+      lastFitAt_ = suspectAt_ = -1e300;
+    }
+    if (suspect) {
+      // The world is not the files' here: a fit over it would put a ridge
+      // into the tyres. The window starts again after it.
+      frames_.clear();
+      suspectAt_ = f.time;
+      return;
     }
     frames_.push_back(f);
     const double keep = options_.fit.window > 0 ? options_.fit.window + 2 : 60;
@@ -149,6 +158,14 @@ void LiveCalibrator::run() {
     std::unique_lock lock(mutex_);
     if (stop_) return;
     ++state_.fits;
+    if (fit.refused.empty() && suspectAt_ >= fit.from) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "the robot departed from its twin at %.1f s (the ground or the robot differ from the files "
+                    "there): that stretch is left out",
+                    suspectAt_);
+      fit.refused = text;
+    }
     if (!fit.refused.empty()) {
       ++state_.refusals;
       state_.lastRefusal = fit.refused;

@@ -95,8 +95,11 @@ class LiveCalibrator {
   LiveCalibrator(const LiveCalibrator&) = delete;
   LiveCalibrator& operator=(const LiveCalibrator&) = delete;
 
-  /// A telemetry frame (joints in the model's order).
-  void frame(const RobotFrame& frame);
+  /// A telemetry frame (joints in the model's order). `suspect`: the robot
+  /// departs from its twin there (app/ghost/ghost_region.h): the frame and
+  /// the window before it are left out, and a fit running over it is
+  /// refused in those words; the fits start again on the frames after.
+  void frame(const RobotFrame& frame, bool suspect = false);
   /// A command sent, taken to arrive at robot time `arrival`.
   void command(const Command& command, double arrival);
   CalibrationState state() const;
@@ -127,6 +130,7 @@ class LiveCalibrator {
   std::deque<RobotFrame> frames_;
   std::deque<TimedCommand> commands_;
   double lastFitAt_ = -1e300;  // robot time of the newest frame the last fit saw
+  double suspectAt_ = -1e300;  // robot time of the newest frame left out for a departure
   CalibrationState state_;
   CalEstimate estimate_;  // state_'s applied, sigma and observed, fused
   std::thread worker_;

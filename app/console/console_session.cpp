@@ -14,6 +14,7 @@
 #include "app/log/session_recorder.h"
 #include "app/robot/stand_in.h"
 #include "app/log/telemetry_recorder.h"
+#include "sim/calibration_table.h"
 #include "sim/model_loader.h"
 #include "sim/perturbation.h"
 #include "sim/terrain_brush.h"
@@ -46,6 +47,24 @@ void ConsoleSession::bindTap() {
   tap_->bind({robot(), ghost_.get(), calibrator_.get(), recorder_.get(), standIn_.get()});
 }
 
+namespace {
+
+ErrorModel errorModelOf(const WorldModel& world, const CalibrationState* calibration) {
+  ErrorModel m = errorModelFor(world);
+  // What the twin knows of the robot: a fitted value's deviation, else
+  // the prior's (the ranges a robot may differ from its files by).
+  const auto deviation = [&](CalParam p) {
+    const auto i = static_cast<size_t>(p);
+    return calibration && calibration->observed[i] ? calibration->sigma[i] : calParam(p).scale;
+  };
+  m.speed = std::hypot(deviation(CalParam::WheelRadius), deviation(CalParam::MotorGain));
+  m.curvature = deviation(CalParam::WheelRadiusSide) / m.track;
+  m.arrival = deviation(CalParam::Delay);
+  return m;
+}
+
+}  // namespace
+
 void ConsoleSession::setWorld(WorldModel world) {
   const TapRebind rebind(*this);
   terrain_.reset();  // its history is of the old world's heights
@@ -58,6 +77,7 @@ void ConsoleSession::setWorld(WorldModel world) {
   ghostError_.clear();
   calibrationSeen_ = calibrationFitsLogged_ = 0;
   if (options_.ghost) ghost_ = Ghost::create(*world_, params_, options_.ghostOptions, ghostError_);
+  if (ghost_) ghost_->setErrorModel(errorModelOf(*world_, nullptr));
   ghostCalibration_ = calValues(params_);
   // The calibration fits the ghost's own twin.
   if (ghost_ && options_.calibrate) {
@@ -81,6 +101,7 @@ void ConsoleSession::takeCalibration() {
     ghost_->setCalibration(calibratedWorld(*world_, calibrated), calibrated.calDelay);
     ghostCalibration_ = s.applied;
   }
+  if (ghost_) ghost_->setErrorModel(errorModelOf(*world_, &s));
   calibrationSeen_ = s.version;
   // The fits since the last call, one row per parameter (the history keeps the newest).
   const int fresh = std::min<int>(s.fits - calibrationFitsLogged_, static_cast<int>(s.history.size()));
@@ -183,6 +204,7 @@ std::string ConsoleSession::startStandIn(const std::string& worldFile, const std
   o.log = options_.log;
   o.logDir = options_.logDir;
   o.perturbSeed = options_.perturbSeed;
+  o.groundFile = options_.ground;
   o.emulation.delay = options_.delay;
   o.emulation.jitter = options_.jitter;
   Diagnostics diag;

@@ -54,6 +54,9 @@ struct ConsoleSessionOptions {
   /// from this seed (sim/perturbation.h); the console's twin, ghost and
   /// rehearsals keep the files. nullopt = the stand-in runs the files.
   std::optional<uint64_t> perturbSeed;
+  /// The stand-in stands on this world's terrain instead of the drawn
+  /// world's (StandInOptions::groundFile): ground the console's map lacks.
+  std::string ground;
   bool ghost = true;                   ///< run the predictive ghost (app/ghost/ghost.h)
   /// Calibrate the twin from telemetry while driving (app/calibration/
   /// live_calibrator.h; needs the ghost: its clock dates the commands).

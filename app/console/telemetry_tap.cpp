@@ -1,6 +1,8 @@
 // Telemetry's one way in (app/console/telemetry_tap.h).
 #include "app/console/telemetry_tap.h"
 
+#include <cstdio>
+
 #include "app/calibration/live_calibrator.h"
 #include "app/ghost/ghost.h"
 #include "app/log/telemetry_recorder.h"
@@ -35,8 +37,9 @@ TelemetryTap::Tapped TelemetryTap::telemetry(const net::TelemetryMsg& t, double 
   } else if (parts_.ghost) {
     lastPrediction_ = parts_.ghost->anchor(f, roundTrip > 0 ? roundTrip : t.rttMs / 1000);
     if (lastPrediction_) logPrediction(*lastPrediction_);
+    if (lastPrediction_ && lastPrediction_->departure != 0) logDeparture();
   }
-  if (parts_.calibrator) parts_.calibrator->frame(f);
+  if (parts_.calibrator) parts_.calibrator->frame(f, lastPrediction_ && lastPrediction_->suspect);
   out.prediction = lastPrediction_;
   return out;
 }
@@ -56,6 +59,20 @@ void TelemetryTap::logPrediction(const GhostError& e) {
   p.headingError = e.heading;
   if (parts_.recorder) parts_.recorder->prediction(p);
   else if (parts_.standIn) parts_.standIn->logPrediction(p);
+}
+
+void TelemetryTap::logDeparture() {
+  const std::vector<Departure> all = parts_.ghost->departures();
+  if (all.empty()) return;
+  const Departure& d = all.back();
+  char text[320];
+  if (d.ended < 0) std::snprintf(text, sizeof text, "%s", d.describe().c_str());
+  else
+    std::snprintf(text, sizeof text,
+                  "the robot is back inside its twin's region (it departed by %.0f cm at (%.1f, %.1f) for %.1f s)",
+                  d.error * 100, d.where.x, d.where.y, d.ended - d.time);
+  if (parts_.recorder) parts_.recorder->event("departure", text);
+  else if (parts_.standIn) parts_.standIn->logEvent("departure", text);
 }
 
 std::optional<GhostError> TelemetryTap::lastPrediction() const {

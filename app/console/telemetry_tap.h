@@ -77,6 +77,7 @@ class TelemetryTap {
 
  private:
   void logPrediction(const GhostError& error);  // under mutex_
+  void logDeparture();  // the ghost's newest departure began or ended (under mutex_)
 
   mutable std::mutex mutex_;
   Parts parts_;

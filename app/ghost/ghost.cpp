@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 
 #include "app/ghost/ghost_impl.h"
 #include "app/ghost/hold_policy.h"
@@ -24,6 +26,27 @@ SimParams Ghost::profile(const SimParams& params) {
   return p;
 }
 
+namespace {
+
+ConformalLayer::Options layerOptions(const SimParams& p, bool conformal = true) {
+  ConformalLayer::Options o;
+  if (!conformal) o.minScores = std::numeric_limits<int>::max();
+  o.levels = {p.ghostRegionInner, p.ghostRegionOuter, p.ghostRegionDeparture};
+  o.window = p.ghostRegionWindow;
+  o.gamma = p.ghostRegionGamma;
+  return o;
+}
+
+}  // namespace
+
+Ghost::Ghost(const WorldModel& world, const SimParams& params, const Options& options)
+    : model_(world), params_(params), options_(options), region_(layerOptions(params, options.conformal)) {
+  DepartureWatch::Options o;
+  o.hold = params.ghostRegionHold;
+  watch_ = DepartureWatch(o);
+  errorModel_ = errorModelFor(world);
+}
+
 std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& params, std::string& error) {
   return create(world, params, Options{}, error);
 }
@@ -32,6 +55,14 @@ std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& p
                                      std::string& error) {
   if (world.robots.empty()) {
     error = "the world has no robot to predict";
+    return nullptr;
+  }
+  if (!ConformalLayer::checkLevels(layerOptions(params).levels).empty()) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "ghost.region.inner (%g), ghost.region.outer (%g) and ghost.region.departure (%g) must ascend",
+                  params.ghostRegionInner, params.ghostRegionOuter, params.ghostRegionDeparture);
+    error = text;
     return nullptr;
   }
   std::unique_ptr<Ghost> g(new Ghost(calibratedWorld(world, params), profile(params), options));
@@ -163,8 +194,15 @@ std::optional<GhostError> Ghost::anchor(const RobotFrame& frame, double roundTri
   std::optional<GhostError> error;
   {
     std::lock_guard lock(recordMutex_);
-    if (reset) record_.clear();
+    if (reset) {
+      record_.clear();
+      region_.clear();
+      watch_.clear();
+      departures_.clear();
+      pending_.clear();
+    }
     error = record_.compare(frame);
+    if (error) judge(*error, frame);
   }
   frames_.publish(std::make_shared<const RobotFrame>(frame));
   {
@@ -173,6 +211,65 @@ std::optional<GhostError> Ghost::anchor(const RobotFrame& frame, double roundTri
   }
   anchorBell_.ring();
   return error;
+}
+
+void Ghost::judge(GhostError& e, const RobotFrame& frame) {
+  if (!(e.scale > 0)) return;
+  e.inner = region_.multiplier(0) * e.scale;
+  e.outer = region_.multiplier(1) * e.scale;
+  e.limit = region_.multiplier(2) * e.scale;
+  const double score = e.position / e.scale;
+  region_.judge(score);
+  const DepartureWatch::Change change = watch_.judge(frame.time, frame.base.p, e.position, e.limit);
+  if (change == DepartureWatch::Change::Began) {
+    departures_.push_back(*watch_.last());
+    e.departure = 1;
+    pending_.clear();  // the run outside was the departure's
+  } else if (change == DepartureWatch::Change::Ended) {
+    e.departure = -1;
+    pending_.clear();  // frames of its clearing
+  }
+  if (watch_.last() && !departures_.empty()) departures_.back() = *watch_.last();
+  e.suspect = watch_.departing();
+  const bool lasting = watch_.departing() && frame.time - watch_.last()->time > kLasting;
+  if (watch_.suspect() && !lasting) {
+    pending_.push_back({frame.time, score});
+    return;
+  }
+  for (const PendingScore& p : pending_) region_.learn(p.time, p.score);  // a run outside that was no departure
+  pending_.clear();
+  region_.learn(frame.time, score);
+}
+
+double Ghost::scaleOf(double t, double made, double speed, const std::vector<std::pair<double, Command>>& timeline,
+                      double spread) const {
+  ErrorModel m = errorModel_;
+  m.arrival = std::hypot(m.arrival, spread);
+  const ErrorSources sources{t - made, speed, commandTiming(timeline, made, t, speed, m.wheelbase)};
+  return errorScale(sources, m);
+}
+
+void Ghost::setErrorModel(const ErrorModel& model) {
+  std::lock_guard lock(recordMutex_);
+  errorModel_ = model;
+}
+
+ErrorModel Ghost::errorModel() const {
+  std::lock_guard lock(recordMutex_);
+  return errorModel_;
+}
+
+std::vector<Departure> Ghost::departures() const {
+  std::lock_guard lock(recordMutex_);
+  return departures_;
+}
+
+Ghost::Coverage Ghost::coverage() const {
+  std::lock_guard lock(recordMutex_);
+  Coverage c;
+  c.judged = region_.judged();
+  for (size_t i = 0; i < c.share.size(); ++i) c.share[i] = region_.coverage(i).value_or(0);
+  return c;
 }
 
 void Ghost::commandSent(const Command& command) {

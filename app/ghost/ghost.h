@@ -50,6 +50,21 @@
 // showed for that frame's robot time: horizontal distance and yaw
 // difference (anchor() returns it; errorMedian() over 10 s of robot time).
 //
+// How sure it is (ghost_region.h). Each state shown gets an error scale
+// from its horizon, its speed, the commands that took effect within it and
+// their arrival's uncertainty (the link's measured jitter, the
+// calibration's delay deviation), the calibration's speed and curvature
+// deviations and the terrain's height uncertainty (setErrorModel()); the
+// view carries its inner and outer regions (ghost.region.inner, .outer:
+// radius = the conformal layer's multiplier x scale) and the trail a band
+// of the outer region at each point. Each judged frame feeds the layer and
+// the departure watch: telemetry outside the ghost.region.departure region
+// for ghost.region.hold s is a departure (departures(); the frame's
+// GhostError says when one begins and ends). Frames of a run outside and
+// of a departure stay out of the layer's quantiles (the region must not
+// grow to swallow a ridge the map lacks) unless the departure lasts
+// kLasting s: then it is the robot that differs, and the layer learns it.
+//
 // Latches: while a frame reports an e-stop or failsafe, the robot is held
 // still; the ghost stops the robot too and ignores the commands in flight
 // (the robot refuses commands while latched).
@@ -68,6 +83,7 @@
 // the rest from one other (the console's GUI thread). The three workers
 // are internal.
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <deque>
@@ -82,6 +98,7 @@
 #include "app/state/ghost_view.h"
 #include "app/state/robot_frame.h"
 #include "app/ghost/ghost_clock.h"
+#include "app/ghost/ghost_region.h"
 #include "app/ghost/ghost_slots.h"
 #include "app/ghost/in_flight.h"
 #include "app/ghost/prediction_record.h"
@@ -116,6 +133,9 @@ class Ghost {
     /// whatever the clock estimate says (a robot whose time leaps, a round
     /// trip of hours): beyond it the view says so instead of predicting.
     double maxAhead = 10;
+    /// false: the regions take the Gaussian multipliers of the scale alone
+    /// (the conformal layer off; a control).
+    bool conformal = true;
   };
 
   /// The ghost's physics profile of `params`: ghost.step and
@@ -156,6 +176,25 @@ class Ghost {
   std::optional<std::pair<double, double>> errorMedian() const;
   /// [m] the largest position error over the same 10 s.
   std::optional<double> errorWorst() const;
+  /// What the region's scale is built from besides the link's jitter
+  /// (measured): the calibration's deviations and the terrain's
+  /// uncertainty (ghost_region.h). From the next view on.
+  void setErrorModel(const ErrorModel& model);
+  ErrorModel errorModel() const;
+  /// The departures telemetry showed since the last reset, oldest first
+  /// (the last may still be on: ended < 0).
+  std::vector<Departure> departures() const;
+  /// The share of judged frames inside the inner, outer and departure
+  /// regions (as each stood when the frame came), and how many were judged.
+  struct Coverage {
+    std::array<double, 3> share{};
+    size_t judged = 0;
+  };
+  Coverage coverage() const;
+  /// [s] a departure lasting this long is the robot, not a place: the
+  /// conformal layer learns from it from then on.
+  static constexpr double kLasting = 5;
+
   /// The robot reported its twin diverged (`why`): the ghost stops
   /// predicting (its view keeps the last prediction, with `why` as its
   /// problem) until the next anchor().
@@ -180,8 +219,7 @@ class Ghost {
     std::vector<int> held;  ///< the full robot's joints welded
   };
 
-  Ghost(const WorldModel& world, const SimParams& params, const Options& options)
-      : model_(world), params_(params), options_(options) {}
+  Ghost(const WorldModel& world, const SimParams& params, const Options& options);
   /// The twin welded at `positions` (the full robot's joints), or the full
   /// robot when not `hold`. Null and `error` when the hold cannot be made.
   std::shared_ptr<const Twin> makeTwin(const std::vector<double>& positions, bool hold, std::string& error) const;
@@ -214,6 +252,14 @@ class Ghost {
   bool advance(World& world, double& t, double target, const std::vector<SentCommand>& commands, size_t& next,
                const std::function<bool()>& abort = {}) const;
   void setProblem(const std::string& problem);
+  /// `e` (a frame just compared) given its regions, judged for a
+  /// departure and fed to the conformal layer (recordMutex_ held).
+  void judge(GhostError& e, const RobotFrame& frame);
+  /// The error scale of a state shown at robot time `t` from telemetry of
+  /// `made`, at base speed `speed` (recordMutex_ held; `timeline` and
+  /// `spread` from the link's timeline).
+  double scaleOf(double t, double made, double speed, const std::vector<std::pair<double, Command>>& timeline,
+                 double spread) const;
   /// The destructor asked the threads to end (a long run ahead gives up).
   bool stopping() const { return stop_.load(); }
 
@@ -243,6 +289,14 @@ class Ghost {
 
   mutable std::mutex recordMutex_;
   PredictionRecord record_;  // what was shown against what came
+  ErrorModel errorModel_;    // the region's sources besides the link
+  ConformalLayer region_;    // inner, outer, departure
+  DepartureWatch watch_;
+  std::vector<Departure> departures_;
+  struct PendingScore {
+    double time, score;
+  };
+  std::vector<PendingScore> pending_;  // frames outside, kept from the layer until judged no departure
 
   mutable std::mutex viewMutex_;  // what the GUI copies out
   GhostView view_;

@@ -18,4 +18,14 @@ bool GhostClock::frame(double robotTime, double wall, double roundTrip) {
   return reset;
 }
 
+double GhostClock::spread() const {
+  if (offsets_.size() < 2) return 0;
+  double mean = 0;
+  for (const auto& o : offsets_) mean += o.second;
+  mean /= static_cast<double>(offsets_.size());
+  double sum = 0;
+  for (const auto& o : offsets_) sum += (o.second - mean) * (o.second - mean);
+  return std::sqrt(sum / static_cast<double>(offsets_.size() - 1));
+}
+
 }  // namespace sp

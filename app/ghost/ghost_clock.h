@@ -29,6 +29,10 @@ class GhostClock {
   double newest() const { return newest_; }
   double offset() const { return offset_; }
   double roundTrip() const { return roundTrip_; }
+  /// [s] the standard deviation of (robot time - arrival) over the offset
+  /// window: the downlink's jitter, which a command's arrival shares
+  /// (ghost_region.h); 0 before two frames.
+  double spread() const;
 
  private:
   std::deque<std::pair<double, double>> offsets_;  // (arrival, T - arrival), last kOffsetWindow

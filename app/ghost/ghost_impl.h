@@ -28,6 +28,7 @@ struct Ghost::TrailRequest {
   uint64_t nextSeq = 0;
   bool latched = false;
   bool urgent = false;  // commands changed: the trail running now is wrong
+  double made = 0;      // robot time of the telemetry its base was anchored on (the band's horizon)
 };
 
 // What the anchor thread keeps from one re-anchoring to the next.

@@ -205,7 +205,8 @@ void Ghost::presentLoop() {
   const auto period = steady(options_.frameInterval);
   for (;;) {
     std::vector<SentCommand> commands;
-    double target = 0, ahead = 0, newest = 0;
+    std::vector<std::pair<double, Command>> timeline;  // for the region's scale
+    double target = 0, ahead = 0, newest = 0, spread = 0;
     bool newBase = false, newCommands = false, capped = false;
     if (!presentBell_.waitUntil(rung, std::chrono::steady_clock::now() + period)) return;
     if (const auto [version, latest] = bases_.latest(); version != seenBase) {
@@ -231,6 +232,8 @@ void Ghost::presentLoop() {
         ahead = target - from;
         target = from + options_.maxAhead;
       }
+      timeline = commands_.upTo(target);
+      spread = clock_.spread();
     }
     if (newBase && base->twin != twin) {
       twin = base->twin;
@@ -257,8 +260,18 @@ void Ghost::presentLoop() {
     const double wall = now();
     std::shared_ptr<TrailRequest> trail;
     if (newCommands || wall - lastTrail >= kTrailPeriod) {
-      trail = std::make_shared<TrailRequest>(TrailRequest{twin, w.snapshot(), t, next, base->latched, newCommands});
+      trail = std::make_shared<TrailRequest>(
+          TrailRequest{twin, w.snapshot(), t, next, base->latched, newCommands, base->made});
       lastTrail = wall;
+    }
+    double scale = 0, inner = 0, outer = 0;
+    std::string departure;
+    {
+      std::lock_guard lock(recordMutex_);
+      scale = scaleOf(t, base->made, std::hypot(r.baseLinearVelocity.x, r.baseLinearVelocity.y), timeline, spread);
+      inner = region_.multiplier(0) * scale;
+      outer = region_.multiplier(1) * scale;
+      if (watch_.departing()) departure = watch_.last()->describe();
     }
     const std::shared_ptr<const RobotFrame> reported = frames_.latest().second;
     {
@@ -274,10 +287,16 @@ void Ghost::presentLoop() {
       if (capped) v.problem = aheadProblem(ahead);
       else v.problem.clear();
       v.commands = next;
+      v.scale = scale;
+      v.inner = inner;
+      v.outer = outer;
+      v.innerLevel = params_.ghostRegionInner;
+      v.outerLevel = params_.ghostRegionOuter;
+      v.departure = std::move(departure);
     }
     {
       std::lock_guard lock(recordMutex_);
-      record_.shown(t, base->made, r.base);
+      record_.shown(t, base->made, r.base, scale);
     }
     {
       std::lock_guard lock(statsMutex_);
@@ -302,9 +321,13 @@ void Ghost::trailLoop() {
     std::shared_ptr<const TrailRequest> request;
     std::tie(seen, request) = trailRequests_.latest();
     std::vector<SentCommand> commands;
-    if (!request->latched && options_.inFlight) {
+    std::vector<std::pair<double, Command>> timeline;
+    double spread = 0;
+    {
       std::lock_guard lock(timelineMutex_);
-      commands = commands_.from(request->nextSeq);
+      if (!request->latched && options_.inFlight) commands = commands_.from(request->nextSeq);
+      timeline = commands_.upTo(request->time + params_.ghostHorizon);
+      spread = clock_.spread();
     }
     const double start = now();
     if (request->twin != twin) {
@@ -323,6 +346,14 @@ void Ghost::trailLoop() {
       return Vec3{p.x, p.y, w.terrainHeight(p.x, p.y)};
     };
     std::vector<Vec3> points{groundPoint()};
+    std::vector<double> band;
+    // The outer region's radius at a trail point of robot time `at`.
+    const auto bandAt = [&](double at) {
+      const Vec3 v = w.linkLinearVelocity(0, 0);
+      std::lock_guard lock(recordMutex_);
+      return region_.multiplier(1) * scaleOf(at, request->made, std::hypot(v.x, v.y), timeline, spread);
+    };
+    band.push_back(bandAt(t));
     // Given up when the commands changed meanwhile; a newer request that
     // only starts from a fresher state waits for this one to finish.
     const auto superseded = [&] {
@@ -334,12 +365,16 @@ void Ghost::trailLoop() {
     bool complete = true;
     for (int k = 1; k <= count && complete; ++k) {
       complete = advance(w, t, request->time + k * options_.trailSpacing, commands, next, superseded);
-      if (complete) points.push_back(groundPoint());
+      if (complete) {
+        points.push_back(groundPoint());
+        band.push_back(bandAt(t));
+      }
     }
     if (!complete && superseded()) continue;
     {
       std::lock_guard lock(viewMutex_);
       view_.trail = std::move(points);  // up to where it diverged, if it did
+      view_.trailBand = std::move(band);
       view_.trailTime = request->time;
       ++view_.version;
     }

@@ -15,7 +15,21 @@ std::vector<SentCommand> InFlightCommands::from(uint64_t seq) const {
 }
 
 void InFlightCommands::forgetBefore(double time) {
-  while (!commands_.empty() && commands_.front().time < time) commands_.pop_front();
+  while (!commands_.empty() && commands_.front().time < time) {
+    const Command& c = commands_.front().command;
+    if (std::holds_alternative<DriveCmd>(c) || std::holds_alternative<StopCmd>(c)) lastDrive_ = commands_.front();
+    commands_.pop_front();
+  }
+}
+
+std::vector<std::pair<double, Command>> InFlightCommands::upTo(double upTo) const {
+  std::vector<std::pair<double, Command>> out;
+  if (lastDrive_) out.emplace_back(lastDrive_->time, lastDrive_->command);
+  for (const SentCommand& c : commands_) {
+    if (c.time > upTo) break;
+    out.emplace_back(c.time, c.command);
+  }
+  return out;
 }
 
 }  // namespace sp

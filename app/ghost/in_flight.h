@@ -7,6 +7,8 @@
 
 #include <cstdint>
 #include <deque>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "sim/command.h"
@@ -26,16 +28,23 @@ class InFlightCommands {
   uint64_t add(const Command& command, double time);
   /// The commands with seq >= `from`, oldest first.
   std::vector<SentCommand> from(uint64_t seq) const;
+  /// The commands that take effect at robot times up to `upTo`, with
+  /// those times, oldest first (as far back as they are remembered).
+  std::vector<std::pair<double, Command>> upTo(double upTo) const;
   /// Forgets commands that took effect before robot time `time` (they are
   /// in the anchored state's set-points by then).
   void forgetBefore(double time);
   /// Forgets every command (the robot was reset); seqs go on counting.
-  void clear() { commands_.clear(); }
+  void clear() {
+    commands_.clear();
+    lastDrive_.reset();
+  }
   /// Commands sent so far: the next seq.
   uint64_t sent() const { return next_; }
 
  private:
   std::deque<SentCommand> commands_;  // oldest first
+  std::optional<SentCommand> lastDrive_;  // the newest drive or stop forgotten: the set-point before commands_
   uint64_t next_ = 0;
 };
 

@@ -16,9 +16,9 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-void PredictionRecord::shown(double time, double made, const Pose& base) {
+void PredictionRecord::shown(double time, double made, const Pose& base, double scale) {
   while (!shown_.empty() && shown_.back().time >= time) shown_.pop_back();  // superseded
-  shown_.push_back({time, made, base});
+  shown_.push_back({time, made, base, scale});
   while (shown_.front().time < time - kShownWindow) shown_.pop_front();
 }
 
@@ -36,6 +36,7 @@ std::optional<GhostError> PredictionRecord::compare(const RobotFrame& frame) {
   e.made = u < 0.5 ? a.made : b.made;
   e.predicted = u < 0.5 ? a.base : b.base;
   e.predicted.p = a.base.p + u * (b.base.p - a.base.p);
+  e.scale = a.scale + u * (b.scale - a.scale);
   e.position = std::hypot(e.predicted.p.x - frame.base.p.x, e.predicted.p.y - frame.base.p.y);
   e.heading = std::abs(std::remainder(heading(e.predicted.q) - heading(frame.base.q), 2 * kPi));
   errors_.push_back(e);

@@ -21,6 +21,15 @@ struct GhostError {
   Pose predicted;       ///< the ghost's base then
   double position = 0;  ///< [m] horizontal distance to the frame's base
   double heading = 0;   ///< [rad] absolute yaw difference
+  /// How sure the ghost was (app/ghost/ghost_region.h): the prediction's
+  /// error scale, and its regions' radii when telemetry judged it (0: the
+  /// ghost gave none).
+  double scale = 0;     ///< [m]
+  double inner = 0, outer = 0, limit = 0;  ///< [m] the inner, outer and departure regions
+  /// +1: this frame announced a departure; -1: it cleared one; 0: neither.
+  int departure = 0;
+  /// In a departure: not the files' world (the calibration leaves it out).
+  bool suspect = false;
 };
 
 class PredictionRecord {
@@ -32,7 +41,8 @@ class PredictionRecord {
   /// The ghost showed `base` for robot time `time`, predicted from the
   /// telemetry of robot time `made`. A later prediction for the same or an
   /// earlier time supersedes what was shown from then on.
-  void shown(double time, double made, const Pose& base);
+  /// `scale` [m]: its error scale (ghost_region.h; 0: none).
+  void shown(double time, double made, const Pose& base, double scale = 0);
   /// `frame` against what was shown for its time (interpolated between the
   /// two shown states around it), recorded; nullopt when nothing was shown
   /// within kMatchWindow of it.
@@ -49,6 +59,7 @@ class PredictionRecord {
   struct Shown {
     double time, made;  // robot time shown; of the telemetry it ran from
     Pose base;
+    double scale;
   };
   std::deque<Shown> shown_;
   std::deque<GhostError> errors_;

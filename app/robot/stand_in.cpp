@@ -48,14 +48,17 @@ std::unique_ptr<StandInRobot> StandInRobot::create(const StandInOptions& options
       model->robots[0].model = std::move(*robot);
     }
   }
-  if (diag.hasErrors() || !params || !model) return nullptr;
+  std::optional<WorldModel> ground;
+  if (!options.groundFile.empty()) ground = loadWorld(options.groundFile, diag);
+  if (diag.hasErrors() || !params || !model || (!options.groundFile.empty() && !ground)) return nullptr;
   if (options.realTimeFactor) params->realTimeFactor = *options.realTimeFactor;
   // A robot that is not its twin runs perturbed physics; what it announces
   // and logs as its files stays the files.
   std::optional<Perturbation> perturbation;
   if (options.perturbSeed) perturbation = drawPerturbation(*options.perturbSeed, model->robots[0].model);
   // A twin calibrated by the parameters (calibration.*) is calibrated here too.
-  const WorldModel physics = calibratedWorld(*model, *params);
+  WorldModel physics = calibratedWorld(*model, *params);
+  if (ground) physics.terrain = ground->terrain;  // the ground as it is, not as the map has it
   std::unique_ptr<World> world = World::create(perturbation ? perturbWorld(physics, *perturbation) : physics, *params, diag);
   if (!world) return nullptr;
   if (options.startState) {

@@ -49,6 +49,10 @@ struct StandInOptions {
   /// A robot file to run in place of the world's own robot (same name and
   /// pose in the world); "" = the world's.
   std::string robotFile;
+  /// A world whose terrain the robot really stands on in place of
+  /// worldFile's, which it still announces and logs as its files: ground
+  /// its map lacks (a ridge, a hollow; issue 61). "" = the world's.
+  std::string groundFile;
   std::string paramsFile;              ///< "" = built-in defaults
   std::vector<std::string> overrides;  ///< key=value, applied after the file
   std::string bind = "127.0.0.1";      ///< any other address needs a token

@@ -27,6 +27,9 @@ constexpr const char* kUsage = R"(usage:
                         relative name not found from the working directory
                         is taken from the data folder (installed with the
                         program; $SIMPARTNER_DATA overrides)
+      --ground FILE     stand on FILE's terrain instead of the world's, which
+                        is still announced and logged as the robot's files:
+                        ground its map lacks (terrains/rough_unmapped.world.xml)
       --port N          TCP port (default: port.robot of the parameters; 0 = any free port)
       --bind ADDRESS    address to listen on (default 127.0.0.1); any other
                         address needs --token
@@ -90,6 +93,7 @@ std::optional<int> parseArgs(const std::vector<std::string>& args, sp::StandInOp
     }
     const std::string& v = args[++i];
     if (a == "--world") options.worldFile = v;
+    else if (a == "--ground") options.groundFile = v;
     else if (a == "--params") options.paramsFile = v;
     else if (a == "--set") options.overrides.push_back(v);
     else if (a == "--bind") options.bind = v;
@@ -133,7 +137,7 @@ int perturbationReport(const sp::StandInOptions& options);
 // something is wrong.
 std::optional<int> checkOptions(sp::StandInOptions& options, bool perturbReport) {
   if (options.worldFile.empty()) options.worldFile = "terrains/flat.world.xml";
-  for (std::string* file : {&options.worldFile, &options.paramsFile}) {
+  for (std::string* file : {&options.worldFile, &options.paramsFile, &options.groundFile}) {
     std::string error;
     *file = sp::findDataFile(*file, error);
     if (!error.empty()) {

@@ -65,6 +65,12 @@ SimParams allChanged() {
   p.maxPenetration = 8;
   p.refineJointLimit = 5;
   p.refineYawRate = 9;
+  p.ghostRegionInner = 0.4;
+  p.ghostRegionOuter = 0.8;
+  p.ghostRegionDeparture = 0.95;
+  p.ghostRegionHold = 1;
+  p.ghostRegionWindow = 30;
+  p.ghostRegionGamma = 0.01;
   return p;
 }
 
@@ -141,7 +147,7 @@ void TestParams::tableDefaultsAreSimParamsDefaults() {
   std::set<std::string> seen;
   const QRegularExpression keyPattern("^[a-z]+(\\.[a-z_]+)+$");
   const std::vector<ParamInfo> table = paramTable();
-  QCOMPARE(table.size(), size_t(60));
+  QCOMPARE(table.size(), size_t(66));
   for (const ParamInfo& info : table) {
     QVERIFY2(seen.insert(info.key).second, info.key.c_str());
     QVERIFY2(keyPattern.match(q(info.key)).hasMatch(), info.key.c_str());
@@ -470,6 +476,11 @@ void TestParams::applyOverrideRejects_data() {
                              << "<command line>: error: physics.step: expected a number, got 'abc'\n";
   QTest::newRow("no value") << "physics.step=" << "<command line>: error: physics.step: expected a number, got ''\n";
   QTest::newRow("out of range") << "port.robot=0" << "<command line>: error: port.robot: must be >= 1, got 0\n";
+  // Issue 61: a region's level is a share, inside (0, 1).
+  QTest::newRow("a level of 1") << "ghost.region.outer=1"
+                                << "<command line>: error: ghost.region.outer: must be < 1, got 1\n";
+  QTest::newRow("a level of 0") << "ghost.region.inner=0"
+                                << "<command line>: error: ghost.region.inner: must be > 0, got 0\n";
 }
 
 // Bad overrides are reported against "<command line>" (no line number) and

@@ -1,0 +1,342 @@
+// Benchmark of how sure the ghost is (issue 61, app/ghost/ghost_region.h):
+// the coverage and sharpness of its regions and its departures, against a
+// stand-in over a 1 s each-way link. Prints a table, asserts nothing.
+//
+//   build/bench/bench_region [--seeds A-B] [--worlds rough,bumpy,track] [--seconds S]
+//                            [--departures A-B] [--matched] [--control]
+//
+// Each case: the console's session (app/console/console_session.h) with its
+// ghost and calibrator, a stand-in on loopback with the link's delay, a
+// client driving as the console does, 60 s of driving and turning drawn
+// from the seed (left turns and straights that stay on the world's
+// terrain; on the test track, gentle steering along it). Seed 0 is the
+// matched robot (the files); others are perturbed (sim/perturbation.h).
+//
+// Judged, after the first 20 s (the layer has learnt): every telemetry
+// frame against what the ghost showed for its time: inside the inner
+// (50 %) and outer (90 %) regions as they stood then; the outer radius's
+// median against the ghost's median error (sharpness); departures
+// announced on mapped ground (false alarms).
+//
+// --departures A-B: the rough field's robot stands on rough_unmapped's
+// ground (a 9 cm ridge at x = -2 m, a 7 cm hollow at x = 2 m) while the
+// console's map is rough.asc; for each crossing of either the time from
+// the front wheels meeting it to the departure's announcement (telemetry's
+// robot time: the departure is dated by the frame that announced it).
+//
+// --control: the conformal layer off (its Gaussian multipliers on the
+// scale alone), to show that the coverage figures can fail.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <deque>
+#include <mutex>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/console/console_session.h"
+#include "net/robot_client.h"
+#include "sim/math.h"
+
+using namespace sp;
+using namespace sp::net;
+
+namespace {
+
+const std::string kToken = "00112233445566778899aabbccddeeff";
+
+struct Phase {
+  double at;  // [s] after the drive's start
+  Command command;
+};
+
+// The drive of `seed` on `world` ("rough", "bumpy", "track") over `seconds`.
+std::vector<Phase> driveOf(const std::string& world, uint64_t seed, double seconds) {
+  std::mt19937_64 rng(seed * 7919 + 17);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Phase> out;
+  const auto add = [&out](double at, const Command& c) {
+    Phase& p = out.emplace_back();
+    p.at = at;
+    p.command = c;
+  };
+  double t = 0;
+  if (world == "track") {
+    // Along the 22 m track, 4 m wide: slow, steering a little either way.
+    double side = u(rng) < 0.5 ? 1 : -1;
+    while (t < seconds) {
+      const double speed = 0.22 + 0.1 * u(rng);
+      const double steer = degToRad(1 + 2.5 * u(rng)) * side;
+      add(t, DriveCmd{speed, steer});
+      t += 3 + 3 * u(rng);
+      side = -side;
+      if (u(rng) < 0.15) {
+        add(t, StopCmd{});
+        t += 1.5;
+      }
+    }
+    return out;
+  }
+  // Left turns and straights: a loop of radius about 4-5 m about a centre
+  // left of the start, inside the 20 m fields.
+  while (t < seconds) {
+    const double speed = 0.35 + 0.2 * u(rng);
+    add(t, DriveCmd{speed, degToRad(15 + 5 * u(rng))});
+    t += 5 + 4 * u(rng);
+    add(t, DriveCmd{speed, 0});
+    t += 1 + 2 * u(rng);
+    if (u(rng) < 0.2) {
+      add(t, StopCmd{});
+      t += 1.5;
+    }
+  }
+  add(seconds, StopCmd{});
+  return out;
+}
+
+struct Seen {
+  std::mutex mutex;
+  bool ready = false, lease = false;
+  std::deque<TelemetryMsg> telemetry;
+};
+
+struct Result {
+  int judged = 0, inner = 0, outer = 0;
+  std::vector<double> errors, radii;
+  int falseAlarms = 0;  // departures on mapped ground
+  std::vector<double> latencies;  // [s] feature met to departure announced (departure runs)
+  int crossings = 0, announced = 0;
+  double anchorsPerSecond = 0;
+  std::string error;
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// Front wheels' x (the robot's front axle, 0.55 m ahead of its base).
+double frontX(const TelemetryMsg& t) { return t.pose.p.x + 0.55 * std::cos(heading(t.pose.q)); }
+
+Result runCase(const std::string& world, uint64_t seed, double seconds, bool unmapped, bool control) {
+  Result r;
+  ConsoleSessionOptions o;
+  const std::string file = world == "track" ? "test_track" : world;
+  o.world = std::string(SP_SOURCE_DIR) + "/terrains/" + file + ".world.xml";
+  if (unmapped) o.ground = std::string(SP_SOURCE_DIR) + "/terrains/rough_unmapped.world.xml";
+  o.token = kToken;
+  o.log = false;
+  o.delay = 1.0;
+  o.overrides = {"link.deadman=0.5"};
+  if (seed != 0) o.perturbSeed = seed;
+  if (control) o.ghostOptions.conformal = false;
+  ConsoleSession session(o);
+  if (std::string e = session.start(); !e.empty()) {
+    r.error = e;
+    return r;
+  }
+  Seen seen;
+  RobotClientCallbacks cb;
+  cb.connection = [&](ConnectionState s, const std::string&) {
+    std::lock_guard lock(seen.mutex);
+    seen.ready = s == ConnectionState::Ready;
+  };
+  cb.lease = [&](const LeaseStateMsg& m) {
+    std::lock_guard lock(seen.mutex);
+    seen.lease = m.yours;
+  };
+  cb.telemetry = [&](const TelemetryMsg& t) {
+    std::lock_guard lock(seen.mutex);
+    seen.telemetry.push_back(t);
+  };
+  RobotClientConfig config = session.clientConfig("bench_region");
+  config.port = session.endpoint().port;
+  config.token = kToken;
+  RobotClient client(config, cb);
+  client.start();
+  const auto start = std::chrono::steady_clock::now();
+  const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  const auto wait = [&](auto pred) {
+    while (elapsed() < 30) {
+      {
+        std::lock_guard lock(seen.mutex);
+        if (pred()) return true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
+  };
+  if (!wait([&] { return seen.ready; })) {
+    r.error = "no connection";
+    return r;
+  }
+  client.acquireLease();
+  if (!wait([&] { return seen.lease; })) {
+    r.error = "no lease";
+    return r;
+  }
+  const std::vector<Phase> drive = driveOf(world, seed, seconds);
+  size_t next = 0;
+  const double t0 = elapsed();
+  double driveStart = -1;     // robot time of the first frame after the drive began
+  double met = -1;            // robot time the front wheels met a feature not yet announced
+  // The ridge's and the hollow's extents along x (terrains/README.md), and
+  // whether the front wheels were on each in the last frame.
+  const std::pair<double, double> features[] = {{-2.3, -1.7}, {1.6, 2.4}};
+  bool on[2] = {false, false};
+  const int64_t anchors0 = session.ghost() ? session.ghost()->stats().anchors : 0;
+  // Until the last command has come back in telemetry.
+  while (elapsed() - t0 < seconds + 2.5) {
+    while (next < drive.size() && elapsed() - t0 >= drive[next].at) {
+      client.sendCommand(drive[next].command, 0, session.robot());
+      session.commandSent(drive[next].command);
+      ++next;
+    }
+    std::deque<TelemetryMsg> batch;
+    {
+      std::lock_guard lock(seen.mutex);
+      batch.swap(seen.telemetry);
+    }
+    if (batch.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    for (const TelemetryMsg& t : batch) {
+      session.telemetry(t, elapsed(), client.stats().rttMs / 1000);
+      session.takeCalibration();
+      if (driveStart < 0) driveStart = t.time;
+      const std::optional<GhostError> e = session.lastPrediction();
+      const bool judged = t.time - driveStart >= 20 + 1.0 && e && e->scale > 0;
+      if (judged) {
+        ++r.judged;
+        r.inner += e->position <= e->inner;
+        r.outer += e->position <= e->outer;
+        r.errors.push_back(e->position);
+        r.radii.push_back(e->outer);
+      }
+      if (unmapped) {
+        // The front wheels coming onto a feature while none is pending.
+        const double x = frontX(t);
+        for (int k = 0; k < 2; ++k) {
+          const bool now = x >= features[k].first && x <= features[k].second;
+          if (now && !on[k] && met < 0 && t.time - driveStart > 2) {
+            met = t.time;
+            ++r.crossings;
+          }
+          on[k] = now;
+        }
+        if (e && e->departure == 1 && met >= 0) {
+          r.latencies.push_back(t.time - met);
+          ++r.announced;
+          met = -1;
+        } else if (met >= 0 && t.time - met > 4) {
+          met = -1;  // not announced within 4 s: missed
+        }
+      } else if (e && e->departure == 1 && t.time - driveStart >= 20) {
+        ++r.falseAlarms;
+      }
+    }
+  }
+  if (session.ghost())
+    r.anchorsPerSecond = static_cast<double>(session.ghost()->stats().anchors - anchors0) / (elapsed() - t0);
+  client.stop();
+  return r;
+}
+
+std::pair<uint64_t, uint64_t> range(const char* text) {
+  unsigned long long a = 0, b = 0;
+  if (std::sscanf(text, "%llu-%llu", &a, &b) == 2) return {a, b};
+  if (std::sscanf(text, "%llu", &a) == 1) return {a, a};
+  std::fprintf(stderr, "bench_region: expected A-B, got '%s'\n", text);
+  std::exit(2);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::pair<uint64_t, uint64_t> seeds{1, 20}, departures{0, 0};
+  bool runDepartures = false, matched = false, control = false;
+  std::string worlds = "rough,bumpy,track";
+  double seconds = 60;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--seeds" && i + 1 < argc) seeds = range(argv[++i]);
+    else if (a == "--worlds" && i + 1 < argc) worlds = argv[++i];
+    else if (a == "--seconds" && i + 1 < argc) seconds = std::atof(argv[++i]);
+    else if (a == "--departures" && i + 1 < argc) {
+      departures = range(argv[++i]);
+      runDepartures = true;
+    } else if (a == "--matched") matched = true;
+    else if (a == "--control") control = true;
+    else {
+      std::fprintf(stderr,
+                   "usage: bench_region [--seeds A-B] [--worlds rough,bumpy,track] [--seconds S] [--departures A-B] "
+                   "[--matched] [--control]\n");
+      return 2;
+    }
+  }
+  if (runDepartures) {
+    std::printf("departures: rough field's map, rough_unmapped's ground, 1 s each way, %.0f s each\n", seconds);
+    std::printf("%6s %9s %9s %s\n", "seed", "crossings", "announced", "latencies [s]");
+    int within = 0, crossings = 0;
+    for (uint64_t s = departures.first; s <= departures.second; ++s) {
+      const Result r = runCase("rough", s, seconds, true, control);
+      if (!r.error.empty()) {
+        std::printf("%6llu error: %s\n", static_cast<unsigned long long>(s), r.error.c_str());
+        continue;
+      }
+      std::string lat;
+      for (double l : r.latencies) {
+        char b[16];
+        std::snprintf(b, sizeof b, " %.2f", l);
+        lat += b;
+        within += l <= 1.0;
+      }
+      crossings += r.crossings;
+      std::printf("%6llu %9d %9d%s\n", static_cast<unsigned long long>(s), r.crossings, r.announced, lat.c_str());
+      std::fflush(stdout);
+    }
+    std::printf("announced within 1 s: %d of %d crossings\n", within, crossings);
+    return 0;
+  }
+  std::printf("coverage: 1 s each way, %.0f s each, judged after 20 s%s\n", seconds,
+              control ? " (control: the conformal layer off)" : "");
+  std::printf("%-6s %6s %7s %7s %7s %9s %9s %6s %6s %8s\n", "world", "seed", "judged", "in 50", "in 90", "err med",
+              "r90 med", "ratio", "false", "anchor/s");
+  size_t from = 0;
+  while (from <= worlds.size()) {
+    const size_t comma = worlds.find(',', from);
+    const std::string w = worlds.substr(from, comma == std::string::npos ? std::string::npos : comma - from);
+    from = comma == std::string::npos ? worlds.size() + 1 : comma + 1;
+    int judged = 0, inner = 0, outer = 0, alarms = 0;
+    std::vector<double> ratios;
+    std::vector<uint64_t> list;
+    if (matched) list.push_back(0);
+    for (uint64_t s = seeds.first; s <= seeds.second && s > 0; ++s) list.push_back(s);
+    for (uint64_t s : list) {
+      const Result r = runCase(w, s, seconds, false, control);
+      if (!r.error.empty()) {
+        std::printf("%-6s %6llu error: %s\n", w.c_str(), static_cast<unsigned long long>(s), r.error.c_str());
+        continue;
+      }
+      const double em = median(r.errors), rm = median(r.radii);
+      std::printf("%-6s %6llu %7d %7.3f %7.3f %8.1fmm %8.1fmm %6.2f %6d %8.1f\n", w.c_str(),
+                  static_cast<unsigned long long>(s), r.judged, r.judged ? double(r.inner) / r.judged : NAN,
+                  r.judged ? double(r.outer) / r.judged : NAN, em * 1000, rm * 1000, rm / em, r.falseAlarms,
+                  r.anchorsPerSecond);
+      std::fflush(stdout);
+      judged += r.judged;
+      inner += r.inner;
+      outer += r.outer;
+      alarms += r.falseAlarms;
+      ratios.push_back(rm / em);
+    }
+    if (judged)
+      std::printf("%-6s %6s %7d %7.3f %7.3f %9s %9s %6.2f %6d\n", w.c_str(), "all", judged, double(inner) / judged,
+                  double(outer) / judged, "", "", median(ratios), alarms);
+  }
+  return 0;
+}
