@@ -32,15 +32,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <deque>
-#include <mutex>
 #include <random>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "app/console/console_session.h"
-#include "net/robot_client.h"
+#include "app/console/session_drive.h"
 #include "sim/math.h"
 
 using namespace sp;
@@ -50,18 +47,13 @@ namespace {
 
 const std::string kToken = "00112233445566778899aabbccddeeff";
 
-struct Phase {
-  double at;  // [s] after the drive's start
-  Command command;
-};
-
 // The drive of `seed` on `world` ("rough", "bumpy", "track") over `seconds`.
-std::vector<Phase> driveOf(const std::string& world, uint64_t seed, double seconds) {
+std::vector<DrivePhase> driveOf(const std::string& world, uint64_t seed, double seconds) {
   std::mt19937_64 rng(seed * 7919 + 17);
   std::uniform_real_distribution<double> u(0, 1);
-  std::vector<Phase> out;
+  std::vector<DrivePhase> out;
   const auto add = [&out](double at, const Command& c) {
-    Phase& p = out.emplace_back();
+    DrivePhase& p = out.emplace_back();
     p.at = at;
     p.command = c;
   };
@@ -99,12 +91,6 @@ std::vector<Phase> driveOf(const std::string& world, uint64_t seed, double secon
   return out;
 }
 
-struct Seen {
-  std::mutex mutex;
-  bool ready = false, lease = false;
-  std::deque<TelemetryMsg> telemetry;
-};
-
 struct Result {
   int judged = 0, inner = 0, outer = 0;
   std::vector<double> errors, radii;
@@ -121,8 +107,13 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Front wheels' x (the robot's front axle, 0.55 m ahead of its base).
-double frontX(const TelemetryMsg& t) { return t.pose.p.x + 0.55 * std::cos(heading(t.pose.q)); }
+// The axles' x: the base is the rear body, whose frame is 0.45 m behind
+// the robot's; the front wheels 1.0 m ahead of it, the rear 0.1 m behind
+// (robots/workpartner.xml), the articulation taken straight.
+std::pair<double, double> axlesX(const TelemetryMsg& t) {
+  const double c = std::cos(heading(t.pose.q));
+  return {t.pose.p.x + 1.0 * c, t.pose.p.x - 0.1 * c};
+}
 
 Result runCase(const std::string& world, uint64_t seed, double seconds, bool unmapped, bool control) {
   Result r;
@@ -141,74 +132,19 @@ Result runCase(const std::string& world, uint64_t seed, double seconds, bool unm
     r.error = e;
     return r;
   }
-  Seen seen;
-  RobotClientCallbacks cb;
-  cb.connection = [&](ConnectionState s, const std::string&) {
-    std::lock_guard lock(seen.mutex);
-    seen.ready = s == ConnectionState::Ready;
-  };
-  cb.lease = [&](const LeaseStateMsg& m) {
-    std::lock_guard lock(seen.mutex);
-    seen.lease = m.yours;
-  };
-  cb.telemetry = [&](const TelemetryMsg& t) {
-    std::lock_guard lock(seen.mutex);
-    seen.telemetry.push_back(t);
-  };
-  RobotClientConfig config = session.clientConfig("bench_region");
-  config.port = session.endpoint().port;
-  config.token = kToken;
-  RobotClient client(config, cb);
-  client.start();
-  const auto start = std::chrono::steady_clock::now();
-  const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  const auto wait = [&](auto pred) {
-    while (elapsed() < 30) {
-      {
-        std::lock_guard lock(seen.mutex);
-        if (pred()) return true;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return false;
-  };
-  if (!wait([&] { return seen.ready; })) {
-    r.error = "no connection";
-    return r;
-  }
-  client.acquireLease();
-  if (!wait([&] { return seen.lease; })) {
-    r.error = "no lease";
-    return r;
-  }
-  const std::vector<Phase> drive = driveOf(world, seed, seconds);
-  size_t next = 0;
-  const double t0 = elapsed();
   double driveStart = -1;     // robot time of the first frame after the drive began
   double met = -1;            // robot time the front wheels met a feature not yet announced
-  // The ridge's and the hollow's extents along x (terrains/README.md), and
-  // whether the front wheels were on each in the last frame.
+  // The ridge's and the hollow's extents along x (terrains/README.md):
+  // the robot meets one when an axle reaches its edge (where a cosine
+  // ridge starts from nothing, a tyre's front touches it no earlier).
   const std::pair<double, double> features[] = {{-2.3, -1.7}, {1.6, 2.4}};
-  bool on[2] = {false, false};
+  bool on = false;  // an axle was on a feature in the last frame
   const int64_t anchors0 = session.ghost() ? session.ghost()->stats().anchors : 0;
+  const auto wall0 = std::chrono::steady_clock::now();
   // Until the last command has come back in telemetry.
-  while (elapsed() - t0 < seconds + 2.5) {
-    while (next < drive.size() && elapsed() - t0 >= drive[next].at) {
-      client.sendCommand(drive[next].command, 0, session.robot());
-      session.commandSent(drive[next].command);
-      ++next;
-    }
-    std::deque<TelemetryMsg> batch;
-    {
-      std::lock_guard lock(seen.mutex);
-      batch.swap(seen.telemetry);
-    }
-    if (batch.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    for (const TelemetryMsg& t : batch) {
-      session.telemetry(t, elapsed(), client.stats().rttMs / 1000);
-      session.takeCalibration();
+  const std::string why = driveSession(session, kToken, driveOf(world, seed, seconds), seconds + 2.5,
+                                       [&](const TelemetryMsg& t, const std::optional<GhostError>& e) {
       if (driveStart < 0) driveStart = t.time;
-      const std::optional<GhostError> e = session.lastPrediction();
       const bool judged = t.time - driveStart >= 20 + 1.0 && e && e->scale > 0;
       if (judged) {
         ++r.judged;
@@ -217,17 +153,28 @@ Result runCase(const std::string& world, uint64_t seed, double seconds, bool unm
         r.errors.push_back(e->position);
         r.radii.push_back(e->outer);
       }
+      if (std::getenv("SP_BENCH_TRACE") && e)
+        std::fprintf(stderr, "%.2f x %.2f err %.1f lim %.1f vert %.1f vlim %.1f scale %.1f dep %d sus %d\n", t.time,
+                     axlesX(t).first, e->position * 1000, e->limit * 1000, e->vertical * 1000, e->verticalLimit * 1000,
+                     e->scale * 1000, e->departure, e->suspect);
       if (unmapped) {
-        // The front wheels coming onto a feature while none is pending.
-        const double x = frontX(t);
-        for (int k = 0; k < 2; ++k) {
-          const bool now = x >= features[k].first && x <= features[k].second;
-          if (now && !on[k] && met < 0 && t.time - driveStart > 2) {
+        // An axle coming onto a feature: the robot meets it (once per
+        // crossing: the next needs both axles off first).
+        const auto [front, rear] = axlesX(t);
+        bool now = false;
+        for (const auto& [lo, hi] : features)
+          for (double x : {front, rear}) now |= x >= lo && x <= hi;
+        if (now && !on && met < 0 && t.time - driveStart > 2) {
+          ++r.crossings;
+          if (session.ghost() && !session.ghost()->departures().empty() &&
+              session.ghost()->departures().back().ended < 0) {
+            r.latencies.push_back(0);  // a departure on already
+            ++r.announced;
+          } else {
             met = t.time;
-            ++r.crossings;
           }
-          on[k] = now;
         }
+        on = now;
         if (e && e->departure == 1 && met >= 0) {
           r.latencies.push_back(t.time - met);
           ++r.announced;
@@ -238,11 +185,10 @@ Result runCase(const std::string& world, uint64_t seed, double seconds, bool unm
       } else if (e && e->departure == 1 && t.time - driveStart >= 20) {
         ++r.falseAlarms;
       }
-    }
-  }
-  if (session.ghost())
-    r.anchorsPerSecond = static_cast<double>(session.ghost()->stats().anchors - anchors0) / (elapsed() - t0);
-  client.stop();
+  });
+  r.error = why;
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (session.ghost()) r.anchorsPerSecond = static_cast<double>(session.ghost()->stats().anchors - anchors0) / wall;
   return r;
 }
 

@@ -67,13 +67,17 @@ struct ConsoleFlags {
   QCommandLineOption perturb = valued({QStringLiteral("perturb")},
                                       "The stand-in is a robot that is not its twin: hidden deviations from the files drawn "
                                       "from SEED (simpartner-robot --help lists them).", "SEED");
+  QCommandLineOption ground = valued({QStringLiteral("ground")},
+                                     "The stand-in stands on FILE's terrain, not the drawn world's: ground the "
+                                     "console's map lacks (terrains/rough_unmapped.world.xml beside --world "
+                                     "terrains/rough.world.xml).", "FILE");
   QCommandLineOption noGhost = flag("no-ghost", "Do not run the predictive ghost.");
   QCommandLineOption noCalibration = flag("no-calibration", "Do not calibrate the twin from telemetry while driving.");
   QCommandLineOption errorDialog = flag("error-dialog",
                                         "Show an error that stops the start in a dialog too (the desktop entry sets it: no "
                                         "terminal shows stderr there).");
   QList<QCommandLineOption> all() const {
-    return {errorDialog, world, params, set, connectTo, token, logDir, noLog, rtf, delay, perturb, noGhost,
+    return {errorDialog, world, params, set, connectTo, token, logDir, noLog, rtf, delay, perturb, ground, noGhost,
             noCalibration, screenshot, quitAfter};
   }
 };
@@ -146,6 +150,13 @@ std::optional<int> readOptions(const QCommandLineParser& parser, const ConsoleFl
     options.perturbSeed = seed;
     if (!options.connectTo.isEmpty()) {
       std::cerr << "<command line>: error: --perturb changes the built-in stand-in; it does not go with --connect\n";
+      return 2;
+    }
+  }
+  if (parser.isSet(f.ground)) {
+    options.ground = findDataFile(parser.value(f.ground));
+    if (!options.connectTo.isEmpty()) {
+      std::cerr << "<command line>: error: --ground changes the built-in stand-in; it does not go with --connect\n";
       return 2;
     }
   }

@@ -1,6 +1,7 @@
 #include "ui/console_monitor.h"
 
 #include "app/console/console_session.h"
+#include "app/ghost/ghost.h"
 #include "ui/robot_connection.h"
 #include "ui/robot_feed.h"
 
@@ -59,10 +60,25 @@ ConsoleMonitor::ConsoleMonitor(RobotConnection* connection, LiveLinkFeed* live, 
   connect(live, &RobotFeed::frame, this, [this](const RobotFrame& f) {
     if (!session_->robot()) return;
     const FrameChanges changes = state_.frame(f, wallSeconds(), session_->edgeDistance(f.base));
+    watchDepartures();
     if (changes.latchedNow) emit robotStopped();  // a latch that comes on stopped the robot
     if (changes.latches) emit latchesChanged(state_.failsafe(), state_.estop());
     notify();
   });
+}
+
+void ConsoleMonitor::watchDepartures() {
+  const Ghost* ghost = session_->ghost();
+  if (!ghost) return;
+  const size_t count = ghost->departureCount();
+  const std::optional<Departure> on = ghost->departing();
+  state_.departure(on ? on->describe() : std::string());
+  if (count < departuresSeen_) departuresSeen_ = 0;  // a reset or a new ghost
+  if (count == departuresSeen_) return;
+  departuresSeen_ = count;
+  const std::vector<Departure> all = ghost->departures();
+  if (all.empty()) return;
+  emit departure(all.back().where, QString::fromStdString(all.back().describe()));
 }
 
 void ConsoleMonitor::tick() {

@@ -12,6 +12,7 @@
 #include <QString>
 
 #include "app/console/console_state.h"
+#include "sim/math.h"
 
 namespace sp {
 
@@ -45,6 +46,9 @@ class ConsoleMonitor : public QObject {
   void latchesChanged(bool failsafe, bool estop);
   /// The robot runs other files than the console's (said once per connection).
   void filesDiffer(const QString& text);
+  /// The robot began to depart from its twin at `where` (its base), for
+  /// the operator in `text` (the banner says it too, until it clears).
+  void departure(const sp::Vec3& where, const QString& text);
 
  private:
   ConsoleSession* session_;
@@ -52,6 +56,9 @@ class ConsoleMonitor : public QObject {
   ConsoleState state_;
   QElapsedTimer clock_;
   uint64_t notified_ = ~uint64_t{0};
+  size_t departuresSeen_ = 0;  // of the ghost's departures, the ones announced
+  /// The ghost's departures into the state (the banner) and `departure`.
+  void watchDepartures();
 };
 
 }  // namespace sp

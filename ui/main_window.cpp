@@ -60,6 +60,7 @@ ConsoleSessionOptions toSessionOptions(const ConsoleOptions& o, const QString& l
   s.rtf = o.rtf;
   s.delay = o.delay;
   s.perturbSeed = o.perturbSeed;
+  s.ground = o.ground.toStdString();
   s.ghost = o.ghost;
   s.calibrate = o.calibrate;
   return s;
@@ -169,6 +170,15 @@ void MainWindow::buildFeeds() {
   connect(ghostFeed_, &RobotFeed::frame, this,
           [this](const RobotFrame& f) { scene_->setGhostState(f.base, f.jointPositions); });
   connect(ghostFeed_, &GhostFeed::trail, scene_, &SceneView::setGhostTrail);
+  connect(ghostFeed_, &GhostFeed::trailBand, scene_, &SceneView::setGhostTrailBand);
+  connect(ghostFeed_, &GhostFeed::region, scene_, &SceneView::setGhostRegion);
+  // A departure: in the event list (the session log has it from the
+  // telemetry's thread), marked on the ground, said by the banner.
+  connect(monitor_, &ConsoleMonitor::departure, this, [this](const Vec3& where, const QString& text) {
+    departures_.push_back(where);
+    scene_->setDepartureMarks(departures_, true);
+    context_->event(QStringLiteral("departure"), text, false);
+  });
 }
 
 void MainWindow::buildPlots() {
@@ -595,6 +605,10 @@ void MainWindow::stateChanged() {
   banner_->setStyleSheet(
       QStringLiteral("QLabel { background: %1; color: white; font-weight: bold; padding: 6px; }").arg(QLatin1String(background)));
   banner_->setProperty("alarm", now.bannerAlarm());
+  if (const bool on = !now.departureText().empty(); on != departureOn_) {
+    departureOn_ = on;
+    scene_->setDepartureMarks(departures_, on);
+  }
   emit context_->stateChanged();
 }
 

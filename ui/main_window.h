@@ -70,6 +70,7 @@ struct ConsoleOptions {
   double rtf = -1;            ///< stand-in real-time factor; < 0 = the parameters'
   double delay = 0;           ///< [s] one-way delay the stand-in's link emulates (each way)
   std::optional<uint64_t> perturbSeed;  ///< the stand-in is a robot that is not its twin (sim/perturbation.h)
+  QString ground;  ///< the stand-in stands on this world's terrain (ConsoleSessionOptions::ground)
   bool ghost = true;          ///< run and show the predictive ghost
   bool calibrate = true;      ///< calibrate the twin from telemetry (app/calibration/live_calibrator.h)
 };
@@ -217,6 +218,8 @@ class MainWindow : public QMainWindow, public ConsoleHost {
   QAction* ghostAction_ = nullptr;
   bool ghostShownBeforeReplay_ = false;
   QLabel* banner_ = nullptr;
+  std::vector<Vec3> departures_;  // where the robot departed from its twin (marked on the ground)
+  bool departureOn_ = false;
   QWidget* bannerRow_ = nullptr;        // the banner and its Reset button
   QPushButton* bannerReset_ = nullptr;  // shown when the twin diverged or the robot is off the terrain
   QLabel* staleLabel_ = nullptr;

@@ -86,9 +86,11 @@ void GhostFeed::poll() {
   version_ = v.version;
   if (v.version == 0) return;  // nothing predicted yet: the ghost stays where it is
   emit frame(frameFromGhost(v));
+  emit region(v.inner, v.outer);
   if (v.trailTime != trailTime_) {
     trailTime_ = v.trailTime;
     emit trail(v.trail);
+    emit trailBand(v.trailBand);
   }
 }
 

@@ -121,6 +121,10 @@ class GhostFeed : public RobotFeed {
  signals:
   /// The ghost's predicted path (ground points) changed.
   void trail(const std::vector<sp::Vec3>& points);
+  /// ... and its band: the outer region's radius at each point [m].
+  void trailBand(const std::vector<double>& radii);
+  /// The ghost's inner and outer regions about its base [m] (with each frame).
+  void region(double inner, double outer);
 
  private:
   ConsoleSession* session_;

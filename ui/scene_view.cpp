@@ -15,6 +15,7 @@ SceneView::Impl::Impl() {
   buildPhantom(rehearsal, {1.00f, 0.70f, 0.15f, 0.50f}, {0.95f, 0.45f, 0.00f, 1.0f}, false);
   buildLaser();
   root->addChild(laserNode);
+  buildRegion();
   // The brush footprint: a yellow ring, unlit, drawn over the ground.
   footprintNode = new osg::Geode;
   footprint = newGeometry();
@@ -144,6 +145,7 @@ void SceneView::Impl::sync() {
     robotDirty = false;
     laserDirty = true;  // the laser rides on the robot
   }
+  syncRegion();  // before the ghost's path is marked clean
   syncPhantom(ghost);
   syncPhantom(rehearsal);
   if (stale != staleShown) {

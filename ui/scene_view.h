@@ -82,6 +82,21 @@ class SceneView : public QOpenGLWidget {
   void setGhostTrail(const std::vector<Vec3>& points);
   /// Points of the trail drawn in the last frame (0 while hidden).
   size_t drawnTrailPoints() const;
+  /// How sure the ghost is (app/ghost/ghost_region.h), drawn with it: its
+  /// inner and outer regions about its base, discs [m] on the ground (0:
+  /// none), and the trail's band, the outer region's radius at each point
+  /// of setGhostTrail()'s (empty: no band).
+  void setGhostRegion(double inner, double outer);
+  void setGhostTrailBand(const std::vector<double>& radii);
+  /// The outer disc's radius and the band's points drawn in the last frame
+  /// (0 while hidden).
+  double drawnGhostRegion() const;
+  size_t drawnTrailBand() const;
+  /// Where the robot departed from its twin (its base at each departure's
+  /// start), marked on the ground in red whether the ghost is shown or not;
+  /// `lastOn`: the last one is on now (drawn brighter).
+  void setDepartureMarks(const std::vector<Vec3>& places, bool lastOn);
+  size_t drawnDepartureMarks() const;
   /// Where the ghost's base link was drawn in the last frame; the identity
   /// while it is hidden.
   Pose drawnGhostBasePose() const;

@@ -446,6 +446,19 @@ struct SceneView::Impl {
     bool bodyShown = true;  // false: only its path (the rehearsal's robot after the run)
   };
   Phantom ghost, rehearsal;
+  // How sure the ghost is (scene_region.cpp): its discs about its base and
+  // the trail's band, translucent on the ground, shown with the ghost; the
+  // departures' marks, shown always.
+  struct Region {
+    osg::ref_ptr<osg::Geode> node, marksNode;
+    osg::ref_ptr<osg::Geometry> inner, outer, bandStrip, marks;
+    double innerRadius = 0, outerRadius = 0;
+    std::vector<double> band;  // per ghost.pathPoints
+    std::vector<Vec3> places;  // departures
+    bool lastOn = false;
+    bool dirty = false, marksDirty = false;
+    Vec3 drawnAt;  // the ghost's base the discs were drawn about
+  } region;
   osg::ref_ptr<osg::Geode> laserNode;
   osg::ref_ptr<osg::Geometry> beams, hits;
   // The terrain as drawn (its heights kept up to date by edits), its mesh,
@@ -516,6 +529,8 @@ struct SceneView::Impl {
   // opaque line in `line`) under root.
   void buildPhantom(Phantom& p, osg::Vec4 body, osg::Vec4 line, bool seeThrough);
   void syncPhantom(Phantom& p);
+  void buildRegion();
+  void syncRegion();
   /// Whether `p` stands where the robot is drawn (kCoincide): then it is not drawn.
   bool coincides(const Phantom& p) const;
   struct Coincide {

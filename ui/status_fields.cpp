@@ -1,5 +1,7 @@
 #include "ui/status_fields.h"
 
+#include <cmath>
+
 #include <QFileInfo>
 #include <QLabel>
 #include <QStatusBar>
@@ -58,7 +60,9 @@ void StatusFields::refresh(const ConsoleState& state, const ConsoleSession& sess
   health_->setToolTip(qs(h.detail));
 
   ghost_->setToolTip(tr("The ghost: how far ahead of the newest telemetry it shows the robot (the link's round "
-                        "trip and the telemetry's age), and its error against the telemetry, median over 10 s"));
+                        "trip and the telemetry's age), its error against the telemetry (median over 10 s), and the "
+                        "radius of its outer region (the band along its trail): the share of predictions it holds "
+                        "is stated and checked against telemetry (held)"));
   if (state.replaying()) {
     ghost_->setText(tr("ghost off (replay)"));
   } else if (const Ghost* ghost = session.ghost(); !ghost) {
@@ -77,6 +81,14 @@ void StatusFields::refresh(const ConsoleState& state, const ConsoleSession& sess
       if (const auto worst = ghost->errorWorst())
         g += *worst < 1 ? tr(" (max %1 cm)").arg(*worst * 100, 0, 'f', 1) : tr(" (max %1 m)").arg(*worst, 0, 'f', 2);
     }
+    // How far to trust it: the outer region's radius, and how often the
+    // region held the robot so far (the figure the layer makes true).
+    if (v.outer > 0) {
+      const Ghost::Coverage c = ghost->coverage();
+      g += tr(", %1 % within %2 cm").arg(std::lround(v.outerLevel * 100)).arg(v.outer * 100, 0, 'f', 1);
+      if (c.judged >= 100) g += tr(" (held %1 %)").arg(std::lround(c.share[1] * 100));
+    }
+    if (!v.departure.empty()) g = alarm(g);
     ghost_->setText(g);
   }
 

@@ -50,6 +50,12 @@ void ConsoleState::filesMismatch(std::string text) {
   ++revision_;
 }
 
+void ConsoleState::departure(std::string text) {
+  if (text == departure_) return;
+  departure_ = std::move(text);
+  ++revision_;
+}
+
 void ConsoleState::terrain(bool heightfield, double width, double depth) {
   heightfield_ = heightfield;
   terrainWidth_ = width;
@@ -255,6 +261,9 @@ std::vector<std::string> ConsoleState::bannerLines() const {
                                      " m heightfield; beyond it the robot falls.");
   }
   if (!filesMismatch_.empty()) lines.push_back(live + filesMismatch_);
+  if (!departure_.empty())
+    lines.push_back(live + "The ghost cannot be trusted here: " + departure_ +
+                    ". The calibration leaves this stretch out.");
   if (slowTwin_ && !replaying())
     lines.push_back("The stand-in's twin runs at " + fixed(shownFactor_, 2) + " × real time (asked " +
                     fixed(targetFactor_, 2) + "): this machine cannot keep up, and the robot, its deadman and the "

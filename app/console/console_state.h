@@ -70,6 +70,10 @@ class ConsoleState {
   void failsafeReason(std::string text);
   /// The robot runs other files than the console's ("" = the same).
   void filesMismatch(std::string text);
+  /// The robot departs from its twin (app/ghost/ghost_region.h): the
+  /// banner says so in `text` until it clears ("").
+  void departure(std::string text);
+  const std::string& departureText() const { return departure_; }
   /// The drawn terrain: a heightfield of `width` × `depth` [m], or a plane.
   void terrain(bool heightfield, double width, double depth);
   /// A live telemetry frame arrived at wall time `wall` [s]; `edge` is how
@@ -178,6 +182,7 @@ class ConsoleState {
   std::string health_;
   std::string failsafeReason_;
   std::string filesMismatch_;
+  std::string departure_;
   bool heightfield_ = false;
   double terrainWidth_ = 0, terrainDepth_ = 0;
   std::optional<double> edge_;

@@ -40,7 +40,15 @@ ConformalLayer::Options layerOptions(const SimParams& p, bool conformal = true) 
 }  // namespace
 
 Ghost::Ghost(const WorldModel& world, const SimParams& params, const Options& options)
-    : model_(world), params_(params), options_(options), region_(layerOptions(params, options.conformal)) {
+    : model_(world),
+      params_(params),
+      options_(options),
+      region_(layerOptions(params, options.conformal)),
+      vertical_([&] {
+        ConformalLayer::Options o = layerOptions(params, options.conformal);
+        o.levels = {params.ghostRegionDeparture};
+        return o;
+      }()) {
   DepartureWatch::Options o;
   o.hold = params.ghostRegionHold;
   watch_ = DepartureWatch(o);
@@ -197,6 +205,7 @@ std::optional<GhostError> Ghost::anchor(const RobotFrame& frame, double roundTri
     if (reset) {
       record_.clear();
       region_.clear();
+      vertical_.clear();
       watch_.clear();
       departures_.clear();
       pending_.clear();
@@ -219,8 +228,14 @@ void Ghost::judge(GhostError& e, const RobotFrame& frame) {
   e.outer = region_.multiplier(1) * e.scale;
   e.limit = region_.multiplier(2) * e.scale;
   const double score = e.position / e.scale;
+  const double vscale = verticalScale(e.scale, errorModel_);
+  e.vertical = verticalOf(e.predicted, frame.base, errorModel_);
+  e.verticalLimit = vertical_.multiplier(0) * vscale;
+  const double vscore = e.vertical / vscale;
   region_.judge(score);
-  const DepartureWatch::Change change = watch_.judge(frame.time, frame.base.p, e.position, e.limit);
+  vertical_.judge(vscore);
+  const DepartureWatch::Change change =
+      watch_.judge(frame.time, frame.base.p, e.position, e.limit, e.vertical, e.verticalLimit);
   if (change == DepartureWatch::Change::Began) {
     departures_.push_back(*watch_.last());
     e.departure = 1;
@@ -233,12 +248,16 @@ void Ghost::judge(GhostError& e, const RobotFrame& frame) {
   e.suspect = watch_.departing();
   const bool lasting = watch_.departing() && frame.time - watch_.last()->time > kLasting;
   if (watch_.suspect() && !lasting) {
-    pending_.push_back({frame.time, score});
+    pending_.push_back({frame.time, score, vscore});
     return;
   }
-  for (const PendingScore& p : pending_) region_.learn(p.time, p.score);  // a run outside that was no departure
+  for (const PendingScore& p : pending_) {  // a run outside that was no departure
+    region_.learn(p.time, p.score);
+    vertical_.learn(p.time, p.vertical);
+  }
   pending_.clear();
   region_.learn(frame.time, score);
+  vertical_.learn(frame.time, vscore);
 }
 
 double Ghost::scaleOf(double t, double made, double speed, const std::vector<std::pair<double, Command>>& timeline,
@@ -262,6 +281,17 @@ ErrorModel Ghost::errorModel() const {
 std::vector<Departure> Ghost::departures() const {
   std::lock_guard lock(recordMutex_);
   return departures_;
+}
+
+size_t Ghost::departureCount() const {
+  std::lock_guard lock(recordMutex_);
+  return departures_.size();
+}
+
+std::optional<Departure> Ghost::departing() const {
+  std::lock_guard lock(recordMutex_);
+  if (!watch_.departing()) return std::nullopt;
+  return watch_.last();
 }
 
 Ghost::Coverage Ghost::coverage() const {

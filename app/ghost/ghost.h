@@ -184,6 +184,10 @@ class Ghost {
   /// The departures telemetry showed since the last reset, oldest first
   /// (the last may still be on: ended < 0).
   std::vector<Departure> departures() const;
+  /// How many departures began since the last reset (cheap to poll).
+  size_t departureCount() const;
+  /// The departure on now, if one is.
+  std::optional<Departure> departing() const;
   /// The share of judged frames inside the inner, outer and departure
   /// regions (as each stood when the frame came), and how many were judged.
   struct Coverage {
@@ -291,10 +295,11 @@ class Ghost {
   PredictionRecord record_;  // what was shown against what came
   ErrorModel errorModel_;    // the region's sources besides the link
   ConformalLayer region_;    // inner, outer, departure
+  ConformalLayer vertical_;  // the departure's level, over the vertical pose's scores
   DepartureWatch watch_;
   std::vector<Departure> departures_;
   struct PendingScore {
-    double time, score;
+    double time, score, vertical;
   };
   std::vector<PendingScore> pending_;  // frames outside, kept from the layer until judged no departure
 

@@ -57,6 +57,18 @@ ErrorModel errorModelFor(const WorldModel& world) {
   return m;
 }
 
+double verticalScale(double horizontal, const ErrorModel& m) {
+  const double floor = m.floor * 0.75, slope = 0.15 * horizontal;
+  return std::sqrt(floor * floor + m.terrain * m.terrain + slope * slope);
+}
+
+double verticalOf(const Pose& predicted, const Pose& actual, const ErrorModel& m) {
+  const Vec3 a = rpyFromQuat(predicted.q), b = rpyFromQuat(actual.q);
+  const double roll = std::abs(std::remainder(a.x - b.x, 2 * kPi)) * m.track / 2;
+  const double pitch = std::abs(std::remainder(a.y - b.y, 2 * kPi)) * m.wheelbase / 2;
+  return std::max({std::abs(predicted.p.z - actual.p.z), roll, pitch});
+}
+
 double gaussianMultiplier(double level) { return std::sqrt(-2 * std::log(1 - level)); }
 
 std::string ConformalLayer::checkLevels(const std::vector<double>& levels) {
@@ -97,10 +109,14 @@ void ConformalLayer::learn(double time, double score) {
   if (!std::isfinite(score) || score < 0) return;
   // Adaptive conformal inference: a miss raises the level the quantile is
   // taken at, a hit lowers it, so that misses come at 1 - level.
+  // A high level's step is smaller in proportion (at 99 %, a tenth): with
+  // one step for all, two misses in a row would take 0.99 to 1 and the
+  // region to the largest score seen.
   if (options_.gamma > 0)
     for (size_t i = 0; i < alpha_.size(); ++i) {
       const bool hit = score <= multipliers_[i];
-      alpha_[i] = std::clamp(alpha_[i] + options_.gamma * ((hit ? 0.0 : 1.0) - (1 - options_.levels[i])), 0.0, 1.0);
+      const double gamma = options_.gamma * std::min(1.0, 10 * (1 - options_.levels[i]));
+      alpha_[i] = std::clamp(alpha_[i] + gamma * ((hit ? 0.0 : 1.0) - (1 - options_.levels[i])), 0.0, 1.0);
     }
   window_.push_back({time, score});
   while (!window_.empty() && window_.front().time < time - options_.window) window_.pop_front();
@@ -143,18 +159,27 @@ std::optional<double> ConformalLayer::coverage(size_t i) const {
 }
 
 std::string Departure::describe() const {
-  char text[200];
-  std::snprintf(text, sizeof text,
-                "the robot departs from its twin by %.0f cm at (%.1f, %.1f): the ground or the robot differ from the "
-                "files there",
-                error * 100, where.x, where.y);
+  char text[240];
+  if (vertical > error)
+    std::snprintf(text, sizeof text,
+                  "the robot departs from its twin at (%.1f, %.1f): it stands %.0f cm off the ground the twin knows "
+                  "there (%.0f cm from where it was predicted): the ground or the robot differ from the files there",
+                  where.x, where.y, vertical * 100, error * 100);
+  else
+    std::snprintf(text, sizeof text,
+                  "the robot departs from its twin by %.0f cm at (%.1f, %.1f): the ground or the robot differ from the "
+                  "files there",
+                  error * 100, where.x, where.y);
   return text;
 }
 
-DepartureWatch::Change DepartureWatch::judge(double time, const Vec3& where, double error, double radius) {
-  const bool outside = error > radius && error > options_.minimum;
+DepartureWatch::Change DepartureWatch::judge(double time, const Vec3& where, double error, double radius,
+                                             double vertical, double verticalLimit) {
+  const bool outside = (error > radius && error > options_.minimum) ||
+                       (vertical > verticalLimit && vertical > options_.minimumVertical);
   if (departing()) {
     last_->error = std::max(last_->error, error);
+    last_->vertical = std::max(last_->vertical, vertical);
     if (outside) {
       insideSince_ = -1;
       return Change::None;
@@ -174,11 +199,12 @@ DepartureWatch::Change DepartureWatch::judge(double time, const Vec3& where, dou
     outsideSince_ = time;
     outsideWhere_ = where;
     outsideRadius_ = radius;
-    outsideWorst_ = 0;
+    outsideWorst_ = outsideVertical_ = 0;
   }
   outsideWorst_ = std::max(outsideWorst_, error);
+  outsideVertical_ = std::max(outsideVertical_, vertical);
   if (time - outsideSince_ < options_.hold) return Change::None;
-  last_ = Departure{outsideSince_, outsideWhere_, outsideWorst_, outsideRadius_, -1};
+  last_ = Departure{outsideSince_, outsideWhere_, outsideWorst_, outsideVertical_, outsideRadius_, -1};
   ++count_;
   insideSince_ = -1;
   return Change::Began;

@@ -87,6 +87,19 @@ double errorScale(const ErrorSources& sources, const ErrorModel& model);
 double commandTiming(const std::vector<std::pair<double, Command>>& commands, double made, double shown, double speed,
                      double wheelbase);
 
+/// The scale [m] of a prediction's vertical discrepancy (verticalOf()):
+/// the floor's, the terrain's uncertainty, and what a horizontal error of
+/// `horizontal` [m] (the prediction's scale) makes of the ground's slope
+/// (0.15: the rough field's steepest, about).
+double verticalScale(double horizontal, const ErrorModel& model);
+
+/// [m] how far the base's vertical pose in `actual` is from `predicted`:
+/// the largest of the height difference, the pitch difference over half
+/// the wheelbase and the roll difference over half the track (the heights
+/// at the axles and sides they mean). A ridge the map lacks lifts an axle
+/// at once, long before the robot lags where the ghost put it.
+double verticalOf(const Pose& predicted, const Pose& actual, const ErrorModel& model);
+
 /// The region's multiplier at `level` for a scale that is a 2-D Gaussian's
 /// per-axis deviation: sqrt(-2 ln(1 - level)) (Rayleigh). What the layer
 /// uses before it has judged enough predictions.
@@ -100,8 +113,9 @@ class ConformalLayer {
     double window = 20;  ///< [s] of robot time the quantiles are over
     int minScores = 50;  ///< below this many, gaussianMultiplier()
     /// Adaptive conformal inference's step per judged prediction (0: off,
-    /// the window's plain quantile). At 50 judged predictions a second,
-    /// 0.005 moves a level by 0.25 a second at most.
+    /// the window's plain quantile), for levels up to 90 %; a level p above
+    /// takes 10 (1 - p) of it. At 50 judged predictions a second, 0.005
+    /// moves a level by 0.25 a second at most.
     double gamma = 0.005;
   };
   explicit ConformalLayer(Options options);
@@ -148,11 +162,14 @@ class ConformalLayer {
   size_t judged_ = 0;
 };
 
-/// A departure: telemetry outside the 99 % region for `hold` seconds.
+/// A departure: telemetry outside the 99 % region for `hold` seconds: the
+/// base's position outside its disc, or its vertical pose outside its own
+/// region (a layer of its own over verticalOf()'s scores).
 struct Departure {
   double time = 0;   ///< [s] robot time it began (the first frame outside)
   Vec3 where;        ///< the robot's base then (as telemetry reported it)
   double error = 0;  ///< [m] the largest distance from the ghost's prediction while it lasts
+  double vertical = 0;  ///< [m] the largest vertical discrepancy (verticalOf()) while it lasts
   double radius = 0; ///< [m] the region's radius it left (at its start)
   double ended = -1; ///< [s] robot time it cleared (< 0: still on)
   /// For the operator: "the robot departs from its twin by 28 cm at
@@ -169,6 +186,10 @@ class DepartureWatch {
     /// [m] an error below this is never a departure, whatever the region
     /// (a region of millimetres on a robot standing still).
     double minimum = 0.03;
+    /// [m] the same for the vertical discrepancy: a 5 cm step under one
+    /// axle makes 2.5 cm; on mapped ground it stays below 5 mm
+    /// (bench_region's false alarms).
+    double minimumVertical = 0.01;
   };
   /// What one judged frame changed.
   enum class Change { None, Began, Ended };
@@ -177,8 +198,10 @@ class DepartureWatch {
   DepartureWatch() : DepartureWatch(Options{}) {}
 
   /// A frame at robot time `time` at `where` was `error` from its
-  /// prediction, whose outer region had radius `radius`.
-  Change judge(double time, const Vec3& where, double error, double radius);
+  /// prediction, whose departure region had radius `radius`, and
+  /// `vertical` off in its vertical pose, whose region was `verticalLimit`.
+  Change judge(double time, const Vec3& where, double error, double radius, double vertical = 0,
+               double verticalLimit = 1e300);
   /// The departure on now, or the last one (ended >= 0); nullopt before any.
   const std::optional<Departure>& last() const { return last_; }
   bool departing() const { return last_ && last_->ended < 0; }
@@ -192,7 +215,7 @@ class DepartureWatch {
   Options options_;
   double outsideSince_ = -1;  // robot time of the first frame of a run outside
   Vec3 outsideWhere_;
-  double outsideRadius_ = 0, outsideWorst_ = 0;
+  double outsideRadius_ = 0, outsideWorst_ = 0, outsideVertical_ = 0;
   double insideSince_ = -1;   // while departing: the first frame of a run inside
   std::optional<Departure> last_;
   int count_ = 0;

@@ -26,6 +26,8 @@ struct GhostError {
   /// ghost gave none).
   double scale = 0;     ///< [m]
   double inner = 0, outer = 0, limit = 0;  ///< [m] the inner, outer and departure regions
+  double vertical = 0;       ///< [m] the vertical pose's discrepancy (ghost_region.h verticalOf())
+  double verticalLimit = 0;  ///< [m] its departure region
   /// +1: this frame announced a departure; -1: it cleared one; 0: neither.
   int departure = 0;
   /// In a departure: not the files' world (the calibration leaves it out).
