@@ -75,21 +75,34 @@ void StatusFields::refresh(const ConsoleState& state, const ConsoleSession& sess
     ghost_->setText(tr("ghost –"));
   } else {
     QString g = tr("ghost +%1 s").arg(v.span, 0, 'f', 2);
+    QString tip = ghost_->toolTip();
     if (const auto median = ghost->errorMedian()) {
       g += tr(", %1 cm / %2°").arg(median->first * 100, 0, 'f', 1).arg(radToDeg(median->second), 0, 'f', 2);
-      // The median over 10 s hid jumps of a metre: the worst is shown too.
-      if (const auto worst = ghost->errorWorst())
-        g += *worst < 1 ? tr(" (max %1 cm)").arg(*worst * 100, 0, 'f', 1) : tr(" (max %1 m)").arg(*worst, 0, 'f', 2);
+      // The median over 10 s hid jumps of a metre: the worst is said too.
+      if (const auto worst = ghost->errorWorst()) {
+        const QString max = *worst < 1 ? tr("max %1 cm").arg(*worst * 100, 0, 'f', 1) : tr("max %1 m").arg(*worst, 0, 'f', 2);
+        if (v.outer > 0) tip += tr("\nLargest error over 10 s: %1.").arg(max);
+        else g += QStringLiteral(" (%1)").arg(max);
+      }
     }
-    // How far to trust it: the outer region's radius, and how often the
-    // region held the robot so far (the figure the layer makes true).
+    // How far to trust it, in the place of the worst error: the outer
+    // region's radius; how often the region held the robot so far (the
+    // share the layer makes true) in the tooltip.
     if (v.outer > 0) {
+      g += tr(", %1 % ≤ %2 cm").arg(std::lround(v.outerLevel * 100)).arg(v.outer * 100, 0, 'f', 1);
       const Ghost::Coverage c = ghost->coverage();
-      g += tr(", %1 % within %2 cm").arg(std::lround(v.outerLevel * 100)).arg(v.outer * 100, 0, 'f', 1);
-      if (c.judged >= 100) g += tr(" (held %1 %)").arg(std::lround(c.share[1] * 100));
+      if (c.judged > 0)
+        tip += tr("\nThe %1 % region held the robot in %2 % of %3 frames so far.")
+                   .arg(std::lround(v.outerLevel * 100))
+                   .arg(c.share[1] * 100, 0, 'f', 1)
+                   .arg(c.judged);
     }
-    if (!v.departure.empty()) g = alarm(g);
+    if (!v.departure.empty()) {
+      g = alarm(g);
+      tip += QStringLiteral("\n") + qs(v.departure);
+    }
     ghost_->setText(g);
+    ghost_->setToolTip(tip);
   }
 
   const QString log = qs(session.logPath());

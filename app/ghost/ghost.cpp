@@ -53,6 +53,7 @@ Ghost::Ghost(const WorldModel& world, const SimParams& params, const Options& op
   o.hold = params.ghostRegionHold;
   watch_ = DepartureWatch(o);
   errorModel_ = errorModelFor(world);
+  if (!options.sources) errorModel_.speed = errorModel_.curvature = errorModel_.arrival = errorModel_.terrain = 0;
 }
 
 std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& params, std::string& error) {
@@ -206,6 +207,7 @@ std::optional<GhostError> Ghost::anchor(const RobotFrame& frame, double roundTri
       record_.clear();
       region_.clear();
       vertical_.clear();
+      learnt_.clear();
       watch_.clear();
       departures_.clear();
       pending_.clear();
@@ -247,30 +249,47 @@ void Ghost::judge(GhostError& e, const RobotFrame& frame) {
   if (watch_.last() && !departures_.empty()) departures_.back() = *watch_.last();
   e.suspect = watch_.departing();
   const bool lasting = watch_.departing() && frame.time - watch_.last()->time > kLasting;
+  const Judged judged{frame.time, e.position, e.vertical, e.sources};
   if (watch_.suspect() && !lasting) {
-    pending_.push_back({frame.time, score, vscore});
+    pending_.push_back(judged);
     return;
   }
-  for (const PendingScore& p : pending_) {  // a run outside that was no departure
-    region_.learn(p.time, p.score);
-    vertical_.learn(p.time, p.vertical);
-  }
+  for (const Judged& p : pending_) learn(p.time, p.position, p.vertical, p.sources);  // a run outside that was no departure
   pending_.clear();
-  region_.learn(frame.time, score);
-  vertical_.learn(frame.time, vscore);
+  learn(judged.time, judged.position, judged.vertical, judged.sources);
 }
 
-double Ghost::scaleOf(double t, double made, double speed, const std::vector<std::pair<double, Command>>& timeline,
-                      double spread) const {
-  ErrorModel m = errorModel_;
-  m.arrival = std::hypot(m.arrival, spread);
-  const ErrorSources sources{t - made, speed, commandTiming(timeline, made, t, speed, m.wheelbase)};
-  return errorScale(sources, m);
+void Ghost::learn(double time, double position, double vertical, const ErrorSources& sources) {
+  const double scale = errorScale(sources, errorModel_);
+  region_.learn(time, position / scale);
+  vertical_.learn(time, vertical / verticalScale(scale, errorModel_));
+  learnt_.push_back({time, position, vertical, sources});
+  while (learnt_.front().time < time - params_.ghostRegionWindow) learnt_.pop_front();
 }
 
-void Ghost::setErrorModel(const ErrorModel& model) {
+ErrorSources Ghost::sourcesOf(double t, double made, double speed,
+                              const std::vector<std::pair<double, Command>>& timeline, double spread) const {
+  return {t - made, speed, commandTiming(timeline, made, t, speed, errorModel_.wheelbase), options_.sources ? spread : 0};
+}
+
+void Ghost::setErrorModel(const ErrorModel& given) {
+  ErrorModel model = given;
+  if (!options_.sources) model.speed = model.curvature = model.arrival = model.terrain = 0;
   std::lock_guard lock(recordMutex_);
+  if (model == errorModel_) return;
   errorModel_ = model;
+  // The window's scores meant the old scale: each rescored under the new
+  // one, from the errors and sources it was learnt with (both layers keep
+  // the same frames in the same order as learnt_).
+  size_t k = 0, v = 0;
+  region_.rescore([&](double, double) {
+    const Judged& j = learnt_[std::min(k++, learnt_.size() - 1)];
+    return j.position / errorScale(j.sources, errorModel_);
+  });
+  vertical_.rescore([&](double, double) {
+    const Judged& j = learnt_[std::min(v++, learnt_.size() - 1)];
+    return j.vertical / verticalScale(errorScale(j.sources, errorModel_), errorModel_);
+  });
 }
 
 ErrorModel Ghost::errorModel() const {

@@ -136,6 +136,9 @@ class Ghost {
     /// false: the regions take the Gaussian multipliers of the scale alone
     /// (the conformal layer off; a control).
     bool conformal = true;
+    /// false: the scale is the floor alone (the estimate's deviations, the
+    /// link's jitter and the terrain's uncertainty taken as zero; a control).
+    bool sources = true;
   };
 
   /// The ghost's physics profile of `params`: ghost.step and
@@ -259,11 +262,13 @@ class Ghost {
   /// `e` (a frame just compared) given its regions, judged for a
   /// departure and fed to the conformal layer (recordMutex_ held).
   void judge(GhostError& e, const RobotFrame& frame);
-  /// The error scale of a state shown at robot time `t` from telemetry of
-  /// `made`, at base speed `speed` (recordMutex_ held; `timeline` and
+  /// What the error scale of a state shown at robot time `t` from
+  /// telemetry of `made`, at base speed `speed`, is made of (`timeline` and
   /// `spread` from the link's timeline).
-  double scaleOf(double t, double made, double speed, const std::vector<std::pair<double, Command>>& timeline,
-                 double spread) const;
+  ErrorSources sourcesOf(double t, double made, double speed, const std::vector<std::pair<double, Command>>& timeline,
+                         double spread) const;
+  /// A judged frame into the layers (recordMutex_ held).
+  void learn(double time, double position, double vertical, const ErrorSources& sources);
   /// The destructor asked the threads to end (a long run ahead gives up).
   bool stopping() const { return stop_.load(); }
 
@@ -298,10 +303,14 @@ class Ghost {
   ConformalLayer vertical_;  // the departure's level, over the vertical pose's scores
   DepartureWatch watch_;
   std::vector<Departure> departures_;
-  struct PendingScore {
-    double time, score, vertical;
+  // A judged frame as the layers learn it: its errors and what its scale
+  // was made of, so that a new model rescores the window.
+  struct Judged {
+    double time, position, vertical;
+    ErrorSources sources;
   };
-  std::vector<PendingScore> pending_;  // frames outside, kept from the layer until judged no departure
+  std::deque<Judged> learnt_;        // the layers' window, with its sources
+  std::vector<Judged> pending_;      // frames outside, kept from the layers until judged no departure
 
   mutable std::mutex viewMutex_;  // what the GUI copies out
   GhostView view_;

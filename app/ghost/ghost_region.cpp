@@ -12,7 +12,7 @@ double errorScale(const ErrorSources& s, const ErrorModel& m) {
   const double along = s.speed * s.horizon * m.speed;
   const double path = s.speed * s.horizon;
   const double across = m.curvature * path * path / 2;
-  const double timing = s.timing * m.arrival;
+  const double timing = s.timing * std::hypot(m.arrival, s.spread);
   const double tilt = m.terrain * m.height / m.wheelbase;
   return std::sqrt(m.floor * m.floor + along * along + across * across + timing * timing + tilt * tilt);
 }

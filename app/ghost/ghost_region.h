@@ -51,6 +51,9 @@ struct ErrorSources {
   /// change of speed they made, plus the sideways drift a change of
   /// articulation makes until the time shown (speed * dphi * age / L).
   double timing = 0;
+  /// [s] the link's jitter when it was shown (GhostClock::spread): a
+  /// command's arrival is off by it as well as by the model's `arrival`.
+  double spread = 0;
 };
 
 /// The uncertainties the scale is built from.
@@ -63,6 +66,7 @@ struct ErrorModel {
   double height = 0.8;        ///< [m] the base's height above the ground: a tilt moves it sideways by this
   double wheelbase = 1.1;     ///< [m] front to rear wheels: a height error over it tilts the base
   double track = 0.84;        ///< [m] left to right wheels: a side split of the tyres curves the path
+  friend bool operator==(const ErrorModel&, const ErrorModel&) = default;
 };
 
 /// The model's geometry for `world`'s first robot (its drive's wheels, its
@@ -74,7 +78,7 @@ ErrorModel errorModelFor(const WorldModel& world);
 /// deviation per axis were it Gaussian): the root sum of squares of
 ///   floor, speed * horizon * speed deviation (along the path),
 ///   curvature * (speed * horizon)^2 / 2 (across it),
-///   timing * arrival deviation (the commands' arrival),
+///   timing * hypot(arrival deviation, spread) (the commands' arrival),
 ///   terrain * height / wheelbase (the base tilted by ground the map has wrong).
 double errorScale(const ErrorSources& sources, const ErrorModel& model);
 
@@ -130,6 +134,14 @@ class ConformalLayer {
   /// Counts a judged prediction for the coverage figures, against the
   /// regions as they stand.
   void judge(double score);
+  /// The window's scores recomputed (the scale's model changed: the old
+  /// scores meant another scale): `rescore` maps each (time, score) to its
+  /// new score. The levels stay where they are.
+  template <typename F>
+  void rescore(F rescore) {
+    for (Score& s : window_) s.score = rescore(s.time, s.score);
+    update();
+  }
   /// Learns from it: the levels move (adaptive conformal inference) and it
   /// joins the window. A departure's frames are judged, not learnt: the
   /// robot is not on the ground the twin knows there.

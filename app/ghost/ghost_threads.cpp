@@ -265,10 +265,12 @@ void Ghost::presentLoop() {
       lastTrail = wall;
     }
     double scale = 0, inner = 0, outer = 0;
+    ErrorSources sources;
     std::string departure;
     {
       std::lock_guard lock(recordMutex_);
-      scale = scaleOf(t, base->made, std::hypot(r.baseLinearVelocity.x, r.baseLinearVelocity.y), timeline, spread);
+      sources = sourcesOf(t, base->made, std::hypot(r.baseLinearVelocity.x, r.baseLinearVelocity.y), timeline, spread);
+      scale = errorScale(sources, errorModel_);
       inner = region_.multiplier(0) * scale;
       outer = region_.multiplier(1) * scale;
       if (watch_.departing()) departure = watch_.last()->describe();
@@ -296,7 +298,7 @@ void Ghost::presentLoop() {
     }
     {
       std::lock_guard lock(recordMutex_);
-      record_.shown(t, base->made, r.base, scale);
+      record_.shown(t, base->made, r.base, scale, sources);
     }
     {
       std::lock_guard lock(statsMutex_);
@@ -351,7 +353,7 @@ void Ghost::trailLoop() {
     const auto bandAt = [&](double at) {
       const Vec3 v = w.linkLinearVelocity(0, 0);
       std::lock_guard lock(recordMutex_);
-      return region_.multiplier(1) * scaleOf(at, request->made, std::hypot(v.x, v.y), timeline, spread);
+      return region_.multiplier(1) * errorScale(sourcesOf(at, request->made, std::hypot(v.x, v.y), timeline, spread), errorModel_);
     };
     band.push_back(bandAt(t));
     // Given up when the commands changed meanwhile; a newer request that

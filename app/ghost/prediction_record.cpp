@@ -16,9 +16,9 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-void PredictionRecord::shown(double time, double made, const Pose& base, double scale) {
+void PredictionRecord::shown(double time, double made, const Pose& base, double scale, const ErrorSources& sources) {
   while (!shown_.empty() && shown_.back().time >= time) shown_.pop_back();  // superseded
-  shown_.push_back({time, made, base, scale});
+  shown_.push_back({time, made, base, scale, sources});
   while (shown_.front().time < time - kShownWindow) shown_.pop_front();
 }
 
@@ -37,6 +37,7 @@ std::optional<GhostError> PredictionRecord::compare(const RobotFrame& frame) {
   e.predicted = u < 0.5 ? a.base : b.base;
   e.predicted.p = a.base.p + u * (b.base.p - a.base.p);
   e.scale = a.scale + u * (b.scale - a.scale);
+  e.sources = u < 0.5 ? a.sources : b.sources;
   e.position = std::hypot(e.predicted.p.x - frame.base.p.x, e.predicted.p.y - frame.base.p.y);
   e.heading = std::abs(std::remainder(heading(e.predicted.q) - heading(frame.base.q), 2 * kPi));
   errors_.push_back(e);

@@ -9,6 +9,7 @@
 #include <optional>
 #include <utility>
 
+#include "app/ghost/ghost_region.h"
 #include "app/state/robot_frame.h"
 #include "sim/math.h"
 
@@ -25,6 +26,7 @@ struct GhostError {
   /// error scale, and its regions' radii when telemetry judged it (0: the
   /// ghost gave none).
   double scale = 0;     ///< [m]
+  ErrorSources sources;  ///< what the scale was made of (the nearer shown state's)
   double inner = 0, outer = 0, limit = 0;  ///< [m] the inner, outer and departure regions
   double vertical = 0;       ///< [m] the vertical pose's discrepancy (ghost_region.h verticalOf())
   double verticalLimit = 0;  ///< [m] its departure region
@@ -43,8 +45,8 @@ class PredictionRecord {
   /// The ghost showed `base` for robot time `time`, predicted from the
   /// telemetry of robot time `made`. A later prediction for the same or an
   /// earlier time supersedes what was shown from then on.
-  /// `scale` [m]: its error scale (ghost_region.h; 0: none).
-  void shown(double time, double made, const Pose& base, double scale = 0);
+  /// `scale` [m]: its error scale (ghost_region.h; 0: none), made of `sources`.
+  void shown(double time, double made, const Pose& base, double scale = 0, const ErrorSources& sources = {});
   /// `frame` against what was shown for its time (interpolated between the
   /// two shown states around it), recorded; nullopt when nothing was shown
   /// within kMatchWindow of it.
@@ -62,6 +64,7 @@ class PredictionRecord {
     double time, made;  // robot time shown; of the telemetry it ran from
     Pose base;
     double scale;
+    ErrorSources sources;
   };
   std::deque<Shown> shown_;
   std::deque<GhostError> errors_;
