@@ -368,6 +368,22 @@ class TestGhost : public QObject {
     QVERIFY(Ghost::create(*world, params, why));
   }
 
+  // Issue 61: the regions' levels must ascend (inner, outer, departure);
+  // each key alone is checked for (0, 1) where it is read (tst_params).
+  void regionLevelsMustAscend() {
+    Diagnostics diag;
+    const auto world = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/flat.world.xml", diag);
+    QVERIFY2(world, diag.format().c_str());
+    SimParams params;
+    params.ghostRegionInner = 0.95;
+    std::string why;
+    QVERIFY(!Ghost::create(*world, params, why));
+    QCOMPARE(QString::fromStdString(why),
+             QString("ghost.region.inner (0.95), ghost.region.outer (0.9) and ghost.region.departure (0.99) must ascend"));
+    params.ghostRegionInner = 0.5;
+    QVERIFY2(Ghost::create(*world, params, why), why.c_str());
+  }
+
   // Issue 59: "the ghost error spikes to ~25 cm at every stop with no delay
   // at all". Criterion, stated before the runs: from the stop's arrival on,
   // for 2 s, every frame is within 2 cm of what the ghost showed for its

@@ -54,6 +54,7 @@ class TestModelLoader : public QObject {
   void initTestCase();
   void testRobotErrors_data();
   void testRobotErrors();
+  void terrainUncertaintyStatedOrDerived();
   void testWorldErrors_data();
   void testWorldErrors();
   void testLinkWithoutGeomWarns();
@@ -395,6 +396,27 @@ void TestModelLoader::testRobotErrors() {
 }
 
 // Each kind of world problem (no files involved) gives exactly this text.
+// Issue 61: a world's stated height uncertainty is taken as it is; unstated,
+// a plane's is 0 and a grid's what interpolating between its samples
+// misses: the rough field's (0.125 m cells, waves down to 0.8 m) more than
+// the bumpy field's (0.25 m, waves of 2.9 m and more), which is under 1 mm.
+void TestModelLoader::terrainUncertaintyStatedOrDerived() {
+  Diagnostics diag;
+  auto stated = parseWorld(R"(<world name="w"><terrain type="plane" height_uncertainty="0.02"/></world>)", "w.xml", "", diag);
+  QVERIFY2(stated, diag.format().c_str());
+  QCOMPARE(terrainUncertainty(stated->terrain), 0.02);
+  auto plane = parseWorld(R"(<world name="w"><terrain type="plane"/></world>)", "w.xml", "", diag);
+  QVERIFY2(plane, diag.format().c_str());
+  QCOMPARE(terrainUncertainty(plane->terrain), 0.0);
+  const auto bumpy = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/bumpy.world.xml", diag);
+  const auto rough = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/rough.world.xml", diag);
+  QVERIFY2(bumpy && rough, diag.format().c_str());
+  const double b = terrainUncertainty(bumpy->terrain), r = terrainUncertainty(rough->terrain);
+  qInfo("derived height uncertainty: bumpy %.2f mm, rough %.2f mm", b * 1000, r * 1000);
+  QVERIFY(b > 0 && b < 0.001);
+  QVERIFY(r > b);
+}
+
 void TestModelLoader::testWorldErrors_data() {
   QTest::addColumn<QByteArray>("xml");
   QTest::addColumn<QString>("expected");
@@ -439,6 +461,16 @@ void TestModelLoader::testWorldErrors_data() {
   <terrain type="profile" file="p.csv" depth="2" format="csv"/>
 </world>)") << "w.xml:2: error: <terrain>: format: a profile is always distance,height CSV\n"
                "w.xml:2: error: <terrain>: terrain file 'p.csv' not found (looked at p.csv)\n";
+  // Issue 61: how well the ground is known is a deviation, >= 0 and finite.
+  QTest::newRow("terrain uncertainty negative") << QByteArray(R"(<world name="w">
+  <terrain type="plane" height_uncertainty="-0.01"/>
+</world>)") << "w.xml:2: error: <terrain>: height_uncertainty must be >= 0, got -0.01\n";
+  QTest::newRow("terrain uncertainty not finite") << QByteArray(R"(<world name="w">
+  <terrain type="plane" height_uncertainty="inf"/>
+</world>)") << "w.xml:2: error: <terrain>: height_uncertainty: expected a number, got 'inf'\n";
+  QTest::newRow("terrain uncertainty not a number") << QByteArray(R"(<world name="w">
+  <terrain type="plane" height_uncertainty="nan"/>
+</world>)") << "w.xml:2: error: <terrain>: height_uncertainty: expected a number, got 'nan'\n";
   QTest::newRow("terrain rolled") << QByteArray(R"(<world name="w">
   <terrain type="plane" rpy="10 0 0"/>
 </world>)") << "w.xml:2: error: <terrain>: rpy: terrain may only be turned about z (yaw)\n";
