@@ -71,11 +71,8 @@ void SceneView::Impl::syncRegion() {
       auto* v = static_cast<osg::Vec3Array*>(g->getVertexArray());
       v->clear();
       v->push_back({f(about.x), f(about.y), f(groundHeight(terrain, about.x, about.y)) + kLift});
-      for (int k = 0; k <= kSegments; ++k) {
-        const double a = 2 * kPi * k / kSegments;
-        const double x = about.x + radius * std::cos(a), y = about.y + radius * std::sin(a);
-        v->push_back({f(x), f(y), f(groundHeight(terrain, x, y)) + kLift});
-      }
+      const std::vector<osg::Vec3> rim = drapedCircle(terrain, about.x, about.y, radius, kSegments, kLift);
+      v->insert(v->end(), rim.begin(), rim.end());
       setCount(g);
     };
     disc(r.outer.get(), r.outerRadius);
@@ -106,12 +103,11 @@ void SceneView::Impl::syncRegion() {
       const Vec3 c = r.places[i];
       const double radius = i + 1 == r.places.size() && r.lastOn ? 0.8 : 0.5;
       const float z = f(groundHeight(terrain, c.x, c.y));
-      for (int k = 0; k < kSegments; ++k)
-        for (int e : {k, k + 1}) {
-          const double a = 2 * kPi * e / kSegments;
-          const double x = c.x + radius * std::cos(a), y = c.y + radius * std::sin(a);
-          v->push_back({f(x), f(y), f(groundHeight(terrain, x, y)) + kLift});
-        }
+      const std::vector<osg::Vec3> ring = drapedCircle(terrain, c.x, c.y, radius, kSegments, kLift);
+      for (size_t k = 0; k + 1 < ring.size(); ++k) {  // as line segments: one geometry for every mark
+        v->push_back(ring[k]);
+        v->push_back(ring[k + 1]);
+      }
       v->push_back({f(c.x), f(c.y), z});
       v->push_back({f(c.x), f(c.y), z + 1.5f});  // a post: seen over the rise that hides the ring
     }

@@ -14,11 +14,8 @@ void SceneView::Impl::updateFootprint() {
   auto* v = static_cast<osg::Vec3Array*>(footprint->getVertexArray());
   v->clear();
   constexpr int kSegments = 64;
-  for (int k = 0; k < kSegments; ++k) {
-    const double a = 2 * kPi * k / kSegments;
-    const double x = hover->x + brushRadius * std::cos(a), y = hover->y + brushRadius * std::sin(a);
-    v->push_back({f(x), f(y), f(groundHeight(terrain, x, y) + 0.03)});
-  }
+  const std::vector<osg::Vec3> ring = drapedCircle(terrain, hover->x, hover->y, brushRadius, kSegments, 0.03f);
+  v->insert(v->end(), ring.begin(), ring.end() - 1);  // a loop: the last point closes it
   v->dirty();
   auto* colour = static_cast<osg::Vec4Array*>(footprint->getColorArray());
   (*colour)[0] = brushWarning ? osg::Vec4(1.0f, 0.45f, 0.0f, 1.0f) : osg::Vec4(1.0f, 0.85f, 0.1f, 1.0f);

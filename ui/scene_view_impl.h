@@ -154,6 +154,21 @@ inline double groundHeight(const TerrainSpec& t, double x, double y) {
   return t.grid.heightAt(local.x, local.y) + t.pose.p.z;
 }
 
+/// The circle of `radius` about (x, y) draped on the ground, `lift` above
+/// it: `segments` + 1 points, the last the first again (the brush's ring,
+/// the ghost's regions, the departures' marks).
+inline std::vector<osg::Vec3> drapedCircle(const TerrainSpec& t, double x, double y, double radius, int segments,
+                                           float lift) {
+  std::vector<osg::Vec3> out;
+  out.reserve(static_cast<size_t>(segments) + 1);
+  for (int k = 0; k <= segments; ++k) {
+    const double a = 2 * kPi * (k % segments) / segments;
+    const double px = x + radius * std::cos(a), py = y + radius * std::sin(a);
+    out.push_back({f(px), f(py), f(groundHeight(t, px, py)) + lift});
+  }
+  return out;
+}
+
 /// Earth at the bottom, grass in the middle, dry light grass on top.
 inline osg::Vec4 heightColor(double t) {
   const osg::Vec4 low(0.45f, 0.38f, 0.28f, 1.0f), mid(0.50f, 0.55f, 0.33f, 1.0f),

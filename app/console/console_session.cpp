@@ -49,10 +49,10 @@ void ConsoleSession::bindTap() {
 
 namespace {
 
-ErrorModel errorModelOf(const WorldModel& world, const CalibrationState* calibration) {
-  ErrorModel m = errorModelFor(world);
-  // What the twin knows of the robot: a fitted value's deviation, else
-  // the prior's (the ranges a robot may differ from its files by).
+// `m` (the ghost's: its world's geometry and terrain) with the deviations
+// of what the twin knows of the robot: a fitted value's deviation, else
+// the prior's (the ranges a robot may differ from its files by).
+ErrorModel withDeviations(ErrorModel m, const CalibrationState* calibration) {
   const auto deviation = [&](CalParam p) {
     const auto i = static_cast<size_t>(p);
     return calibration && calibration->observed[i] ? calibration->sigma[i] : calParam(p).scale;
@@ -77,7 +77,7 @@ void ConsoleSession::setWorld(WorldModel world) {
   ghostError_.clear();
   calibrationSeen_ = calibrationFitsLogged_ = 0;
   if (options_.ghost) ghost_ = Ghost::create(*world_, params_, options_.ghostOptions, ghostError_);
-  if (ghost_) ghost_->setErrorModel(errorModelOf(*world_, nullptr));
+  if (ghost_) ghost_->setErrorModel(withDeviations(ghost_->errorModel(), nullptr));
   ghostCalibration_ = calValues(params_);
   // The calibration fits the ghost's own twin.
   if (ghost_ && options_.calibrate) {
@@ -101,7 +101,7 @@ void ConsoleSession::takeCalibration() {
     ghost_->setCalibration(calibratedWorld(*world_, calibrated), calibrated.calDelay);
     ghostCalibration_ = s.applied;
   }
-  if (ghost_) ghost_->setErrorModel(errorModelOf(*world_, &s));
+  if (ghost_) ghost_->setErrorModel(withDeviations(ghost_->errorModel(), &s));
   calibrationSeen_ = s.version;
   // The fits since the last call, one row per parameter (the history keeps the newest).
   const int fresh = std::min<int>(s.fits - calibrationFitsLogged_, static_cast<int>(s.history.size()));

@@ -65,12 +65,14 @@ void TelemetryTap::logDeparture() {
   const std::vector<Departure> all = parts_.ghost->departures();
   if (all.empty()) return;
   const Departure& d = all.back();
-  char text[320];
-  if (d.ended < 0) std::snprintf(text, sizeof text, "%s", d.describe().c_str());
-  else
-    std::snprintf(text, sizeof text,
+  std::string text = d.describe();
+  if (d.ended >= 0) {
+    char back[160];
+    std::snprintf(back, sizeof back,
                   "the robot is back inside its twin's region (it departed by %.0f cm at (%.1f, %.1f) for %.1f s)",
                   d.error * 100, d.where.x, d.where.y, d.ended - d.time);
+    text = back;
+  }
   if (parts_.recorder) parts_.recorder->event("departure", text);
   else if (parts_.standIn) parts_.standIn->logEvent("departure", text);
 }

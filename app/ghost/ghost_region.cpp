@@ -198,13 +198,12 @@ DepartureWatch::Change DepartureWatch::judge(double time, const Vec3& where, dou
   if (outsideSince_ < 0) {
     outsideSince_ = time;
     outsideWhere_ = where;
-    outsideRadius_ = radius;
     outsideWorst_ = outsideVertical_ = 0;
   }
   outsideWorst_ = std::max(outsideWorst_, error);
   outsideVertical_ = std::max(outsideVertical_, vertical);
   if (time - outsideSince_ < options_.hold) return Change::None;
-  last_ = Departure{outsideSince_, outsideWhere_, outsideWorst_, outsideVertical_, outsideRadius_, -1};
+  last_ = Departure{outsideSince_, outsideWhere_, outsideWorst_, outsideVertical_, -1};
   ++count_;
   insideSince_ = -1;
   return Change::Began;

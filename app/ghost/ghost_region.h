@@ -182,7 +182,6 @@ struct Departure {
   Vec3 where;        ///< the robot's base then (as telemetry reported it)
   double error = 0;  ///< [m] the largest distance from the ghost's prediction while it lasts
   double vertical = 0;  ///< [m] the largest vertical discrepancy (verticalOf()) while it lasts
-  double radius = 0; ///< [m] the region's radius it left (at its start)
   double ended = -1; ///< [s] robot time it cleared (< 0: still on)
   /// For the operator: "the robot departs from its twin by 28 cm at
   /// (5.1, 0.2): the ground or the robot differ from the files there".
@@ -227,7 +226,7 @@ class DepartureWatch {
   Options options_;
   double outsideSince_ = -1;  // robot time of the first frame of a run outside
   Vec3 outsideWhere_;
-  double outsideRadius_ = 0, outsideWorst_ = 0, outsideVertical_ = 0;
+  double outsideWorst_ = 0, outsideVertical_ = 0;
   double insideSince_ = -1;   // while departing: the first frame of a run inside
   std::optional<Departure> last_;
   int count_ = 0;

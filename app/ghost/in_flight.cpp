@@ -27,7 +27,9 @@ std::vector<std::pair<double, Command>> InFlightCommands::upTo(double upTo) cons
   if (lastDrive_) out.emplace_back(lastDrive_->time, lastDrive_->command);
   for (const SentCommand& c : commands_) {
     if (c.time > upTo) break;
-    out.emplace_back(c.time, c.command);
+    // A terrain patch moves no base and carries its heights: not copied
+    // for the region's scale every frame.
+    if (!std::holds_alternative<TerrainPatchCmd>(c.command)) out.emplace_back(c.time, c.command);
   }
   return out;
 }

@@ -29,7 +29,8 @@ class InFlightCommands {
   /// The commands with seq >= `from`, oldest first.
   std::vector<SentCommand> from(uint64_t seq) const;
   /// The commands that take effect at robot times up to `upTo`, with
-  /// those times, oldest first (as far back as they are remembered).
+  /// those times, oldest first (as far back as they are remembered; the
+  /// newest drive or stop forgotten first), terrain patches left out.
   std::vector<std::pair<double, Command>> upTo(double upTo) const;
   /// Forgets commands that took effect before robot time `time` (they are
   /// in the anchored state's set-points by then).
