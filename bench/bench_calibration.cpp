@@ -4,7 +4,7 @@
 // 3 s, two steps each from the last values), then judged over the next 30 s
 // and on a rehearsed sequence. Prints a table; asserts nothing.
 //
-//   build/bench/bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J] [--seed S] [--iterations N] [--window S] [--horizon S]
+//   build/bench/bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J] [--seed S] [--iterations N] [--window S] [--horizon S] [--weak-motor WHEEL=F]
 //
 // Per world and seed:
 //   ghost error   the ghost's prediction over a 1 s each way link is 2 s
@@ -129,6 +129,9 @@ int gIterations = kLive.iterations;
 // The fit's window and each segment's horizon [s]: the console's (8, 2)
 // unless --window / --horizon measure others.
 double gWindow = kLive.window, gHorizon = kLive.horizon;
+// --weak-motor WHEEL=F: every robot's motor at that wheel has F x its torque
+// limit on top of its seed's deviations (the seed-0 control too).
+std::array<double, 4> gWheelTorque{1, 1, 1, 1};
 
 struct Case {
   std::string world;
@@ -176,7 +179,8 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
   c.world = name;
   c.seed = seed;
   const RobotModel& robot = world.robots[0].model;
-  const Perturbation p = seed == 0 ? identity(world) : drawPerturbation(seed, robot);
+  Perturbation p = seed == 0 ? identity(world) : drawPerturbation(seed, robot);
+  p.wheelTorque = gWheelTorque;
   const std::vector<TimedCommand> drive = parse(world, kDrive);
   const RecordedDrive d = recordDrive(world, SimParams{}, p, drive, 60.0);
   if (!d.problem.empty()) {
@@ -318,8 +322,17 @@ int main(int argc, char** argv) {
     else if (a == "--seed" && i + 1 < argc) seeds = only = std::max(0, std::atoi(argv[++i]));
     else if (a == "--window" && i + 1 < argc) gWindow = std::clamp(std::atof(argv[++i]), 3.0, 30.0);
     else if (a == "--horizon" && i + 1 < argc) gHorizon = std::clamp(std::atof(argv[++i]), 0.5, 8.0);
+    else if (a == "--weak-motor" && i + 1 < argc) {
+      Perturbation p;
+      p.wheelTorque = gWheelTorque;
+      if (const std::string why = parseWeakMotor(argv[++i], p); !why.empty()) {
+        std::fprintf(stderr, "bench_calibration: --weak-motor: %s\n", why.c_str());
+        return 2;
+      }
+      gWheelTorque = p.wheelTorque;
+    }
     else {
-      std::fprintf(stderr, "usage: bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J] [--seed S] [--iterations N] [--window S] [--horizon S]\n");
+      std::fprintf(stderr, "usage: bench_calibration [--seeds N] [--worlds flat,bumpy,track] [--jobs J] [--seed S] [--iterations N] [--window S] [--horizon S] [--weak-motor WHEEL=F]\n");
       return 2;
     }
   }

@@ -55,7 +55,7 @@ WorldModel perturbWorld(WorldModel world, const Perturbation& p) {
         if (g.type == GeomType::Cylinder || g.type == GeomType::Sphere) g.radius *= p.wheelRadius[w];
       for (ActuatorSpec& a : robot.actuators)
         if (a.joint == joint) {
-          a.maxTorque *= p.torqueLimit;
+          a.maxTorque *= p.torqueLimit * p.wheelTorque[w];
           a.velocityScale *= p.velocityGain;
         }
     }
@@ -154,6 +154,19 @@ std::optional<std::string> calibratedRobotText(const std::string& text, const Ro
   return std::string(printer.CStr(), static_cast<size_t>(printer.CStrSize() > 0 ? printer.CStrSize() - 1 : 0));
 }
 
+std::string parseWeakMotor(const std::string& text, Perturbation& p) {
+  static const char* kWheels[] = {"fl", "fr", "rl", "rr"};
+  const size_t eq = text.find('=');
+  const std::string wheel = text.substr(0, eq);
+  size_t w = 0;
+  while (w < 4 && wheel != kWheels[w]) ++w;
+  const auto factor = eq == std::string::npos ? std::nullopt : parseReal(std::string_view(text).substr(eq + 1));
+  if (w == 4 || !factor) return "'" + text + "': a weak motor is WHEEL=FACTOR, the wheel fl, fr, rl or rr (rl=0.5)";
+  if (!(*factor > 0 && *factor <= 2)) return "'" + text + "': the torque factor must lie in (0, 2]";
+  p.wheelTorque[w] = *factor;
+  return {};
+}
+
 std::string Perturbation::report(const RobotModel& robot) const {
   std::string out = "seed = " + std::to_string(seed) + "\n";
   static const char* kWheels[] = {"fl", "fr", "rl", "rr"};
@@ -165,6 +178,8 @@ std::string Perturbation::report(const RobotModel& robot) const {
   }
   out += "friction = " + number(friction) + "\n";
   out += "wheel_torque_limit = " + number(torqueLimit) + "\n";
+  for (size_t w = 0; w < 4; ++w)
+    if (wheelTorque[w] != 1) out += std::string("wheel_torque_limit.") + kWheels[w] + " = " + number(wheelTorque[w]) + "\n";
   out += "wheel_velocity_gain = " + number(velocityGain) + "\n";
   out += "actuator_delay = " + number(delay) + "\n";
   out += "imu_roll_bias = " + number(rollBias) + "\n";

@@ -15,6 +15,8 @@
 //   centre of mass    per link, ± 2 cm on each axis (link frame)
 //   friction          every contact's mu, ± 30 % (one factor: the ground)
 //   torque limit      the wheel motors' torque limit, ± 20 %
+//   (not drawn)       a factor per wheel motor's torque limit on top (a weak
+//                     motor: `simpartner-robot --weak-motor rl=0.5`); 1 unless set
 //   velocity gain     the wheel motors reach gain x the commanded speed, ± 20 %
 //   actuator delay    0 – 60 ms between a command's arrival and its effect
 //   IMU bias          roll and pitch each ± 1°, in what the robot reports
@@ -53,6 +55,10 @@ struct Perturbation {
   std::vector<Vec3> centreOfMass;      ///< [m] shift per link, link frame
   double friction = 1;                 ///< factor on every contact's mu
   double torqueLimit = 1;              ///< factor on the wheel motors' torque limit
+  /// Factor per wheel motor's torque limit (FL FR RL RR) on top of
+  /// torqueLimit: not drawn (a seed's robot stays the same), set to make
+  /// one motor weak.
+  std::array<double, 4> wheelTorque{1, 1, 1, 1};
   double velocityGain = 1;             ///< factor on the wheel motors' speed
   double delay = 0;                    ///< [s] actuator delay
   double rollBias = 0, pitchBias = 0;  ///< [rad] added to the reported roll and pitch
@@ -64,6 +70,10 @@ struct Perturbation {
 
 /// The deviations of `robot` drawn from `seed` within `ranges`.
 Perturbation drawPerturbation(uint64_t seed, const RobotModel& robot, const PerturbationRanges& ranges = {});
+
+/// Parses a weak motor, `WHEEL=FACTOR` (fl, fr, rl or rr; a factor in
+/// (0, 2]), into `p.wheelTorque`: "" or why not, naming the text.
+std::string parseWeakMotor(const std::string& text, Perturbation& p);
 
 /// `world` with its first robot's physics perturbed by `p` (wheel geoms'
 /// radius, link masses and centres of mass, contact friction, wheel

@@ -54,6 +54,8 @@ struct ConsoleSessionOptions {
   /// from this seed (sim/perturbation.h); the console's twin, ghost and
   /// rehearsals keep the files. nullopt = the stand-in runs the files.
   std::optional<uint64_t> perturbSeed;
+  /// The stand-in's wheel motors' torque factors on top (StandInOptions::wheelTorque).
+  std::array<double, 4> wheelTorque{1, 1, 1, 1};
   /// The stand-in stands on this world's terrain instead of the drawn
   /// world's (StandInOptions::groundFile): ground the console's map lacks.
   std::string ground;

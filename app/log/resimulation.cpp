@@ -10,6 +10,7 @@
 
 #include "app/log/session_log.h"
 #include "sim/command_file.h"
+#include "sim/text.h"
 #include "sim/file_set.h"
 #include "sim/model_loader.h"
 #include "sim/params.h"
@@ -79,6 +80,20 @@ std::optional<LoggedWorld> loggedWorld(const SessionLogReader& reader, const std
       return std::nullopt;
     }
     logged.perturbation = drawPerturbation(value, logged.world.robots[0].model);
+  }
+  if (const std::string torque = get(meta, "perturbation_wheel_torque"); !torque.empty()) {
+    const std::vector<std::string_view> words = splitWords(torque);
+    std::array<double, 4> factor{};
+    for (size_t w = 0; w < 4; ++w) {
+      const std::optional<double> x = w < words.size() ? parseReal(words[w]) : std::nullopt;
+      if (words.size() != 4 || !x || !(*x > 0)) {
+        error = path + ": meta perturbation_wheel_torque: expected four positive factors (FL FR RL RR), got '" + torque + "'";
+        return std::nullopt;
+      }
+      factor[w] = *x;
+    }
+    if (!logged.perturbation) logged.perturbation = Perturbation{};
+    logged.perturbation->wheelTorque = factor;
   }
   return logged;
 }

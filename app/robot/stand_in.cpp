@@ -11,6 +11,7 @@
 #include "app/robot/twin_host.h"
 #include "net/auth.h"
 #include "net/robot_server.h"
+#include "sim/text.h"
 #include "net/thread_priority.h"
 #include "sim/model_loader.h"
 #include "sim/perturbation.h"
@@ -56,6 +57,10 @@ std::unique_ptr<StandInRobot> StandInRobot::create(const StandInOptions& options
   // and logs as its files stays the files.
   std::optional<Perturbation> perturbation;
   if (options.perturbSeed) perturbation = drawPerturbation(*options.perturbSeed, model->robots[0].model);
+  if (options.wheelTorque != std::array<double, 4>{1, 1, 1, 1}) {
+    if (!perturbation) perturbation = Perturbation{};
+    perturbation->wheelTorque = options.wheelTorque;
+  }
   // A twin calibrated by the parameters (calibration.*) is calibrated here too.
   WorldModel physics = calibratedWorld(*model, *params);
   if (ground) physics.terrain = ground->terrain;  // the ground as it is, not as the map has it
@@ -90,6 +95,11 @@ std::map<std::string, std::string> StandInRobot::logMeta() const {
   if (options_.perturbSeed) {
     meta["perturbation_seed"] = std::to_string(*options_.perturbSeed);
     meta["perturbation"] = drawPerturbation(*options_.perturbSeed, world_.robots[0].model).report(world_.robots[0].model);
+  }
+  if (options_.wheelTorque != std::array<double, 4>{1, 1, 1, 1}) {
+    std::string text;
+    for (double f : options_.wheelTorque) text += (text.empty() ? "" : " ") + shortestText(f);
+    meta["perturbation_wheel_torque"] = text;
   }
   return meta;
 }

@@ -78,6 +78,10 @@ struct StandInOptions {
   /// hashes stay the files'; the session log records the deviations (meta
   /// `perturbation_seed` and `perturbation`), and re-simulation applies them.
   std::optional<uint64_t> perturbSeed;
+  /// A factor per wheel motor's torque limit (FL FR RL RR), on top of any
+  /// perturbation: a weak motor (Perturbation::wheelTorque). The log records
+  /// it (meta `perturbation_wheel_torque`) and re-simulation applies it.
+  std::array<double, 4> wheelTorque{1, 1, 1, 1};
   /// Further meta for the session log (`parent_log`, `parent_time`).
   std::map<std::string, std::string> logMeta;
   /// Lines for the operator (no newline): connections, refusals, lease

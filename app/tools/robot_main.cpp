@@ -52,6 +52,9 @@ constexpr const char* kUsage = R"(usage:
                         +-30 %, wheel torque limit and speed gain +-20 %,
                         actuator delay 0-60 ms, IMU roll/pitch bias +-1 deg);
                         WELCOME and telemetry do not tell them, the log does
+      --weak-motor WHEEL=F  that wheel motor's torque limit times F (fl, fr, rl
+                        or rr; F in (0, 2]; repeatable): a weak motor, with or
+                        without --perturb; the log records it
       --perturb-report  print the deviations (with --perturb) and exit
   Prints `world PATH`, `logging to PATH`, then `listening on ADDRESS:PORT`
   when ready;
@@ -110,6 +113,15 @@ std::optional<int> parseArgs(const std::vector<std::string>& args, sp::StandInOp
         return 2;
       }
       options.perturbSeed = seed;
+    }
+    else if (a == "--weak-motor") {
+      sp::Perturbation p;
+      p.wheelTorque = options.wheelTorque;
+      if (const std::string why = sp::parseWeakMotor(v, p); !why.empty()) {
+        std::cerr << "<command line>: error: --weak-motor: " << why << "\n";
+        return 2;
+      }
+      options.wheelTorque = p.wheelTorque;
     }
     else if (a == "--delay" || a == "--jitter" || a == "--loss") {
       char* end = nullptr;

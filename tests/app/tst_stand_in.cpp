@@ -348,6 +348,7 @@ class TestStandIn : public QObject {
                                     std::string& robotHash, double& roll) {
       StandInOptions o = options(log);
       o.perturbSeed = seed;
+      if (seed) o.wheelTorque = {1, 1, 0.5, 1};  // and a weak rear-left motor
       Diagnostics diag;
       auto robot = StandInRobot::create(o, diag);
       QVERIFY2(robot, diag.format().c_str());
@@ -399,23 +400,26 @@ class TestStandIn : public QObject {
     const auto meta = reader->meta();
     QCOMPARE(meta.at("perturbation_seed"), std::string("11"));
     QCOMPARE(meta.at("perturbation"), p.report(robot));
+    QCOMPARE(meta.at("perturbation_wheel_torque"), std::string("1 1 0.5 1"));
     reader.reset();
     const std::optional<ResimReport> r = resimulate(path, {}, error);
     QVERIFY2(r, error.c_str());
     QVERIFY2(!r->divergence, "the perturbed log does not re-simulate with its deviations");
     QVERIFY(r->hashesCompared >= 2);
-    // Control: the same log as if the robot were its twin.
-    const std::string copy = dir.filePath("unperturbed.splog").toStdString();
-    std::filesystem::copy_file(path, copy);
-    {
+    // Controls: the same log as if the robot were its twin, and as if its
+    // rear-left motor were as strong as the rest.
+    for (const char* pattern : {"perturbation%", "perturbation_wheel_torque"}) {
+      const std::string copy = dir.filePath(QString("without-%1.splog").arg(pattern[12] == '%' ? "all" : "torque")).toStdString();
+      std::filesystem::copy_file(path, copy);
       sqlite3* db = nullptr;
       QCOMPARE(sqlite3_open(copy.c_str(), &db), SQLITE_OK);
-      QCOMPARE(sqlite3_exec(db, "DELETE FROM meta WHERE key LIKE 'perturbation%'", nullptr, nullptr, nullptr), SQLITE_OK);
+      const std::string sql = std::string("DELETE FROM meta WHERE key LIKE '") + pattern + "'";
+      QCOMPARE(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
       sqlite3_close(db);
+      const std::optional<ResimReport> control = resimulate(copy, {}, error);
+      QVERIFY2(control, error.c_str());
+      QVERIFY2(control->divergence, (std::string("re-simulated without meta ") + pattern + ", the log still matched").c_str());
     }
-    const std::optional<ResimReport> control = resimulate(copy, {}, error);
-    QVERIFY2(control, error.c_str());
-    QVERIFY2(control->divergence, "re-simulated without its deviations, the log still matched: they change nothing");
   }
 
   // start() refuses a log file that exists, and then runs nothing; create()

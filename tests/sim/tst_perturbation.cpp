@@ -111,6 +111,31 @@ class TestPerturbation : public QObject {
     QCOMPARE(w.defaultContact.mu, files.defaultContact.mu * p.friction);
   }
 
+  // A weak motor: one wheel's torque limit times its factor, on top of the
+  // seed's; the others and the seed's draws stay (control: no factor, the
+  // seed's limit alone). Bad text is refused naming it.
+  void weakMotorScalesOneWheel() {
+    const WorldModel files = flat();
+    const RobotModel& robot = files.robots[0].model;
+    Perturbation p = drawPerturbation(11, robot);
+    const Perturbation drawn = p;
+    QCOMPARE(parseWeakMotor("rl=0.5", p), std::string());
+    QCOMPARE(p.torqueLimit, drawn.torqueLimit);
+    const WorldModel w = perturbWorld(files, p);
+    for (size_t k = 0; k < 4; ++k)
+      for (size_t a = 0; a < robot.actuators.size(); ++a)
+        if (robot.actuators[a].joint == robot.drive->wheels[k])
+          QCOMPARE(w.robots[0].model.actuators[a].maxTorque, robot.actuators[a].maxTorque * p.torqueLimit * (k == 2 ? 0.5 : 1.0));
+    QVERIFY(p.report(robot).find("wheel_torque_limit.rl = 0.5\n") != std::string::npos);
+    QVERIFY(drawn.report(robot).find("wheel_torque_limit.rl") == std::string::npos);
+    for (const char* bad : {"rl", "rear=0.5", "rl=0", "rl=3", "rl=x", "=0.5"}) {
+      Perturbation q;
+      const std::string why = parseWeakMotor(bad, q);
+      QVERIFY2(why.find(std::string("'") + bad + "'") == 0, why.c_str());
+      QCOMPARE(q.wheelTorque, (std::array<double, 4>{1, 1, 1, 1}));
+    }
+  }
+
   // The robot feels it: its wheels turn (mean over 1-1.5 s) at gain x the commanded speed
   // (within 3 %: its torque limit is perturbed too); control: the twin of
   // the files turns them at the commanded speed within 1 %.
