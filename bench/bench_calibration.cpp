@@ -142,6 +142,8 @@ struct Case {
   double radiusFit = 0, radiusTrue = 0, massFit = 0, massTrue = 0;
   Vec3 comFit, comTrue;  // [m] forward, left of the files' (calibration.com_x, com_y)
   double rehearseFiles = 0, rehearseCal = 0, rehearseGhostValues = 0, rehearseOracle = 0, rehearseOwn = 0;  // [m] end position errors
+  std::array<double, 4> torqueFit{}, torqueTrue{};  // each wheel motor's torque limit, factor
+  std::array<double, 4> tyreError{};                // |fitted / hidden - 1| per tyre (rolling radius)
   double checkMs = 0;
   double fitMsMax = 0, fitMsMedian = 0;
   int fits = 0, refused = 0;
@@ -255,6 +257,28 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
   oracle[static_cast<size_t>(CalParam::Mass)] = c.massTrue;
   oracle[static_cast<size_t>(CalParam::ComX)] = c.comTrue.x;
   oracle[static_cast<size_t>(CalParam::ComY)] = c.comTrue.y;
+  for (size_t w = 0; w < 4; ++w) {
+    const size_t i = static_cast<size_t>(CalParam::TorqueFL) + w;
+    oracle[i] = c.torqueTrue[w] = p.torqueLimit * p.wheelTorque[w];
+    c.torqueFit[w] = values[i];
+  }
+  {
+    // Each tyre as the twins build it from the fitted mean and splits
+    // (calibratedWorld) against the hidden one.
+    SimParams fitted = withCalValues(SimParams{}, values);
+    const WorldModel tw = calibratedWorld(world, fitted);
+    for (size_t w = 0; w < 4; ++w) {
+      const auto& geoms = [&](const WorldModel& m) -> const std::vector<GeomSpec>& {
+        const RobotModel& rm = m.robots[0].model;
+        return rm.links[static_cast<size_t>(rm.joints[static_cast<size_t>(rm.drive->wheels[w])].child)].geoms;
+      };
+      for (size_t g = 0; g < geoms(world).size(); ++g)
+        if (geoms(world)[g].type == GeomType::Cylinder || geoms(world)[g].type == GeomType::Sphere) {
+          c.tyreError[w] = std::abs(geoms(tw)[g].radius / (geoms(world)[g].radius * radii[w]) - 1);
+          break;
+        }
+    }
+  }
   check(world, oracle, c.oraclePos, c.oracleHead);
   if (std::getenv("SP_BENCH_VALUES")) {  // each parameter: estimate +- sigma [applied] (hidden)
     std::string text;
@@ -388,6 +412,10 @@ int main(int argc, char** argv) {
                   c.radiusTrue, c.massFit, c.massTrue, c.comFit.x * 1000, c.comTrue.x * 1000, c.comFit.y * 1000, c.comTrue.y * 1000,
                   c.rehearseFiles, c.rehearseCal, c.rehearseGhostValues, c.rehearseOracle, c.rehearseOwn, c.fits, c.refused, c.fitMsMedian,
                   c.fitMsMax, c.checkMs, c.problem.c_str());
+      std::printf("       torque fit/true FL %.3f/%.3f FR %.3f/%.3f RL %.3f/%.3f RR %.3f/%.3f | tyre |err| FL %.2f FR %.2f RL %.2f RR %.2f %%\n",
+                  c.torqueFit[0], c.torqueTrue[0], c.torqueFit[1], c.torqueTrue[1], c.torqueFit[2], c.torqueTrue[2],
+                  c.torqueFit[3], c.torqueTrue[3], c.tyreError[0] * 100, c.tyreError[1] * 100, c.tyreError[2] * 100,
+                  c.tyreError[3] * 100);
       std::fflush(stdout);
       cases[i] = std::move(c);
     }
@@ -436,6 +464,28 @@ int main(int argc, char** argv) {
                 *std::max_element(merr.begin(), merr.end()) * 100, *std::max_element(cerr.begin(), cerr.end()) * 1000,
                 median(cerr) * 1000, median(reh), *std::max_element(reh.begin(), reh.end()),
                 within, oracleWithin, ownWithin, reh.size(), controlRatio);
+  }
+  // The motors and tyres (issue 61): a weak motor (--weak-motor) fitted as
+  // the motor within 15 %, the others' fits, and the tyres within 0.5 %.
+  std::printf("\nmotors and tyres (every seed, the control too):\n");
+  for (const auto& [name, _] : loaded) {
+    int weak = 0, weakWithin = 0;
+    double otherWorst = 0, tyreWorst = 0;
+    for (const Case& c : cases) {
+      if (c.world != name || !c.problem.empty()) continue;
+      for (size_t w = 0; w < 4; ++w) {
+        const double off = std::abs(c.torqueFit[w] / c.torqueTrue[w] - 1);
+        if (gWheelTorque[w] < 1) {
+          ++weak;
+          weakWithin += off <= 0.15;
+        } else {
+          otherWorst = std::max(otherWorst, off);
+        }
+        tyreWorst = std::max(tyreWorst, c.tyreError[w]);
+      }
+    }
+    std::printf("%-6s | weak motors within 15 %%: %d of %d | the other motors' |fit/true - 1| max %.3f | tyres |err| max %.2f %%\n",
+                name.c_str(), weakWithin, weak, otherWorst, tyreWorst * 100);
   }
   return 0;
 }

@@ -33,6 +33,18 @@ constexpr std::array<CalParamInfo, kCalParams> kTable{{
      "twins: [m] the centre of mass moved forward (every link's centre)", "m", 0, -0.1, 0.1, 0.02, 0, kComBias},
     {P::ComY, &S::calComY, "calibration.com_y", "centre of mass left", "CoM left",
      "twins: [m] the centre of mass moved left (every link's centre)", "m", 0, -0.1, 0.1, 0.02, 0, kComBias},
+    // A motor's limit shows only where the wheel asks more of it than it
+    // has: the forces the twin's wheels put on the ground against the
+    // robot's (app/calibration/calibration_torque.cpp). Probes go down: above
+    // what the wheel asks, a limit changes nothing.
+    {P::TorqueFL, &S::calTorqueFL, "calibration.torque_fl", "front-left motor torque", "torque FL",
+     "twins: factor on the front-left wheel motor's torque limit", "", 1, 0.1, 2, 0.2, 0.15, 0},
+    {P::TorqueFR, &S::calTorqueFR, "calibration.torque_fr", "front-right motor torque", "torque FR",
+     "twins: factor on the front-right wheel motor's torque limit", "", 1, 0.1, 2, 0.2, 0.15, 0},
+    {P::TorqueRL, &S::calTorqueRL, "calibration.torque_rl", "rear-left motor torque", "torque RL",
+     "twins: factor on the rear-left wheel motor's torque limit", "", 1, 0.1, 2, 0.2, 0.15, 0},
+    {P::TorqueRR, &S::calTorqueRR, "calibration.torque_rr", "rear-right motor torque", "torque RR",
+     "twins: factor on the rear-right wheel motor's torque limit", "", 1, 0.1, 2, 0.2, 0.15, 0},
 }};
 
 constexpr bool inOrder() {

@@ -12,8 +12,11 @@
 namespace sp {
 
 /// The fitted parameters, in the order of calParams().
-enum class CalParam : int { WheelRadius, WheelRadiusSplit, WheelRadiusSide, WheelRadiusDiag, Friction, MotorGain, Delay, Mass, ComX, ComY };
-constexpr int kCalParams = 10;
+enum class CalParam : int {
+  WheelRadius, WheelRadiusSplit, WheelRadiusSide, WheelRadiusDiag, Friction, MotorGain, Delay, Mass, ComX, ComY,
+  TorqueFL, TorqueFR, TorqueRL, TorqueRR  ///< each wheel motor's torque limit (FL FR RL RR), from the wheels' forces
+};
+constexpr int kCalParams = 14;
 
 /// [m] about what the load fit of the centre of mass reads of a robot that
 /// is its twin: 0.3-0.5 mm on flat ground (tst_calibration

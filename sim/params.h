@@ -105,6 +105,8 @@ struct SimParams {
   /// [m] the robot's centre of mass moved forward (x) and left (y) of the
   /// files', robot frame at zero pose: every link's centre moved by as much.
   double calComX = 0, calComY = 0;
+  /// Each wheel motor's torque limit, a factor (FL FR RL RR): a weak motor.
+  double calTorqueFL = 1, calTorqueFR = 1, calTorqueRL = 1, calTorqueRR = 1;
   /// Whether any calibration.* key differs from the files (identity).
   bool calibrated() const;
   // Gaits (sim/gait.h); swings in degrees about the stance pose

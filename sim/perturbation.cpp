@@ -84,6 +84,7 @@ Perturbation calibrationPerturbation(const SimParams& params, const RobotModel& 
     p.centreOfMass[i] = rotate(conjugate(robot.links[i].pose.q), Vec3{params.calComX, params.calComY, 0});
   p.friction = params.calFriction;
   p.velocityGain = params.calMotorGain;
+  p.wheelTorque = {params.calTorqueFL, params.calTorqueFR, params.calTorqueRL, params.calTorqueRR};
   return p;
 }
 
@@ -128,8 +129,11 @@ std::optional<std::string> calibratedRobotText(const std::string& text, const Ro
       }
     } else if (std::string_view(e->Name()) == "actuator" && robot.drive && e->Attribute("joint")) {
       const int joint = robot.findJoint(e->Attribute("joint"));
-      for (int wheel : robot.drive->wheels)
-        if (joint >= 0 && joint == wheel) scale(e, "velocity_scale", p.velocityGain, 1);
+      for (size_t w = 0; w < 4; ++w)
+        if (joint >= 0 && joint == robot.drive->wheels[w]) {
+          scale(e, "velocity_scale", p.velocityGain, 1);
+          if (p.wheelTorque[w] != 1) scale(e, "max_torque", p.wheelTorque[w], 0);
+        }
     }
   }
   for (size_t i = 0; i < seen.size(); ++i)
@@ -138,7 +142,7 @@ std::optional<std::string> calibratedRobotText(const std::string& text, const Ro
       return std::nullopt;
     }
   const std::string note = " Calibrated from telemetry (SimPartner, app/calibration/): link masses x " +
-                           shortestText(params.calMass) + ", tyre radii and wheel motors' velocity_scale written in. " +
+                           shortestText(params.calMass) + ", tyre radii and wheel motors' velocity_scale and max_torque written in. " +
                            "Not in a robot file, keep them in the parameters: calibration.friction = " +
                            shortestText(params.calFriction) + " (the ground's contact), calibration.delay = " +
                            shortestText(params.calDelay) + " s (the link's)" +

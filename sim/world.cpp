@@ -121,7 +121,7 @@ bool World::step() {
   if (health_.healthy()) canonicalizeQuaternions();
   // Contact feedback is valid until the contact joints go.
   if (health_.healthy()) updateMotionResistance();
-  if (options_.sensors && health_.healthy()) {
+  if ((options_.sensors || options_.wheelForces) && health_.healthy()) {
     accumulateWheelForces();
     sampleSensors();
   }

@@ -109,6 +109,9 @@ struct HealthReport {
 struct WorldOptions {
   bool sensors = true;      ///< sample the robot's sensors
   bool controllers = true;  ///< run actuators, drive kinematics and damping
+  /// With sensors off, still sample the wheel_force sensors (the contacts'
+  /// feedback; no laser, no IMU): what a calibration compares of the forces.
+  bool wheelForces = false;
 };
 
 /// One contact point of the last step that involves a robot's link.

@@ -143,7 +143,7 @@ void World::collide() {
     // the force from the ground into the wheel.
     const Vec3 n{c.geom.normal[0], c.geom.normal[1], c.geom.normal[2]};
     const GeomInfo* wheel = i1->wheelSensor >= 0 ? i1 : (i2->wheelSensor >= 0 ? i2 : nullptr);
-    if (wheel && options_.sensors) {
+    if (wheel && (options_.sensors || options_.wheelForces)) {
       dJointSetFeedback(j, &m.contactFeedback[k]);
       const bool first = wheel == i1;
       // ODE fills f1 for the first non-null body it was attached to.

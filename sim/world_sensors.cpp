@@ -32,6 +32,7 @@ void World::sampleSensors() {
     for (size_t si = 0; si < robot.sensors.size(); ++si) {
       SensorState& st = rt.sensors[si];
       if (steps_ < st.nextStep) continue;
+      if (!options_.sensors && robot.sensors[si].type != SensorType::WheelForce) continue;  // WorldOptions::wheelForces
       const int64_t period = rt.sensorPeriod[si];
       st.nextStep += period;
       const SensorSpec& spec = robot.sensors[si];

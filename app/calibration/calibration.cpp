@@ -409,7 +409,10 @@ CalibrationFit fitCalibration(const WorldModel& files, const SimParams& profile,
     fit.costAfter = fit.costBefore;
   }
   deviationsAtTheFit(o, t, fit);
-  return done(settle(start, rolled, t, fit));
+  if (std::string refused = settle(start, rolled, t, fit); !refused.empty()) return done(refused);
+  // The motors' torque limits last, the rest as fitted: the forces depend on them all.
+  CalValues v = fit.value;
+  return done(fitMotorTorques(pb, o, v, fit, elapsedMs, abort));
 }
 
 PredictionCheck checkPredictions(const WorldModel& files, const SimParams& profile, const std::vector<RobotFrame>& in,

@@ -30,6 +30,10 @@
 //     filter: the twin is the model, with its contacts and its controller;
 //     nothing linearised by hand has to agree with it, and a new parameter
 //     is one more column.
+//   - Each wheel motor's torque limit from the wheels' tangential forces,
+//     the twin's against the robot's, the rest held (calibration_torque.cpp):
+//     a weak motor is carried along by the others, so the motion hardly
+//     shows it; what its wheel pushes does.
 //
 // Observability. From J'J with each residual at its scale, each
 // parameter's standard deviation; a parameter whose deviation exceeds half

@@ -11,6 +11,7 @@
 #include "app/state/robot_shapes.h"
 #include "sim/kinematics.h"
 #include "sim/perturbation.h"
+#include "sim/readout.h"
 #include "sim/rigid.h"
 #include "sim/runner.h"
 #include "sim/text.h"
@@ -73,7 +74,8 @@ int modelJoint(const std::optional<RigidRobot>& rigid, int full) {
 }  // namespace
 
 std::optional<std::vector<double>> residuals(const Problem& pb, const CalValues& v, std::string& why,
-                                             std::vector<std::pair<double, double>>* turns, double jitter) {
+                                             std::vector<std::pair<double, double>>* turns, double jitter,
+                                             std::vector<double>* forces) {
   WorldModel model = calibratedWorld(*pb.files, withCalValues(pb.profile, v));
   std::optional<RigidRobot> rigid;
   if (!pb.held.empty()) {
@@ -83,6 +85,7 @@ std::optional<std::vector<double>> residuals(const Problem& pb, const CalValues&
   }
   WorldOptions options;
   options.sensors = false;
+  options.wheelForces = forces != nullptr;
   Diagnostics diag;
   std::unique_ptr<World> world = World::create(model, pb.profile, diag, options);
   if (!world) {
@@ -154,6 +157,10 @@ std::optional<std::vector<double>> residuals(const Problem& pb, const CalValues&
         r.push_back((twinTurn[w] - robotTurn[w]) / kResidualScale.wheelTurn);
         if (turns) turns->emplace_back(twinTurn[w], robotTurn[w]);
       }
+      if (forces) {
+        const std::array<double, 4> twin = readRobot(*world).wheelTangential;
+        for (size_t w = 0; w < 4; ++w) forces->push_back((twin[w] - f[c].wheelTangential[w]) / kResidualScale.force);
+      }
       r.push_back(articulation < 0 ? 0
                                    : (world->jointPosition(0, articulation) -
                                       f[c].jointPositions[static_cast<size_t>(pb.articulation)]) /
@@ -190,7 +197,12 @@ std::vector<std::optional<std::vector<double>>> runAll(const Problem& pb, const 
     }
     // The candidate fails, not the fit: a twin that throws is a bad candidate.
     try {
-      out[i] = residuals(pb, candidates[i].values, whys[i], nullptr, candidates[i].jitter);
+      if (candidates[i].forces) {
+        std::vector<double> f;
+        if (residuals(pb, candidates[i].values, whys[i], nullptr, candidates[i].jitter, &f)) out[i] = std::move(f);
+      } else {
+        out[i] = residuals(pb, candidates[i].values, whys[i], nullptr, candidates[i].jitter);
+      }
     } catch (const std::exception& e) {
       out[i].reset();
       whys[i] = std::string("its twin failed: ") + e.what();

@@ -22,6 +22,7 @@ struct ResidualScale {
   double heading = 0.01;    // [rad]
   double wheelTurn = 0.2;   // [rad] a wheel's turn since the anchor (contacts make it chatter by ~0.05)
   double articulation = 0.01;  // [rad]
+  double force = 20;           // [N] a wheel's tangential force (the contacts chatter by about this)
 };
 constexpr ResidualScale kResidualScale;
 constexpr int kPerCheckpoint = 8;  // x, y, heading, 4 wheel rates, articulation
@@ -56,9 +57,12 @@ std::string makeProblem(const WorldModel& files, const SimParams& profile, const
 /// anchor, (twin, robot), for the motor gain's closed form. `jitter` [m]
 /// lifts every anchor by that much: a run from anchors a micrometre off
 /// differs from the plain one by the contacts' chaos alone (the noise probe).
+/// `forces`, when given, receives each checkpoint's four wheels' tangential
+/// forces, twin less robot, at kResidualScale.force (the twin then samples
+/// its wheel_force sensors, WorldOptions::wheelForces).
 std::optional<std::vector<double>> residuals(const Problem& pb, const CalValues& v, std::string& why,
                                              std::vector<std::pair<double, double>>* turns = nullptr,
-                                             double jitter = 0);
+                                             double jitter = 0, std::vector<double>* forces = nullptr);
 
 double meanSquare(const std::vector<double>& r);
 
@@ -66,6 +70,7 @@ double meanSquare(const std::vector<double>& r);
 struct Candidate {
   CalValues values;
   double jitter = 0;
+  bool forces = false;  ///< its residuals are the wheels' forces (residuals()' `forces`), not the motion's
 };
 
 /// Runs the candidates on up to `threads` threads; a failed one is nullopt
@@ -73,5 +78,13 @@ struct Candidate {
 std::vector<std::optional<std::vector<double>>> runAll(const Problem& pb, const std::vector<Candidate>& candidates,
                                                        int threads, std::string& why,
                                                        const std::function<bool()>& abort = {});
+
+/// Each wheel motor's torque limit (CalParam::TorqueFL..RR) fitted to the
+/// wheels' tangential forces, the rest of `v` held (calibration_torque.cpp):
+/// into `v` and `fit` (value, sigma, observed), those the window never
+/// pushed to a limit unobserved at their start. Nothing when the frames
+/// report no tangential forces. "" or why the fit is refused.
+std::string fitMotorTorques(const Problem& pb, const CalibrationOptions& o, CalValues& v, CalibrationFit& fit,
+                            const std::function<double()>& elapsedMs, const std::function<bool()>& abort);
 
 }  // namespace sp::calibration_detail

@@ -4,6 +4,8 @@
 
 #include <sqlite3.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -311,7 +313,12 @@ bool SessionLogWriter::writeBatch(std::deque<Item>& batch) {
       for (int i = 0; i < 3; ++i) st.bind(3 + i, m->base[static_cast<std::size_t>(i)]);
       for (int i = 0; i < 4; ++i) st.bind(6 + i, m->quat[static_cast<std::size_t>(i)]);
       st.bind(10, packDoubles(m->joints.data(), m->joints.size()));
-      st.bind(11, packDoubles(m->wheelNormal.data(), m->wheelNormal.size()));
+      // The normal forces, then the tangential ones: a reader of the older
+      // four-value column reads the normals as before.
+      std::array<double, 8> wheels{};
+      std::copy(m->wheelNormal.begin(), m->wheelNormal.end(), wheels.begin());
+      std::copy(m->wheelTangential.begin(), m->wheelTangential.end(), wheels.begin() + 4);
+      st.bind(11, packDoubles(wheels.data(), wheels.size()));
       st.bind(12, m->roll); st.bind(13, m->pitch);
       rc = st.exec();
     } else if (const auto* l = std::get_if<LogLaser>(&item)) {
@@ -454,6 +461,7 @@ LogSample readSample(Stmt& q) {
   s.joints = q.doubles(9);
   std::vector<double> wheels = q.doubles(10);
   for (std::size_t i = 0; i < 4 && i < wheels.size(); ++i) s.wheelNormal[i] = wheels[i];
+  for (std::size_t i = 0; i < 4 && i + 4 < wheels.size(); ++i) s.wheelTangential[i] = wheels[i + 4];
   s.roll = q.f64(11);
   s.pitch = q.f64(12);
   return s;

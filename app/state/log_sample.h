@@ -16,6 +16,7 @@ struct LogSample {
   std::array<double, 4> quat{1, 0, 0, 0};  ///< base orientation w, x, y, z
   std::vector<double> joints;        ///< positions [rad or m] then velocities
   std::array<double, 4> wheelNormal{};  ///< wheel normal forces FL, FR, RL, RR [N]
+  std::array<double, 4> wheelTangential{};  ///< ... and across the normal [N]; 0 in older logs
   double roll = 0, pitch = 0;        ///< [rad]
   friend bool operator==(const LogSample&, const LogSample&) = default;
 };

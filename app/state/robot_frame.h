@@ -26,6 +26,9 @@ struct RobotFrame {
   std::vector<double> jointPositions;  ///< model joint order [rad or m]; 0 where unknown
   std::vector<double> jointRates;      ///< model joint order; 0 where unknown
   std::array<double, 4> wheelNormal{};  ///< [N] FL FR RL RR
+  /// [N] FL FR RL RR, the contacts' force across the normal; all 0 where
+  /// not reported (a log written before 2026-12-02).
+  std::array<double, 4> wheelTangential{};
   double roll = 0, pitch = 0;          ///< [rad]
   std::vector<ObjectReadout> objects;  ///< dynamic objects by name
   std::string health;                  ///< "" while healthy

@@ -31,6 +31,7 @@ LogSample sampleFromReadout(const RobotReadout& r) {
   s.joints.insert(s.joints.end(), r.jointPositions.begin(), r.jointPositions.end());
   s.joints.insert(s.joints.end(), r.jointRates.begin(), r.jointRates.end());
   s.wheelNormal = r.wheelNormal;
+  s.wheelTangential = r.wheelTangential;
   s.roll = r.roll;
   s.pitch = r.pitch;
   return s;
@@ -48,6 +49,7 @@ LogSample sampleFromTelemetry(const net::TelemetryMsg& t, int64_t step, const Ro
   const std::vector<double> r = rates.toModelOrder(t.jointNames, t.jointVelocities, robot);
   s.joints.insert(s.joints.end(), r.begin(), r.end());
   s.wheelNormal = t.wheelNormal;
+  s.wheelTangential = t.wheelTangential;
   s.roll = t.roll;
   s.pitch = t.pitch;
   return s;
@@ -64,6 +66,7 @@ RobotFrame frameFromTelemetry(const net::TelemetryMsg& t, const RobotModel* robo
     f.baseAngularVelocity = {t.baseVelocity[3], t.baseVelocity[4], t.baseVelocity[5]};
   }
   f.wheelNormal = t.wheelNormal;
+  f.wheelTangential = t.wheelTangential;
   f.roll = t.roll;
   f.pitch = t.pitch;
   f.health = t.health;
@@ -87,6 +90,7 @@ RobotFrame frameFromSample(const LogSample& s, size_t joints) {
   for (size_t j = 0; j < joints && j < s.joints.size(); ++j) f.jointPositions[j] = s.joints[j];
   for (size_t j = 0; j < joints && joints + j < s.joints.size(); ++j) f.jointRates[j] = s.joints[joints + j];
   f.wheelNormal = s.wheelNormal;
+  f.wheelTangential = s.wheelTangential;
   f.roll = s.roll;
   f.pitch = s.pitch;
   return f;
@@ -102,6 +106,7 @@ RobotFrame frameFromReadout(const RobotReadout& r) {
   f.jointPositions = r.jointPositions;
   f.jointRates = r.jointRates;
   f.wheelNormal = r.wheelNormal;
+  f.wheelTangential = r.wheelTangential;
   f.roll = r.roll;
   f.pitch = r.pitch;
   f.health = r.health;

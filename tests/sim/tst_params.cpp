@@ -147,7 +147,7 @@ void TestParams::tableDefaultsAreSimParamsDefaults() {
   std::set<std::string> seen;
   const QRegularExpression keyPattern("^[a-z]+(\\.[a-z_]+)+$");
   const std::vector<ParamInfo> table = paramTable();
-  QCOMPARE(table.size(), size_t(66));
+  QCOMPARE(table.size(), size_t(70));
   for (const ParamInfo& info : table) {
     QVERIFY2(seen.insert(info.key).second, info.key.c_str());
     QVERIFY2(keyPattern.match(q(info.key)).hasMatch(), info.key.c_str());
