@@ -1,7 +1,9 @@
 // The 3D view's picture of how sure the ghost is (ui/scene_view_impl.h):
 // two translucent discs on the ground about the ghost's base (the inner and
-// outer regions), a band along its trail that widens with the horizon, and
-// red marks where the robot departed from its twin.
+// outer regions), the ghost's faint spread (two fainter ghosts as far ahead
+// and behind as the outer region reaches), a band along its trail that widens with the horizon, and
+// red marks where the robot departed from its twin; and the rehearsed
+// path's band, where the robustness runs went.
 #include "ui/scene_view_impl.h"
 
 namespace sp {
@@ -10,6 +12,8 @@ namespace {
 
 constexpr int kSegments = 48;
 constexpr float kLift = 0.03f;  // [m] above the ground, under the trail's line
+// [m] an outer region narrower than this puts the spread inside the ghost: not drawn.
+constexpr double kSpreadMin = 0.05;
 
 osg::ref_ptr<osg::Geometry> filled(GLenum mode, osg::Vec4 colour) {
   osg::ref_ptr<osg::Geometry> g = newGeometry();
@@ -27,6 +31,23 @@ void setCount(osg::Geometry* g) {
   v->dirty();
   static_cast<osg::DrawArrays*>(g->getPrimitiveSet(0))->setCount(static_cast<GLsizei>(v->size()));
   g->dirtyBound();
+}
+
+// A band along `p` on the ground: each point moved sideways by its radius, both ways.
+void fillBand(osg::Geometry* g, const TerrainSpec& terrain, const std::vector<Vec3>& p, const std::vector<double>& radius) {
+  auto* v = static_cast<osg::Vec3Array*>(g->getVertexArray());
+  v->clear();
+  if (radius.size() == p.size() && p.size() > 1)
+    for (size_t k = 0; k < p.size(); ++k) {
+      const Vec3 a = p[k > 0 ? k - 1 : k], b = p[k + 1 < p.size() ? k + 1 : k];
+      const double dx = b.x - a.x, dy = b.y - a.y, d = std::hypot(dx, dy);
+      const double nx = d > 1e-9 ? -dy / d : 0, ny = d > 1e-9 ? dx / d : 0;
+      for (double side : {1.0, -1.0}) {
+        const double x = p[k].x + side * nx * radius[k], y = p[k].y + side * ny * radius[k];
+        v->push_back({f(x), f(y), f(groundHeight(terrain, x, y)) + kLift});
+      }
+    }
+  setCount(g);
 }
 
 }  // namespace
@@ -49,6 +70,35 @@ void SceneView::Impl::buildRegion() {
   s->setRenderingHint(osg::StateSet::TRANSPARENT_BIN);
   r.node->setNodeMask(0);
   root->addChild(r.node);
+  // The spread: the ghost's link transforms under an offset each, in the
+  // ghost's blue at a third of its strength, writing no depth (two faint
+  // copies never hide each other or what stands behind).
+  for (osg::ref_ptr<osg::MatrixTransform>& spread : r.spread) {
+    spread = new osg::MatrixTransform;
+    spread->addChild(ghost.body);
+    auto* tint = new osg::Material;
+    tint->setColorMode(osg::Material::OFF);
+    const osg::Vec4 faint{kGhostTint[0], kGhostTint[1], kGhostTint[2], kGhostTint[3] / 3};
+    tint->setDiffuse(osg::Material::FRONT_AND_BACK, faint);
+    tint->setAmbient(osg::Material::FRONT_AND_BACK, {faint.r() / 2, faint.g() / 2, faint.b() / 2, faint.a()});
+    tint->setSpecular(osg::Material::FRONT_AND_BACK, {0, 0, 0, faint.a()});
+    osg::StateSet* st = spread->getOrCreateStateSet();
+    st->setAttributeAndModes(tint, osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+    st->setMode(GL_BLEND, osg::StateAttribute::ON);
+    st->setAttributeAndModes(new osg::BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA), osg::StateAttribute::ON);
+    st->setAttributeAndModes(new osg::Depth(osg::Depth::LESS, 0.0, 1.0, false), osg::StateAttribute::ON);
+    st->setAttributeAndModes(new osg::CullFace(osg::CullFace::BACK), osg::StateAttribute::ON | osg::StateAttribute::OVERRIDE);
+    st->setRenderingHint(osg::StateSet::TRANSPARENT_BIN);
+    spread->setNodeMask(0);
+    root->addChild(spread);
+  }
+  // The rehearsed path's band: the rehearsal's amber, as faint, the same state.
+  r.rehearsalNode = new osg::Geode;
+  r.rehearsalStrip = filled(GL_TRIANGLE_STRIP, {1.00f, 0.60f, 0.10f, 0.18f});
+  r.rehearsalNode->addDrawable(r.rehearsalStrip);
+  r.rehearsalNode->setStateSet(s);
+  r.rehearsalNode->setNodeMask(0);
+  root->addChild(r.rehearsalNode);
   // Departures: a red ring and a post at each, unlit, over everything near.
   r.marksNode = new osg::Geode;
   r.marks = filled(GL_LINES, {0.85f, 0.10f, 0.10f, 1.0f});
@@ -77,23 +127,26 @@ void SceneView::Impl::syncRegion() {
     };
     disc(r.outer.get(), r.outerRadius);
     disc(r.inner.get(), r.innerRadius);
-    // The band: each trail point moved sideways by its radius, both ways.
-    auto* v = static_cast<osg::Vec3Array*>(r.bandStrip->getVertexArray());
-    v->clear();
-    const std::vector<Vec3>& p = ghost.pathPoints;
-    if (r.band.size() == p.size() && p.size() > 1)
-      for (size_t k = 0; k < p.size(); ++k) {
-        const Vec3 a = p[k > 0 ? k - 1 : k], b = p[k + 1 < p.size() ? k + 1 : k];
-        const double dx = b.x - a.x, dy = b.y - a.y, d = std::hypot(dx, dy);
-        const double nx = d > 1e-9 ? -dy / d : 0, ny = d > 1e-9 ? dx / d : 0;
-        for (double side : {1.0, -1.0}) {
-          const double x = p[k].x + side * nx * r.band[k], y = p[k].y + side * ny * r.band[k];
-          v->push_back({f(x), f(y), f(groundHeight(terrain, x, y)) + kLift});
-        }
-      }
-    setCount(r.bandStrip.get());
+    fillBand(r.bandStrip.get(), terrain, ghost.pathPoints, r.band);
     r.drawnAt = about;
     r.dirty = false;
+  }
+  // The spread follows the ghost's body (drawn only where the ghost is).
+  const bool spread = shown && ghost.node->getNodeMask() != 0 && r.outerRadius >= kSpreadMin;
+  const Vec3 heading = rotate(ghost.base.q, Vec3{1, 0, 0});
+  const double along = std::hypot(heading.x, heading.y);
+  for (size_t k = 0; k < r.spread.size(); ++k) {
+    r.spread[k]->setNodeMask(spread && along > 1e-6 ? ~0u : 0u);
+    const double d = (k == 0 ? 1 : -1) * r.outerRadius / std::max(along, 1e-6);
+    r.spread[k]->setMatrix(osg::Matrix::translate(f(heading.x * d), f(heading.y * d), 0.0f));
+  }
+  r.spreadDrawn = spread && along > 1e-6 ? r.outerRadius : 0;
+  const bool rehearsalBand = rehearsal.visible && hasRobot && r.rehearsalBand.size() == rehearsal.pathPoints.size() &&
+                             rehearsal.pathPoints.size() > 1;
+  r.rehearsalNode->setNodeMask(rehearsalBand ? ~0u : 0u);
+  if (r.rehearsalDirty) {
+    fillBand(r.rehearsalStrip.get(), terrain, rehearsal.pathPoints, r.rehearsalBand);
+    r.rehearsalDirty = false;
   }
   r.marksNode->setNodeMask(hasRobot && !r.places.empty() ? ~0u : 0u);
   if (r.marksDirty) {
@@ -133,6 +186,18 @@ double SceneView::drawnGhostRegion() const { return m_->region.node->getNodeMask
 
 size_t SceneView::drawnTrailBand() const {
   return m_->region.node->getNodeMask() ? m_->region.bandStrip->getVertexArray()->getNumElements() / 2 : 0;
+}
+
+double SceneView::drawnGhostSpread() const { return m_->region.spreadDrawn; }
+
+void SceneView::setRehearsalBand(const std::vector<double>& radii) {
+  m_->region.rehearsalBand = radii;
+  m_->region.rehearsalDirty = true;
+  update();
+}
+
+size_t SceneView::drawnRehearsalBand() const {
+  return m_->region.rehearsalNode->getNodeMask() ? m_->region.rehearsalStrip->getVertexArray()->getNumElements() / 2 : 0;
 }
 
 void SceneView::setDepartureMarks(const std::vector<Vec3>& places, bool lastOn) {

@@ -314,6 +314,8 @@ void SceneView::setWorld(const WorldModel& world) {
     p->envelopePoints.clear();
     p->pathDirty = true;
   }
+  m.region.rehearsalBand.clear();
+  m.region.rehearsalDirty = true;
   m.laserRanges.clear();
   m.laserDirty = true;
   if (!m.hasRobot) m.centre = {};

@@ -92,6 +92,10 @@ class SceneView : public QOpenGLWidget {
   /// (0 while hidden).
   double drawnGhostRegion() const;
   size_t drawnTrailBand() const;
+  /// [m] how far ahead and behind the ghost its faint spread is drawn (the
+  /// outer region's radius; 0 when hidden: the ghost or region hidden, or
+  /// the region under 5 cm).
+  double drawnGhostSpread() const;
   /// Where the robot departed from its twin (its base at each departure's
   /// start), marked on the ground in red whether the ghost is shown or not;
   /// `lastOn`: the last one is on now (drawn brighter).
@@ -108,6 +112,12 @@ class SceneView : public QOpenGLWidget {
   void setRehearsalPath(const std::vector<Vec3>& points);
   /// A closed line drawn with the path (the robustness runs' end positions).
   void setRehearsalEnvelope(const std::vector<Vec3>& points);
+  /// The rehearsed path's band: a radius per rehearsal path point (the
+  /// robustness runs' 90 %, SequenceWorkflow::band()), drawn translucent on
+  /// the ground with the path; empty for none.
+  void setRehearsalBand(const std::vector<double>& radii);
+  /// The band's points as drawn (0 when hidden or none).
+  size_t drawnRehearsalBand() const;
   void setRehearsalVisible(bool visible);
   bool rehearsalVisible() const;
   /// The amber robot itself (its path stays): hidden once the rehearsed

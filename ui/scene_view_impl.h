@@ -469,6 +469,14 @@ struct SceneView::Impl {
     osg::ref_ptr<osg::Geometry> inner, outer, bandStrip, marks;
     double innerRadius = 0, outerRadius = 0;
     std::vector<double> band;  // per ghost.pathPoints
+    // The ghost's faint spread: the ghost's body again, fainter, as far
+    // ahead and behind along its heading as the outer region reaches.
+    std::array<osg::ref_ptr<osg::MatrixTransform>, 2> spread;
+    double spreadDrawn = 0;  // [m] their offset as drawn; 0 hidden
+    osg::ref_ptr<osg::Geode> rehearsalNode;  // the rehearsed path's band, shown with that path
+    osg::ref_ptr<osg::Geometry> rehearsalStrip;
+    std::vector<double> rehearsalBand;  // per rehearsal.pathPoints
+    bool rehearsalDirty = false;
     std::vector<Vec3> places;  // departures
     bool lastOn = false;
     bool dirty = false, marksDirty = false;

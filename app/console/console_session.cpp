@@ -91,6 +91,15 @@ SimParams ConsoleSession::twinParams() const {
   return calibrator_ ? withCalValues(params_, calibrator_->fullPhysics()) : params_;
 }
 
+std::optional<RobotEstimate> ConsoleSession::twinEstimate() const {
+  if (!calibrator_) return std::nullopt;
+  const CalibrationState s = calibrator_->state();
+  RobotEstimate e;
+  e.sigma = s.sigma;
+  e.observed = s.observed;
+  return e;
+}
+
 void ConsoleSession::takeCalibration() {
   if (!calibrator_ || calibrator_->version() == calibrationSeen_) return;
   const CalibrationState s = calibrator_->state();

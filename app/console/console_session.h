@@ -26,6 +26,7 @@
 #include "app/console/telemetry_tap.h"
 #include "app/ghost/ghost.h"
 #include "app/log/resimulation.h"
+#include "app/rehearse/rehearsal.h"
 #include "app/state/robot_frame.h"
 #include "net/message.h"
 #include "net/robot_client.h"
@@ -184,6 +185,11 @@ class ConsoleSession {
   /// (the calibrator's fullPhysics(): the radius splits once the full
   /// physics confirmed them).
   SimParams twinParams() const;
+  /// What the console knows of the robot for robustness draws: the
+  /// calibration's deviations where its fits observed a parameter, the
+  /// prior's range where not; nullopt without a calibrator (the rules'
+  /// fixed ranges then).
+  std::optional<RobotEstimate> twinEstimate() const;
   /// The last telemetry frame against the ghost's prediction for its time;
   /// nullopt when the ghost had shown nothing for that time.
   std::optional<GhostError> lastPrediction() const;

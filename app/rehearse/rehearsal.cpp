@@ -341,12 +341,24 @@ RehearsalPlan perturbed(const RehearsalPlan& plan, uint64_t seed) {
   Random random(seed);
   auto spread = [&](double range) { return range * (2 * random.uniform() - 1); };
   const FlightRules& r = plan.rules;
-  p.world.defaultContact.mu *= 1 + spread(r.robustFriction);
-  for (ContactSpec& c : p.world.contacts) c.mu *= 1 + spread(r.robustFriction);
-  for (LinkSpec& link : p.world.robots[0].model.links) {
-    const double f = 1 + spread(r.robustMass);
-    link.mass *= f;
-    for (GeomSpec& g : link.geoms) g.mass *= f;
+  if (plan.estimate) {
+    // The robot as the console knows it: the calibration's own parameters
+    // (friction and mass among them), which rehearse() applies.
+    for (size_t i = 0; i < kCalParams; ++i) {
+      const CalParamInfo& info = calParams()[i];
+      double& value = p.params.*info.field;
+      const double drawn = plan.estimate->observed[i] ? value + plan.estimate->sigma[i] * random.normal()
+                                                      : value + spread(info.scale);
+      value = std::clamp(drawn, info.lower, info.upper);
+    }
+  } else {
+    p.world.defaultContact.mu *= 1 + spread(r.robustFriction);
+    for (ContactSpec& c : p.world.contacts) c.mu *= 1 + spread(r.robustFriction);
+    for (LinkSpec& link : p.world.robots[0].model.links) {
+      const double f = 1 + spread(r.robustMass);
+      link.mass *= f;
+      for (GeomSpec& g : link.geoms) g.mass *= f;
+    }
   }
   if (p.world.terrain.kind == TerrainSpec::Kind::Heightfield && r.robustTerrain > 0) {
     // A smooth random field: offsets drawn every kTerrainCell metres and
@@ -377,6 +389,17 @@ RehearsalPlan perturbed(const RehearsalPlan& plan, uint64_t seed) {
   return p;
 }
 
+std::string RobustnessResult::verdict() const {
+  char within[64];
+  const double w = within90.value_or(0);
+  if (w < 0.01) std::snprintf(within, sizeof within, "%.0f mm", w * 1000);
+  else std::snprintf(within, sizeof within, "%.0f cm", w * 100);
+  return std::string(passed == samples ? "passes" : "fails") + " in " + std::to_string(passed == samples ? passed : samples - passed) +
+         " of " + std::to_string(samples) +
+         (fromEstimate ? " draws of what the console knows of the robot" : " perturbed rehearsals") +
+         (within90 ? std::string("; 90 % of the ends within ") + within : std::string());
+}
+
 RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int threads,
                             const std::function<bool(int, int)>& progress) {
   const auto t0 = Clock::now();
@@ -386,6 +409,7 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
   out.endPoses.resize(n);
   out.endHashes.resize(n);
   out.failures.resize(n);
+  out.paths.resize(n);
   // Per sample, written by the worker threads: chars, not vector<bool>'s
   // shared bits, so two threads never write one word.
   std::vector<char> passed(static_cast<size_t>(n), 0), ranToTheEnd(static_cast<size_t>(n), 0);
@@ -397,6 +421,7 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
     passed[s] = r.passed;
     out.failures[s] = r.summary();
     if (!r.path.empty()) out.endPoses[s] = r.path.back().base;
+    for (const RehearsalSample& q : r.path) out.paths[s].push_back(q.base.p);
     out.endHashes[s] = r.endHash;
     ranToTheEnd[s] = !r.stoppedEarly;
     refined += !r.refined.empty();
@@ -412,9 +437,17 @@ RobustnessResult robustness(const RehearsalPlan& plan, uint64_t seed, int thread
   const auto ended = std::count(ranToTheEnd.begin(), ranToTheEnd.end(), 1);
   for (size_t k = 0; k < out.endPoses.size(); ++k)
     if (ranToTheEnd[k]) mean = mean + (1.0 / static_cast<double>(ended)) * out.endPoses[k].p;
+  std::vector<double> distances;
   for (size_t k = 0; k < out.endPoses.size(); ++k)
-    if (ranToTheEnd[k])
-      out.spread = std::max(out.spread, std::hypot(out.endPoses[k].p.x - mean.x, out.endPoses[k].p.y - mean.y));
+    if (ranToTheEnd[k]) {
+      distances.push_back(std::hypot(out.endPoses[k].p.x - mean.x, out.endPoses[k].p.y - mean.y));
+      out.spread = std::max(out.spread, distances.back());
+    }
+  if (distances.size() >= 2) {
+    std::sort(distances.begin(), distances.end());
+    out.within90 = distances[std::min(distances.size() - 1, static_cast<size_t>(std::ceil(0.9 * static_cast<double>(distances.size()))) - 1)];
+  }
+  out.fromEstimate = plan.estimate.has_value();
   out.wallSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return out;
 }

@@ -24,6 +24,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/calibration_table.h"
 #include "app/rehearse/held_twin.h"
 #include "sim/command.h"
 #include "sim/flight_rules.h"
@@ -34,6 +35,15 @@
 namespace sp {
 
 /// What to rehearse.
+/// What the console knows of the robot, for robustness draws: each
+/// calibration.* parameter (sim/calibration_table.h) about the plan's
+/// params' value, with its deviation where a fit observed it, else over its
+/// prior range (CalParamInfo::scale: what a robot may differ by).
+struct RobotEstimate {
+  std::array<double, kCalParams> sigma{};
+  std::array<bool, kCalParams> observed{};
+};
+
 struct RehearsalPlan {
   WorldModel world;  ///< robots[0] is the robot
   SimParams params;
@@ -60,6 +70,9 @@ struct RehearsalPlan {
   /// (RehearsalResult::refined says why). Off for a preview that the full
   /// rehearsal follows anyway (the console's first verdicts).
   bool refine = true;
+  /// Robustness samples draw the robot from this (perturbed()) instead of
+  /// the rules' fixed friction and mass ranges; nullopt: the ranges.
+  std::optional<RobotEstimate> estimate = std::nullopt;
 };
 
 /// A world's start settled: the robot let down onto the ground (worlds
@@ -160,8 +173,11 @@ std::string sequenceText(const std::vector<TimedCommand>& commands, const RobotM
 std::string sequenceHash(const std::string& canonicalText);
 
 /// The plan with its parameters drawn for one robustness sample (seeded,
-/// reproducible): every contact's friction and every link's mass scaled
-/// within the rules' ranges, heightfield samples moved, the start shifted.
+/// reproducible): the robot from plan.estimate where given (each
+/// calibration.* parameter normal about its value with its deviation where
+/// observed, uniform over its prior range where not, within its bounds),
+/// else every contact's friction and every link's mass scaled within the
+/// rules' ranges; heightfield samples moved, the start shifted.
 RehearsalPlan perturbed(const RehearsalPlan& plan, uint64_t seed);
 
 /// N perturbed rehearsals, each in the plan's profile (the console and
@@ -175,10 +191,21 @@ struct RobustnessResult {
   std::vector<uint64_t> endHashes;    ///< per sample: World::stateHash() at its end (a sweep's `hash`)
   std::vector<bool> samplePassed;     ///< per sample
   std::vector<std::string> failures;  ///< per sample: summary() ("passed" if it did)
+  /// Per sample, its base's position every RehearsalResult::kSampleInterval
+  /// up to where it ended (the rehearsed path's band, SequenceWorkflow::band()).
+  std::vector<std::vector<Vec3>> paths;
   /// [m] largest distance of an end position from their mean, over the
   /// samples that ran to the end (a failed one stops where it failed)
   double spread = 0;
+  /// [m] 90 % of those ends lie within this of their mean (the 90th
+  /// percentile of their distances); none with fewer than two
+  std::optional<double> within90;
+  bool fromEstimate = false;  ///< drawn from what the console knows of the robot (RehearsalPlan::estimate)
   double wallSeconds = 0;
+  /// The verdict for people: "passes in 16 of 16 draws of what the console
+  /// knows of the robot; 90 % of the ends within 12 cm" (or "... of 16
+  /// perturbed rehearsals" without an estimate).
+  std::string verdict() const;
 };
 /// rules.robustSamples rehearsals of perturbed(plan, seed + i) on `threads`
 /// threads; `progress(done, total)` after each (from the worker threads; false cancels).

@@ -1,6 +1,9 @@
 // One command sequence's way from text to the robot (sequence_workflow.h).
 #include "app/rehearse/sequence_workflow.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "app/rehearse/sequence_relay.h"
 #include "sim/command_file.h"
 #include "sim/text.h"
@@ -92,6 +95,28 @@ std::vector<Vec3> SequenceWorkflow::path() const {
   return path;
 }
 
+std::vector<double> SequenceWorkflow::band() const {
+  if (!robust_ || !result_) return {};
+  std::vector<double> out;
+  out.reserve(result_->path.size());
+  std::vector<double> d;
+  for (size_t k = 0; k < result_->path.size(); ++k) {
+    // The runs sample the same instants as the rehearsal (every
+    // kSampleInterval from the start): the k-th point of each is this time's.
+    const Vec3 at = result_->path[k].base.p;
+    d.clear();
+    for (const std::vector<Vec3>& p : robust_->paths)
+      if (k < p.size()) d.push_back(std::hypot(p[k].x - at.x, p[k].y - at.y));
+    if (d.size() < 2) {
+      out.push_back(0);
+      continue;
+    }
+    std::sort(d.begin(), d.end());
+    out.push_back(d[std::min(d.size() - 1, static_cast<size_t>(std::ceil(0.9 * static_cast<double>(d.size()))) - 1)]);
+  }
+  return out;
+}
+
 std::vector<Vec3> SequenceWorkflow::envelope() const {
   if (!robust_) return {};
   std::vector<Vec3> ends;
@@ -111,8 +136,7 @@ std::string SequenceWorkflow::rehearsalLogLine() const {
 
 std::string SequenceWorkflow::robustnessLogLine() const {
   if (!robust_) return {};
-  return "robustness: " + std::to_string(robust_->passed) + " of " + std::to_string(robust_->samples) +
-         " passed, end spread " + shortestText(robust_->spread) + " m";
+  return "robustness: " + robust_->verdict() + " (end spread " + shortestText(robust_->spread) + " m)";
 }
 
 }  // namespace sp

@@ -94,6 +94,10 @@ class SequenceWorkflow {
   /// The session log's lines: the rehearsal's ("<hash> passed (3 commands,
   /// 12 s simulated): ...") and the robustness runs'.
   std::string rehearsalLogLine() const;
+  /// The rehearsed path's band: per path() point, the radius within which
+  /// 90 % of the robustness runs were at that time (those still running);
+  /// empty before robustness runs, 0 where fewer than two ran.
+  std::vector<double> band() const;
   std::string robustnessLogLine() const;
 
  private:

@@ -150,6 +150,65 @@ class TestRehearsal : public QObject {
     QCOMPARE(fastTip.refined, 4);
   }
 
+  // Issue 61: robustness runs draw the robot from what the console knows
+  // of it. A parameter a fit observed is drawn about its value with its
+  // deviation, one never observed over its prior range; the rules' fixed
+  // friction and mass ranges are then not applied (control: without an
+  // estimate they are, and the parameters stay). The verdict says so, and
+  // a robot known closely ends closer together than one known only by its
+  // prior (criterion: 90 % radius at least 3x smaller, stated before the run).
+  void robustnessDrawsFromTheEstimate() {
+    RehearsalPlan plan{loadOrFail("terrains/flat.world.xml"), {}, {}, {}, {}};
+    plan.rules.settle = 3;
+    plan.rules.robustStartPosition = plan.rules.robustStartHeading = 0;  // the robot's draws alone
+    plan.commands = parseOrFail("0.5 drive 0.6 10\n", plan.world.robots[0].model);
+    RobotEstimate known;
+    known.observed.fill(true);
+    known.sigma.fill(1e-4);
+    const size_t kFriction = static_cast<size_t>(CalParam::Friction), kMass = static_cast<size_t>(CalParam::Mass);
+    known.sigma[kFriction] = 0.01;
+    RobotEstimate prior;  // nothing observed
+    RobotEstimate mixed = known;
+    mixed.observed[kMass] = false;
+    plan.estimate = mixed;
+    double lo = 1e9, hi = -1e9, sum = 0, sum2 = 0, massLo = 1e9, massHi = -1e9;
+    constexpr int kDraws = 50;
+    for (int seed = 0; seed < kDraws; ++seed) {
+      const RehearsalPlan p = perturbed(plan, static_cast<uint64_t>(seed));
+      QCOMPARE(p.world.defaultContact.mu, plan.world.defaultContact.mu);  // no fixed range on top
+      lo = std::min(lo, p.params.calFriction);
+      hi = std::max(hi, p.params.calFriction);
+      sum += p.params.calFriction;
+      sum2 += p.params.calFriction * p.params.calFriction;
+      massLo = std::min(massLo, p.params.calMass);
+      massHi = std::max(massHi, p.params.calMass);
+    }
+    const double sd = std::sqrt(sum2 / kDraws - (sum / kDraws) * (sum / kDraws));
+    qInfo("friction drawn %.4f..%.4f (sd %.4f, stated 0.01); mass (unobserved) %.3f..%.3f", lo, hi, sd, massLo, massHi);
+    QVERIFY(lo > 0.95 && hi < 1.05 && sd > 0.006 && sd < 0.014);
+    QVERIFY(massLo >= 1 - calParam(CalParam::Mass).scale && massHi <= 1 + calParam(CalParam::Mass).scale);
+    QVERIFY(massHi - massLo > calParam(CalParam::Mass).scale);  // over the prior's range, not the deviation's
+    plan.estimate.reset();
+    const RehearsalPlan ranges = perturbed(plan, 3);
+    QVERIFY(ranges.world.defaultContact.mu != plan.world.defaultContact.mu);
+    QCOMPARE(ranges.params.calFriction, 1.0);
+
+    plan.rules.robustSamples = 8;
+    plan.fast = plan.stopAtFirstFailure = true;
+    plan.estimate = known;
+    const RobustnessResult close = robustness(plan, 1, 2);
+    plan.estimate = prior;
+    const RobustnessResult loose = robustness(plan, 1, 2);
+    qInfo("known closely: %s; by the prior: %s", close.verdict().c_str(), loose.verdict().c_str());
+    QVERIFY2(close.verdict().rfind("passes in 8 of 8 draws of what the console knows of the robot; 90 % of the ends within ", 0) == 0,
+             close.verdict().c_str());
+    QVERIFY(close.fromEstimate && loose.fromEstimate);
+    QVERIFY(close.within90 && loose.within90);
+    QVERIFY(*loose.within90 > 0 && *close.within90 * 3 < *loose.within90);
+    plan.estimate.reset();
+    QVERIFY(robustness(plan, 1, 2).verdict().find("perturbed rehearsals") != std::string::npos);
+  }
+
   // Holding the joints no command moves is a speed lever, not another
   // physics: criterion, the held rehearsal of the test-track drive ends
   // within 1 cm and 0.1 deg of the full one with the same verdicts, having

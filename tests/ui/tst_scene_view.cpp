@@ -296,6 +296,62 @@ class TstSceneView : public QObject {
     QCOMPARE(view->drawnTrailPoints(), size_t{0});
   }
 
+  // Issue 61: how sure the ghost and a rehearsal are, drawn. With a region
+  // the ghost gets its two discs, its trail band (a radius per trail
+  // point) and its faint spread as far ahead and behind as the outer region
+  // reaches, and they change the picture; a rehearsed path gets its band.
+  // Controls: a band whose radii do not match the points is not drawn; a
+  // region under 5 cm draws no spread; hiding the ghost hides them all.
+  void regionsBandsAndSpreadDrawn() {
+    auto view = shownView(flat_);
+    QVERIFY(view);
+    view->setFollow(false);
+    const sp::RobotModel& robot = flat_.robots[0].model;
+    const sp::Pose base = flat_.robots[0].pose * robot.links[0].pose;
+    const std::vector<double> zero(robot.joints.size(), 0.0);
+    view->setRobotState(base, zero);
+    sp::Pose ahead = base;
+    ahead.p.x += 1.0;  // the ghost a metre ahead of the robot: drawn
+    view->setGhostState(ahead, zero);
+    view->setGhostVisible(true);
+    std::vector<sp::Vec3> trail;
+    for (int k = 0; k <= 20; ++k) trail.push_back({base.p.x + 0.05 * k, base.p.y, base.p.z});
+    view->setGhostTrail(trail);
+    QVERIFY(waitFrames(*view, 3));
+    const QImage without = frame(*view);
+    QCOMPARE(view->drawnGhostSpread(), 0.0);
+    view->setGhostRegion(0.12, 0.3);
+    view->setGhostTrailBand(std::vector<double>(trail.size(), 0.1));
+    QVERIFY(waitFrames(*view, 3));
+    QCOMPARE(view->drawnGhostRegion(), 0.3);
+    QCOMPARE(view->drawnTrailBand(), trail.size());
+    QCOMPARE(view->drawnGhostSpread(), 0.3);
+    const QImage with = frame(*view);
+    QVERIFY(with.save(QStringLiteral(SP_BINARY_DIR "/scene_view_region.png")));
+    const int changed = countDiffering(without, with, with.rect());
+    QVERIFY2(changed > 300, qPrintable(QString::number(changed)));
+    view->setGhostTrailBand(std::vector<double>(trail.size() - 1, 0.1));  // not one per point
+    view->setGhostRegion(0.01, 0.04);
+    QVERIFY(waitFrames(*view, 2));
+    QCOMPARE(view->drawnTrailBand(), size_t{0});
+    QCOMPARE(view->drawnGhostSpread(), 0.0);
+    QCOMPARE(view->drawnGhostRegion(), 0.04);
+    view->setGhostRegion(0.12, 0.3);
+    view->setGhostVisible(false);
+    QVERIFY(waitFrames(*view, 2));
+    QCOMPARE(view->drawnGhostRegion(), 0.0);
+    QCOMPARE(view->drawnGhostSpread(), 0.0);
+
+    view->setRehearsalPath(trail);
+    view->setRehearsalVisible(true);
+    view->setRehearsalBand(std::vector<double>(trail.size(), 0.2));
+    QVERIFY(waitFrames(*view, 2));
+    QCOMPARE(view->drawnRehearsalBand(), trail.size());
+    view->setRehearsalBand({});
+    QVERIFY(waitFrames(*view, 2));
+    QCOMPARE(view->drawnRehearsalBand(), size_t{0});
+  }
+
   // Issue 31: at low speed the ghost's trail lies under the robot. Where
   // the robot hides it, it is drawn again faintly (seen through).
   // Criterion: a 1.2 m trail across the ground under its front axle

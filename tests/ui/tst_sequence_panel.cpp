@@ -262,6 +262,16 @@ class TestSequencePanel : public QObject {
                            scene->drawnRehearsalBasePose().p.y - at->base.p.y) < 1e-3);
     QTRY_VERIFY(scene->rehearsalRobotDrawn());  // scrubbed 2 s ahead of the robot: drawn
 
+    // Robustness here (issue 61): the draws come from what the console
+    // knows of the robot (its calibration, the prior where nothing is fitted
+    // yet), the verdict says so, and the rehearsed path gets its band.
+    QCOMPARE(scene->drawnRehearsalBand(), size_t(0));
+    QVERIFY(p->checkRobustness());
+    QTRY_VERIFY_WITH_TIMEOUT(!p->busy(), 120000);
+    QVERIFY2(p->status().contains("draws of what the console knows of the robot; 90 % of the ends within"), qPrintable(p->status()));
+    QTRY_VERIFY(scene->drawnRehearsalBand() == scene->drawnRehearsalPathPoints());
+    QVERIFY(scene->drawnRehearsalBand() > 10);
+
     // Robustness on cluster: the same perturbed rehearsals written as a sweep
     // (app/sweep/sweep.h), from the robot's state; no cluster answers here, so the
     // status names the folder and what sbatch said, or the command to run.

@@ -80,9 +80,10 @@ void SequenceJob::install(ConsoleContext& context) {
   // follow camera's way: its path stays, the robot goes (scrubbing shows it).
   connect(panel_, &SequencePanel::runEnded, &scene, [&scene] { scene.setRehearsalRobotShown(false); });
   connect(panel_, &SequencePanel::pathChanged, &scene,
-          [&scene](const std::vector<Vec3>& path, const std::vector<Vec3>& envelope) {
+          [&scene](const std::vector<Vec3>& path, const std::vector<Vec3>& envelope, const std::vector<double>& band) {
             scene.setRehearsalPath(path);
             scene.setRehearsalEnvelope(envelope);
+            scene.setRehearsalBand(band);
             scene.setRehearsalVisible(!path.empty());
           });
   connect(panel_, &SequencePanel::logEvent, this,
@@ -104,7 +105,8 @@ void SequenceJob::install(ConsoleContext& context) {
   connect(&context, &ConsoleContext::worldChanged, this, [this](const WorldModel&, bool fresh) {
     // Rehearsals run the twin as calibrated when they start (app/calibration).
     if (fresh)
-      panel_->setWorld([this] { return context_->session().world(); }, [this] { return context_->session().twinParams(); });
+      panel_->setWorld([this] { return context_->session().world(); }, [this] { return context_->session().twinParams(); },
+                       [this] { return context_->session().twinEstimate(); });
   });
   connect(&context, &ConsoleContext::terrainEdited, panel_, [this] { panel_->terrainEdited(); });
   connect(&context, &ConsoleContext::rehearseFrom, this,

@@ -156,7 +156,9 @@ void SequencePanel::setBackground(BackgroundJobs* jobs) {
   });
 }
 
-void SequencePanel::setWorld(std::function<const WorldModel*()> world, std::function<SimParams()> params) {
+void SequencePanel::setWorld(std::function<const WorldModel*()> world, std::function<SimParams()> params,
+                             std::function<std::optional<RobotEstimate>()> estimate) {
+  estimate_ = std::move(estimate);
   world_ = std::move(world);
   params_ = std::move(params);
   workflow_.forget();
@@ -237,6 +239,7 @@ bool SequencePanel::rehearse() {
   std::optional<RehearsalPlan> plan = workflow_.plan(text().toStdString(), world_ ? world_() : nullptr,
                                                      params_ ? params_() : SimParams{}, rules_,
                                                      startProvider_ ? startProvider_() : std::nullopt, why);
+  if (plan && !workflow_.pinned() && estimate_) plan->estimate = estimate_();
   if (!plan) {
     QString said = qs(why);
     said[0] = said[0].toUpper();
@@ -271,7 +274,7 @@ bool SequencePanel::rehearse() {
 
 void SequencePanel::showResult() {
   results_->showResult(workflow_.result() ? &*workflow_.result() : nullptr);
-  emit pathChanged(workflow_.path(), workflow_.envelope());
+  emit pathChanged(workflow_.path(), workflow_.envelope(), workflow_.band());
   updateButtons();
 }
 
@@ -376,16 +379,15 @@ void SequencePanel::robustnessFinished(RobustnessResult result) {
   QString worst;
   for (int i = 0; i < r.samples && worst.isEmpty(); ++i)
     if (!r.samplePassed[i]) worst = qs(r.failures[i]);
-  setStatus(tr("Robustness: %1 of %2 passed (%3 %), end positions within %4 m of their mean%5%6")
-                .arg(r.passed)
-                .arg(r.samples)
+  setStatus(tr("Robustness: %1 (%2 %), every end within %3 m of their mean%4%5")
+                .arg(qs(r.verdict()))
                 .arg(100 * r.probability(), 0, 'f', 0)
                 .arg(r.spread, 0, 'f', 3)
                 .arg(worst.isEmpty() ? QString() : tr("; e.g. %1").arg(worst))
                 .arg(r.refined ? tr("; %1 near a limit or failing run again at full fidelity").arg(r.refined)
                                : QString()));
   emit logEvent("rehearsal", qs(workflow_.robustnessLogLine()));
-  emit pathChanged(workflow_.path(), workflow_.envelope());
+  emit pathChanged(workflow_.path(), workflow_.envelope(), workflow_.band());
   updateButtons();
   emit robustnessDone();
 }

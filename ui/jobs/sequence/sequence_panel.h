@@ -74,7 +74,10 @@ class SequencePanel : public QWidget {
   /// here), null without one; and the parameters, read at each rehearsal
   /// (the console's calibration moves on). Re-checks the text. Drops the
   /// last rehearsal.
-  void setWorld(std::function<const WorldModel*()> world, std::function<SimParams()> params);
+  /// `estimate`, when given, is what robustness runs draw the robot from
+  /// (RehearsalPlan::estimate); else the rules' fixed ranges.
+  void setWorld(std::function<const WorldModel*()> world, std::function<SimParams()> params,
+                std::function<std::optional<RobotEstimate>()> estimate = {});
   void setRules(const FlightRules& rules);
   const FlightRules& rules() const { return rules_; }
   /// Where a rehearsal starts: the robot's state now (nullopt = not known:
@@ -172,7 +175,7 @@ class SequencePanel : public QWidget {
   void runEnded();
   /// A new rehearsal path (base positions on the ground) and the robustness
   /// envelope (hull of end positions; empty for none).
-  void pathChanged(const std::vector<sp::Vec3>& path, const std::vector<sp::Vec3>& envelope);
+  void pathChanged(const std::vector<sp::Vec3>& path, const std::vector<sp::Vec3>& envelope, const std::vector<double>& band);
   /// Something for the session log: kind "rehearsal", "relay" or "guard".
   void logEvent(const QString& kind, const QString& text);
   /// The operator must know now (the guard tripped, the robot refused).
@@ -194,6 +197,7 @@ class SequencePanel : public QWidget {
 
   std::function<const WorldModel*()> world_;  // the console's world (and terrain) now
   std::function<SimParams()> params_;
+  std::function<std::optional<RobotEstimate>()> estimate_;
   FlightRules rules_;
   std::function<std::optional<RehearsalStart>()> startProvider_;
   bool linkReady_ = false;
