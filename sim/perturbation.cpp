@@ -10,6 +10,9 @@ namespace sp {
 
 namespace {
 
+// The wheels' short names, FL FR RL RR: the report's keys and --weak-motor's.
+constexpr const char* kWheels[] = {"fl", "fr", "rl", "rr"};
+
 std::string number(double value) {
   char text[64];
   std::snprintf(text, sizeof text, "%.6g", value);
@@ -159,7 +162,6 @@ std::optional<std::string> calibratedRobotText(const std::string& text, const Ro
 }
 
 std::string parseWeakMotor(const std::string& text, Perturbation& p) {
-  static const char* kWheels[] = {"fl", "fr", "rl", "rr"};
   const size_t eq = text.find('=');
   const std::string wheel = text.substr(0, eq);
   size_t w = 0;
@@ -173,7 +175,6 @@ std::string parseWeakMotor(const std::string& text, Perturbation& p) {
 
 std::string Perturbation::report(const RobotModel& robot) const {
   std::string out = "seed = " + std::to_string(seed) + "\n";
-  static const char* kWheels[] = {"fl", "fr", "rl", "rr"};
   for (size_t w = 0; w < 4; ++w) out += std::string("wheel_radius.") + kWheels[w] + " = " + number(wheelRadius[w]) + "\n";
   for (size_t i = 0; i < robot.links.size() && i < linkMass.size(); ++i) {
     out += "mass." + robot.links[i].name + " = " + number(linkMass[i]) + "\n";
