@@ -52,8 +52,15 @@ Ghost::Ghost(const WorldModel& world, const SimParams& params, const Options& op
   DepartureWatch::Options o;
   o.hold = params.ghostRegionHold;
   watch_ = DepartureWatch(o);
-  errorModel_ = errorModelFor(world);
-  if (!options.sources) errorModel_.speed = errorModel_.curvature = errorModel_.arrival = errorModel_.terrain = 0;
+  givenModel_ = errorModelFor(world);
+  errorModel_ = asOptioned(givenModel_);
+}
+
+ErrorModel Ghost::asOptioned(ErrorModel m) const {
+  // (The link's jitter, measured, is scaled in sourcesOf.)
+  if (!options_.sources) m.speed = m.curvature = m.arrival = m.terrain = 0;
+  for (double* d : {&m.floor, &m.speed, &m.curvature, &m.arrival, &m.terrain}) *d *= options_.modelFactor;
+  return m;
 }
 
 std::unique_ptr<Ghost> Ghost::create(const WorldModel& world, const SimParams& params, std::string& error) {
@@ -269,13 +276,13 @@ void Ghost::learn(double time, double position, double vertical, const ErrorSour
 
 ErrorSources Ghost::sourcesOf(double t, double made, double speed,
                               const std::vector<std::pair<double, Command>>& timeline, double spread) const {
-  return {t - made, speed, commandTiming(timeline, made, t, speed, errorModel_.wheelbase), options_.sources ? spread : 0};
+  return {t - made, speed, commandTiming(timeline, made, t, speed, errorModel_.wheelbase), options_.sources ? spread * options_.modelFactor : 0};
 }
 
 void Ghost::setErrorModel(const ErrorModel& given) {
-  ErrorModel model = given;
-  if (!options_.sources) model.speed = model.curvature = model.arrival = model.terrain = 0;
+  const ErrorModel model = asOptioned(given);
   std::lock_guard lock(recordMutex_);
+  givenModel_ = given;
   if (model == errorModel_) return;
   errorModel_ = model;
   // The window's scores meant the old scale: each rescored under the new
@@ -294,7 +301,7 @@ void Ghost::setErrorModel(const ErrorModel& given) {
 
 ErrorModel Ghost::errorModel() const {
   std::lock_guard lock(recordMutex_);
-  return errorModel_;
+  return givenModel_;
 }
 
 std::vector<Departure> Ghost::departures() const {

@@ -139,6 +139,10 @@ class Ghost {
     /// false: the scale is the floor alone (the estimate's deviations, the
     /// link's jitter and the terrain's uncertainty taken as zero; a control).
     bool sources = true;
+    /// Every deviation of the error model (the floor's too) multiplied by
+    /// this: a model wrong by a factor, which the conformal layer must
+    /// correct and the Gaussian multipliers cannot (a control).
+    double modelFactor = 1;
   };
 
   /// The ghost's physics profile of `params`: ghost.step and
@@ -183,6 +187,7 @@ class Ghost {
   /// (measured): the calibration's deviations and the terrain's
   /// uncertainty (ghost_region.h). From the next view on.
   void setErrorModel(const ErrorModel& model);
+  /// The model last given (before Options' controls act on it).
   ErrorModel errorModel() const;
   /// The departures telemetry showed since the last reset, oldest first
   /// (the last may still be on: ended < 0).
@@ -269,6 +274,8 @@ class Ghost {
                          double spread) const;
   /// A judged frame into the layers (recordMutex_ held).
   void learn(double time, double position, double vertical, const ErrorSources& sources);
+  /// `model` as the options have it: the sources dropped, the factor applied.
+  ErrorModel asOptioned(ErrorModel model) const;
   /// The destructor asked the threads to end (a long run ahead gives up).
   bool stopping() const { return stop_.load(); }
 
@@ -298,7 +305,8 @@ class Ghost {
 
   mutable std::mutex recordMutex_;
   PredictionRecord record_;  // what was shown against what came
-  ErrorModel errorModel_;    // the region's sources besides the link
+  ErrorModel errorModel_;    // the region's sources besides the link, as optioned
+  ErrorModel givenModel_;    // ... as given
   ConformalLayer region_;    // inner, outer, departure
   ConformalLayer vertical_;  // the departure's level, over the vertical pose's scores
   DepartureWatch watch_;

@@ -108,15 +108,22 @@ class TestGhostTrust : public QObject {
   }
 
   void outerRegionHoldsItsShare_data() {
+    // The layer off with the model as it is holds what the a-priori
+    // model happens to give (0.96 in one run, above 0.97 in others): no
+    // control, since a well-made model may hold its share alone. What the
+    // layer must do is correct a model that is wrong by a factor.
     QTest::addColumn<bool>("conformal");
     QTest::addColumn<bool>("sources");
-    QTest::newRow("the conformal layer") << true << true;
-    QTest::newRow("control: the layer off") << false << true;
-    QTest::newRow("control: the layer off, the floor alone") << false << false;
+    QTest::addColumn<double>("factor");
+    QTest::newRow("the conformal layer") << true << true << 1.0;
+    QTest::newRow("the conformal layer, a model 4x too wide") << true << true << 4.0;
+    QTest::newRow("control: the layer off, a model 4x too wide") << false << true << 4.0;
+    QTest::newRow("control: the layer off, the floor alone") << false << false << 1.0;
   }
   void outerRegionHoldsItsShare() {
     QFETCH(bool, conformal);
     QFETCH(bool, sources);
+    QFETCH(double, factor);
     ConsoleSessionOptions o;
     o.world = kRough;
     o.token = kToken;
@@ -126,6 +133,7 @@ class TestGhostTrust : public QObject {
     o.overrides = {"link.deadman=0.5"};
     o.ghostOptions.conformal = conformal;
     o.ghostOptions.sources = sources;
+    o.ghostOptions.modelFactor = factor;
     ConsoleSession session(o);
     const std::string started = session.start();
     QVERIFY2(started.empty(), started.c_str());
