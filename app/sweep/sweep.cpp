@@ -74,6 +74,7 @@ bool samplePlan(const SweepSpec& spec, const std::vector<std::string>& sets, uin
     return false;
   }
   plan = RehearsalPlan{*world, params, rules, *commands, spec.start};
+  plan.estimate = spec.estimate;
   if (spec.perturb) plan = perturbed(plan, seed);
   return true;
 }
@@ -173,6 +174,10 @@ bool createSweep(const std::string& dir, const SweepSpec& given, std::string& er
   m << "samples " << spec.samples << "\n"
     << "seed " << spec.seed << "\n"
     << "perturb " << (spec.perturb ? "true" : "false") << "\n";
+  if (spec.estimate)
+    for (size_t i = 0; i < kCalParams; ++i)
+      m << "estimate " << calParams()[i].key << " " << shortestText(spec.estimate->sigma[i]) << " "
+        << (spec.estimate->observed[i] ? "observed" : "prior") << "\n";
   if (spec.start) {
     const RehearsalStart& s = *spec.start;
     const auto numbers = [&](const char* key, std::initializer_list<double> values) {
@@ -231,6 +236,7 @@ bool createSweepFromPlan(const std::string& dir, const RehearsalPlan& plan, uint
   spec.seed = seed;
   spec.start = plan.start;
   spec.consecutiveSeeds = true;
+  spec.estimate = plan.estimate;
   std::string params = "# The console's parameters when the sweep was made\n";
   for (const ParamInfo& p : paramTable()) params += p.key + " = " + paramValue(plan.params, p.key) + "\n";
   const std::string sequence = "# The rehearsed sequence, as the console relays it\n" +
@@ -292,6 +298,20 @@ bool readSweep(const std::string& dir, SweepSpec& spec, std::vector<SweepSample>
     } else if (word == "perturb") {
       if (rest != "true" && rest != "false") return fail("perturb: expected true or false");
       spec.perturb = rest == "true";
+    } else if (word == "estimate") {
+      std::istringstream r(rest);
+      std::string key, kind;
+      double sigma = 0;
+      if (!(r >> key >> sigma >> kind) || !(kind == "observed" || kind == "prior"))
+        return fail("expected: estimate KEY SIGMA observed|prior");
+      const auto& table = calParams();
+      const auto it = std::find_if(table.begin(), table.end(), [&](const CalParamInfo& c) { return key == c.key; });
+      if (it == table.end()) return fail("estimate: '" + key + "' is not a calibration.* parameter");
+      if (!std::isfinite(sigma) || sigma < 0) return fail("estimate " + key + ": the deviation must be finite and >= 0");
+      if (!spec.estimate) spec.estimate = RobotEstimate{};
+      const size_t i = static_cast<size_t>(it - table.begin());
+      spec.estimate->sigma[i] = sigma;
+      spec.estimate->observed[i] = kind == "observed";
     } else if (word.rfind("start_", 0) == 0) {
       if (!spec.start) spec.start = RehearsalStart{};
       RehearsalStart& st = *spec.start;
@@ -542,7 +562,10 @@ SweepSummary collectSweep(const std::string& dir, std::string& error) {
   std::ostringstream md;
   md << "# Sweep " << fs::path(dir).filename().string() << "\n\n"
      << "`" << spec.commands << "` on `" << spec.world << "`, " << spec.samples << " samples, seed " << spec.seed
-     << (spec.perturb ? ", each perturbed within the rules' robustness ranges" : "") << ".\n";
+     << (!spec.perturb    ? ""
+         : spec.estimate ? ", each robot drawn from what the console knows of it (the calibration's estimate)"
+                         : ", each perturbed within the rules' robustness ranges")
+     << ".\n";
   for (const SweepVary& v : spec.vary) md << "- `" << v.key << "` drawn in [" << shortestText(v.lo) << ", " << shortestText(v.hi) << "]\n";
   md << "\n**" << sum.passed << " of " << sum.done << " samples that ran passed every rule**";
   if (sum.done) md << " (" << shortestText(std::round(1000.0 * sum.passed / sum.done) / 10) << " %)";

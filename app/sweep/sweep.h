@@ -57,6 +57,9 @@ struct SweepSpec {
   /// console's cluster robustness equals its local one sample for sample);
   /// otherwise drawn from the seed and i (splitmix64).
   bool consecutiveSeeds = false;
+  /// With `perturb`: each sample draws the robot from what the console
+  /// knows of it (RehearsalPlan::estimate) instead of the rules' ranges.
+  std::optional<RobotEstimate> estimate;
 };
 
 /// One sample of the manifest.

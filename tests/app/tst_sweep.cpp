@@ -237,6 +237,65 @@ class TestSweep : public QObject {
     QVERIFY(other.endPoses[0].p.x != local.endPoses[0].p.x || other.endPoses[0].p.y != local.endPoses[0].p.y);
   }
 
+  // The console's cluster robustness with a calibration's estimate: the
+  // manifest keeps it (read back as written; a damaged line named), and
+  // every sample equals robustness()'s, drawn from the estimate. Control:
+  // the ranges' draws end elsewhere.
+  void clusterRobustnessDrawsFromTheEstimate() {
+    Diagnostics diag;
+    std::optional<WorldModel> world = loadWorld(SP_SOURCE_DIR "/terrains/flat.world.xml", diag);
+    QVERIFY2(world, diag.format().c_str());
+    std::optional<std::vector<TimedCommand>> commands = loadCommandSequence(seq_, diag, &world->robots[0].model);
+    QVERIFY2(commands, diag.format().c_str());
+    FlightRules rules;
+    rules.robustSamples = 2;
+    RehearsalPlan plan{*world, SimParams{}, rules, *commands, std::nullopt};
+    RobotEstimate estimate;
+    for (size_t i = 0; i < kCalParams; ++i) estimate.sigma[i] = 0.01 * static_cast<double>(i + 1);
+    estimate.observed[static_cast<size_t>(CalParam::WheelRadius)] = true;
+    estimate.observed[static_cast<size_t>(CalParam::TorqueRL)] = true;
+    plan.estimate = estimate;
+
+    const std::string dir = tmp_.filePath("estimate").toStdString();
+    std::string error;
+    QVERIFY2(createSweepFromPlan(dir, plan, 1, error), error.c_str());
+    SweepSpec read;
+    std::vector<SweepSample> samples;
+    QVERIFY2(readSweep(dir, read, samples, error), error.c_str());
+    QVERIFY(read.estimate);
+    QVERIFY(read.estimate->sigma == estimate.sigma);
+    QVERIFY(read.estimate->observed == estimate.observed);
+    QVERIFY(runSweepLocal(dir, {}, 2, error));
+    const SweepSummary sum = collectSweep(dir, error);
+    QCOMPARE(sum.done, 2);
+    QVERIFY(readText(dir + "/report.md").find("drawn from what the console knows of it") != std::string::npos);
+    const RobustnessResult local = robustness(plan, 1, 2);
+    QVERIFY(local.fromEstimate);
+    const std::vector<std::string> hashes = sweepHashes(dir);
+    QCOMPARE(hashes.size(), size_t{2});
+    for (size_t i = 0; i < 2; ++i) QCOMPARE(hashes[i], hashHex(local.endHashes[i]));
+    RehearsalPlan ranges = plan;
+    ranges.estimate.reset();
+    const RobustnessResult other = robustness(ranges, 1, 2);
+    QVERIFY(hashHex(other.endHashes[0]) != hashes[0]);
+
+    // A damaged estimate line is named at its line and key.
+    std::string text = readText(dir + "/manifest.txt");
+    const size_t at = text.find("estimate calibration.delay ");
+    QVERIFY(at != std::string::npos);
+    text.replace(at, 27, "estimate calibration.dealy ");
+    std::ofstream(dir + "/manifest.txt") << text;
+    QVERIFY(!readSweep(dir, read, samples, error));
+    QVERIFY2(error.find("manifest.txt:") != std::string::npos && error.find("calibration.dealy") != std::string::npos,
+             error.c_str());
+    text.replace(at, 27, "estimate calibration.delay ");
+    const size_t sigma = text.find(' ', at + 27);
+    text.replace(at + 27, sigma - at - 27, "-1");
+    std::ofstream(dir + "/manifest.txt") << text;
+    QVERIFY(!readSweep(dir, read, samples, error));
+    QVERIFY2(error.find("the deviation must be finite") != std::string::npos, error.c_str());
+  }
+
   // The job array script and its index list.
   void slurmScript() {
     QCOMPARE(slurmArrayList({0, 1, 2, 3, 5, 7, 8}), std::string("0-3,5,7-8"));
