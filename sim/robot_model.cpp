@@ -82,6 +82,12 @@ const ContactSpec& WorldModel::contactFor(std::string_view a, std::string_view b
   return defaultContact;
 }
 
+double groundHeight(const TerrainSpec& t, double x, double y) {
+  if (t.kind == TerrainSpec::Kind::Plane || t.grid.columns < 2 || t.grid.rows < 2) return t.pose.p.z;
+  const Vec3 local = transformPoint(inverse(t.pose), {x, y, 0});
+  return t.grid.heightAt(local.x, local.y) + t.pose.p.z;
+}
+
 double terrainUncertainty(const TerrainSpec& terrain) {
   if (terrain.heightUncertainty >= 0) return terrain.heightUncertainty;
   if (terrain.kind == TerrainSpec::Kind::Plane) return 0;

@@ -191,6 +191,10 @@ struct TerrainSpec {
 /// differences, along both axes).
 double terrainUncertainty(const TerrainSpec& terrain);
 
+/// Ground height at world (x, y): the plane's height, or the heightfield's
+/// (its edge value outside it, as HeightGrid::heightAt does).
+double groundHeight(const TerrainSpec& terrain, double x, double y);
+
 /// A static or dynamic object of the world.
 struct ObjectSpec {
   std::string name;

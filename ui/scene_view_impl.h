@@ -146,14 +146,6 @@ inline osg::ref_ptr<osg::Geode> geomsNode(const std::vector<GeomSpec>& geoms) {
   return geode;
 }
 
-/// Ground height at world (x, y): the plane's height, or the heightfield's
-/// (its edge value outside it, as HeightGrid::heightAt does).
-inline double groundHeight(const TerrainSpec& t, double x, double y) {
-  if (t.kind == TerrainSpec::Kind::Plane || t.grid.columns < 2 || t.grid.rows < 2) return t.pose.p.z;
-  const Vec3 local = transformPoint(inverse(t.pose), {x, y, 0});
-  return t.grid.heightAt(local.x, local.y) + t.pose.p.z;
-}
-
 /// The circle of `radius` about (x, y) draped on the ground, `lift` above
 /// it: `segments` + 1 points, the last the first again (the brush's ring,
 /// the ghost's regions, the departures' marks).

@@ -11,6 +11,7 @@
 #include "app/ghost/ghost_impl.h"
 #include "app/ghost/hold_policy.h"
 #include "sim/perturbation.h"
+#include "sim/terrain_brush.h"
 #include "sim/runner.h"
 
 namespace sp {
@@ -41,6 +42,7 @@ ConformalLayer::Options layerOptions(const SimParams& p, bool conformal = true) 
 
 Ghost::Ghost(const WorldModel& world, const SimParams& params, const Options& options)
     : model_(world),
+      robot_(world.robots.at(0).model),
       params_(params),
       options_(options),
       region_(layerOptions(params, options.conformal)),
@@ -52,6 +54,7 @@ Ghost::Ghost(const WorldModel& world, const SimParams& params, const Options& op
   DepartureWatch::Options o;
   o.hold = params.ghostRegionHold;
   watch_ = DepartureWatch(o);
+  ground_ = world.terrain;
   givenModel_ = errorModelFor(world);
   errorModel_ = asOptioned(givenModel_);
 }
@@ -238,7 +241,14 @@ void Ghost::judge(GhostError& e, const RobotFrame& frame) {
   e.limit = region_.multiplier(2) * e.scale;
   const double score = e.position / e.scale;
   const double vscale = verticalScale(e.scale, errorModel_);
-  e.vertical = verticalOf(e.predicted, frame.base, errorModel_);
+  while (!groundEdits_.empty() && groundEdits_.front().first <= frame.time) {
+    if (ground_.kind == TerrainSpec::Kind::Heightfield && patchFits(&ground_.grid, groundEdits_.front().second).empty())
+      applyPatch(ground_.grid, groundEdits_.front().second);
+    groundEdits_.pop_front();
+  }
+  const WheelClearances actual = wheelClearances(
+      robot_, [this](double x, double y) { return groundHeight(ground_, x, y); }, frame.base, frame.jointPositions);
+  e.vertical = groundDiscrepancy(e.clearance, actual);
   e.verticalLimit = vertical_.multiplier(0) * vscale;
   const double vscore = e.vertical / vscale;
   region_.judge(score);
@@ -256,22 +266,25 @@ void Ghost::judge(GhostError& e, const RobotFrame& frame) {
   if (watch_.last() && !departures_.empty()) departures_.back() = *watch_.last();
   e.suspect = watch_.departing();
   const bool lasting = watch_.departing() && frame.time - watch_.last()->time > kLasting;
-  const Judged judged{frame.time, e.position, e.vertical, e.sources};
+  // A lasting departure's frames teach the position's layer (the robot
+  // differs: the region must widen to it), never the ground's: ground that
+  // is not the map's stays a departure wherever the robot meets it.
+  const Judged judged{frame.time, e.position, e.vertical, e.sources, !watch_.departing()};
   if (watch_.suspect() && !lasting) {
     pending_.push_back(judged);
     return;
   }
-  for (const Judged& p : pending_) learn(p.time, p.position, p.vertical, p.sources);  // a run outside that was no departure
+  for (const Judged& p : pending_) learn(p);  // a run outside that was no departure
   pending_.clear();
-  learn(judged.time, judged.position, judged.vertical, judged.sources);
+  learn(judged);
 }
 
-void Ghost::learn(double time, double position, double vertical, const ErrorSources& sources) {
-  const double scale = errorScale(sources, errorModel_);
-  region_.learn(time, position / scale);
-  vertical_.learn(time, vertical / verticalScale(scale, errorModel_));
-  learnt_.push_back({time, position, vertical, sources});
-  while (learnt_.front().time < time - params_.ghostRegionWindow) learnt_.pop_front();
+void Ghost::learn(const Judged& j) {
+  const double scale = errorScale(j.sources, errorModel_);
+  region_.learn(j.time, j.position / scale);
+  if (j.ground) vertical_.learn(j.time, j.vertical / verticalScale(scale, errorModel_));
+  learnt_.push_back(j);
+  while (learnt_.front().time < j.time - params_.ghostRegionWindow) learnt_.pop_front();
 }
 
 ErrorSources Ghost::sourcesOf(double t, double made, double speed,
@@ -294,6 +307,7 @@ void Ghost::setErrorModel(const ErrorModel& given) {
     return j.position / errorScale(j.sources, errorModel_);
   });
   vertical_.rescore([&](double, double) {
+    while (v + 1 < learnt_.size() && !learnt_[v].ground) ++v;  // frames the ground's layer did not learn
     const Judged& j = learnt_[std::min(v++, learnt_.size() - 1)];
     return j.vertical / verticalScale(errorScale(j.sources, errorModel_), errorModel_);
   });
@@ -329,9 +343,15 @@ Ghost::Coverage Ghost::coverage() const {
 }
 
 void Ghost::commandSent(const Command& command) {
+  double effect = 0;
   {
     std::lock_guard lock(timelineMutex_);
-    commands_.add(command, clock_.ghostTime(now()) + delay_);
+    effect = clock_.ghostTime(now()) + delay_;
+    commands_.add(command, effect);
+  }
+  if (const auto* patch = std::get_if<TerrainPatchCmd>(&command)) {
+    std::lock_guard lock(recordMutex_);
+    groundEdits_.emplace_back(effect, *patch);
   }
   presentBell_.ring();
 }

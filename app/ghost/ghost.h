@@ -60,10 +60,13 @@
 // of the outer region at each point. Each judged frame feeds the layer and
 // the departure watch: telemetry outside the ghost.region.departure region
 // for ghost.region.hold s is a departure (departures(); the frame's
-// GhostError says when one begins and ends). Frames of a run outside and
-// of a departure stay out of the layer's quantiles (the region must not
-// grow to swallow a ridge the map lacks) unless the departure lasts
-// kLasting s: then it is the robot that differs, and the layer learns it.
+// GhostError says when one begins and ends), and so is a wheel that stands
+// off the map's ground by more than its own layer's departure region
+// (groundDiscrepancy(): the twin's wheels' clearance over the map against
+// telemetry's). Frames of a run outside and of a departure stay out of the
+// layers' quantiles (the region must not grow to swallow a ridge the map
+// lacks) unless the departure lasts kLasting s: then it is the robot that
+// differs, and the position's layer learns it (the ground's never does).
 //
 // Latches: while a frame reports an e-stop or failsafe, the robot is held
 // still; the ghost stops the robot too and ignores the commands in flight
@@ -273,13 +276,15 @@ class Ghost {
   ErrorSources sourcesOf(double t, double made, double speed, const std::vector<std::pair<double, Command>>& timeline,
                          double spread) const;
   /// A judged frame into the layers (recordMutex_ held).
-  void learn(double time, double position, double vertical, const ErrorSources& sources);
+  struct Judged;
+  void learn(const Judged& judged);
   /// `model` as the options have it: the sources dropped, the factor applied.
   ErrorModel asOptioned(ErrorModel model) const;
   /// The destructor asked the threads to end (a long run ahead gives up).
   bool stopping() const { return stop_.load(); }
 
   WorldModel model_;  // the full world, as calibrated: the anchor thread's once it runs
+  const RobotModel robot_;  // the full robot as the files have it: its wheels' clearances
   SimParams params_;  // the ghost profile
   Options options_;
   std::vector<int> held_;  // joints the ghost may hold rigid (ghost.hold's subtrees but the drive's), sorted
@@ -311,11 +316,16 @@ class Ghost {
   ConformalLayer vertical_;  // the departure's level, over the vertical pose's scores
   DepartureWatch watch_;
   std::vector<Departure> departures_;
+  // The map telemetry's wheels are judged on, with the terrain edits sent
+  // (each from the robot time it takes effect).
+  TerrainSpec ground_;
+  std::deque<std::pair<double, TerrainPatchCmd>> groundEdits_;
   // A judged frame as the layers learn it: its errors and what its scale
   // was made of, so that a new model rescores the window.
   struct Judged {
     double time, position, vertical;
     ErrorSources sources;
+    bool ground;  // the ground's layer learns it too (no departure on)
   };
   std::deque<Judged> learnt_;        // the layers' window, with its sources
   std::vector<Judged> pending_;      // frames outside, kept from the layers until judged no departure

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "sim/kinematics.h"
+
 namespace sp {
 
 double errorScale(const ErrorSources& s, const ErrorModel& m) {
@@ -58,15 +60,36 @@ ErrorModel errorModelFor(const WorldModel& world) {
 }
 
 double verticalScale(double horizontal, const ErrorModel& m) {
-  const double floor = m.floor * 0.75, slope = 0.15 * horizontal;
-  return std::sqrt(floor * floor + m.terrain * m.terrain + slope * slope);
+  const double floor = m.floor * 0.75, across = 0.02 * horizontal;
+  return std::sqrt(floor * floor + m.terrain * m.terrain + across * across);
 }
 
-double verticalOf(const Pose& predicted, const Pose& actual, const ErrorModel& m) {
-  const Vec3 a = rpyFromQuat(predicted.q), b = rpyFromQuat(actual.q);
-  const double roll = std::abs(std::remainder(a.x - b.x, 2 * kPi)) * m.track / 2;
-  const double pitch = std::abs(std::remainder(a.y - b.y, 2 * kPi)) * m.wheelbase / 2;
-  return std::max({std::abs(predicted.p.z - actual.p.z), roll, pitch});
+WheelClearances wheelClearances(const RobotModel& robot, const std::function<double(double, double)>& ground,
+                                const Pose& base, std::span<const double> jointPositions) {
+  WheelClearances out{kNoClearance, kNoClearance, kNoClearance, kNoClearance};
+  if (!robot.drive) return out;
+  const std::vector<Pose> links = linkPoses(robot, base, jointPositions);
+  constexpr double e = 0.05;  // [m] the slope's finite difference: under a tyre's contact patch
+  for (size_t k = 0; k < 4; ++k) {
+    const int j = robot.drive->wheels[k];
+    if (j < 0 || j >= static_cast<int>(robot.joints.size())) continue;
+    const int child = robot.joints[static_cast<size_t>(j)].child;
+    if (child < 0 || child >= static_cast<int>(links.size())) continue;
+    const Vec3 hub = links[static_cast<size_t>(child)].p;
+    const double gx = (ground(hub.x + e, hub.y) - ground(hub.x - e, hub.y)) / (2 * e);
+    const double gy = (ground(hub.x, hub.y + e) - ground(hub.x, hub.y - e)) / (2 * e);
+    // The hub's height above the ground's tangent plane, along its normal.
+    out[k] = (hub.z - ground(hub.x, hub.y)) / std::sqrt(1 + gx * gx + gy * gy) - robot.drive->wheelRadius;
+  }
+  return out;
+}
+
+double groundDiscrepancy(const WheelClearances& predicted, const WheelClearances& actual) {
+  double worst = 0;
+  for (size_t k = 0; k < predicted.size(); ++k)
+    if (predicted[k] < kLiftedClearance && std::isfinite(actual[k]))
+      worst = std::max(worst, std::abs(actual[k] - predicted[k]));
+  return worst;
 }
 
 double gaussianMultiplier(double level) { return std::sqrt(-2 * std::log(1 - level)); }
@@ -162,7 +185,7 @@ std::string Departure::describe() const {
   char text[240];
   if (vertical > error)
     std::snprintf(text, sizeof text,
-                  "the robot departs from its twin at (%.1f, %.1f): it stands %.0f cm off the ground the twin knows "
+                  "the robot departs from its twin at (%.1f, %.1f): a wheel stands %.0f cm off the ground the map has "
                   "there (%.0f cm from where it was predicted): the ground or the robot differ from the files there",
                   where.x, where.y, vertical * 100, error * 100);
   else

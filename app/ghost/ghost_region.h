@@ -30,9 +30,13 @@
 //
 // Thread: plain values; the ghost guards them (its record's mutex).
 
+#include <array>
 #include <cstdint>
 #include <deque>
+#include <functional>
+#include <limits>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -91,18 +95,34 @@ double errorScale(const ErrorSources& sources, const ErrorModel& model);
 double commandTiming(const std::vector<std::pair<double, Command>>& commands, double made, double shown, double speed,
                      double wheelbase);
 
-/// The scale [m] of a prediction's vertical discrepancy (verticalOf()):
-/// the floor's, the terrain's uncertainty, and what a horizontal error of
-/// `horizontal` [m] (the prediction's scale) makes of the ground's slope
-/// (0.15: the rough field's steepest, about).
+/// The scale [m] of the ground's discrepancy under the wheels
+/// (groundDiscrepancy()): the floor's (the tyres' compression, the
+/// interpolation of the map), the terrain's uncertainty, and a little of
+/// the prediction's horizontal scale `horizontal` [m] (a wheel predicted
+/// on other ground than it stands on: 2 %, a grid cell's curvature).
 double verticalScale(double horizontal, const ErrorModel& model);
 
-/// [m] how far the base's vertical pose in `actual` is from `predicted`:
-/// the largest of the height difference, the pitch difference over half
-/// the wheelbase and the roll difference over half the track (the heights
-/// at the axles and sides they mean). A ridge the map lacks lifts an axle
-/// at once, long before the robot lags where the ghost put it.
-double verticalOf(const Pose& predicted, const Pose& actual, const ErrorModel& model);
+/// [m] each drive wheel's clearance over the map's ground (FL, FR, RL, RR): its
+/// hub's distance from the ground along the ground's normal, less the
+/// wheel's radius: about 0 for a wheel on the ground, below 0 for one lower
+/// than the map has the ground (a hollow the map lacks), above for one lifted
+/// (a step the map lacks, or a gait). NaN for a robot without a drive. Of
+/// the robot `robot` at `base` with `jointPositions` (model order).
+/// `ground(x, y)` is the map's height there (a World's terrainHeight, or
+/// groundHeight() of a TerrainSpec).
+using WheelClearances = std::array<double, 4>;
+constexpr double kNoClearance = std::numeric_limits<double>::quiet_NaN();
+WheelClearances wheelClearances(const RobotModel& robot, const std::function<double(double, double)>& ground,
+                                const Pose& base, std::span<const double> jointPositions);
+
+/// [m] how far telemetry's ground is from the map's under the wheels: the
+/// largest |actual - predicted| clearance over the wheels the twin had on
+/// the ground (predicted below kLiftedClearance; a wheel it lifted, as a
+/// gait does, is left out). The prediction's horizontal error hardly enters:
+/// both clearances are measured from the map where each robot stands. 0
+/// when no wheel can be compared.
+double groundDiscrepancy(const WheelClearances& predicted, const WheelClearances& actual);
+constexpr double kLiftedClearance = 0.02;  ///< [m]
 
 /// The region's multiplier at `level` for a scale that is a 2-D Gaussian's
 /// per-axis deviation: sqrt(-2 ln(1 - level)) (Rayleigh). What the layer
@@ -176,12 +196,13 @@ class ConformalLayer {
 
 /// A departure: telemetry outside the 99 % region for `hold` seconds: the
 /// base's position outside its disc, or its vertical pose outside its own
-/// region (a layer of its own over verticalOf()'s scores).
+/// region: the ground under a wheel not where the map has it (a layer of
+/// its own over groundDiscrepancy()'s scores).
 struct Departure {
   double time = 0;   ///< [s] robot time it began (the first frame outside)
   Vec3 where;        ///< the robot's base then (as telemetry reported it)
   double error = 0;  ///< [m] the largest distance from the ghost's prediction while it lasts
-  double vertical = 0;  ///< [m] the largest vertical discrepancy (verticalOf()) while it lasts
+  double vertical = 0;  ///< [m] the largest ground discrepancy under a wheel (groundDiscrepancy()) while it lasts
   double ended = -1; ///< [s] robot time it cleared (< 0: still on)
   /// For the operator: "the robot departs from its twin by 28 cm at
   /// (5.1, 0.2): the ground or the robot differ from the files there".

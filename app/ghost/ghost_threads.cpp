@@ -276,6 +276,7 @@ void Ghost::presentLoop() {
       if (watch_.departing()) departure = watch_.last()->describe();
     }
     const std::shared_ptr<const RobotFrame> reported = frames_.latest().second;
+    std::vector<double> shownPositions;
     {
       std::lock_guard lock(viewMutex_);
       if (!halted_.empty()) continue;  // the robot's twin diverged: nothing to predict until it reports again
@@ -285,6 +286,7 @@ void Ghost::presentLoop() {
       v.span = t - newest;
       v.base = r.base;
       v.jointPositions = fullPositions(*twin, r.jointPositions, reported ? &reported->jointPositions : nullptr);
+      shownPositions = v.jointPositions;
       v.objects = r.objects;
       if (capped) v.problem = aheadProblem(ahead);
       else v.problem.clear();
@@ -296,9 +298,11 @@ void Ghost::presentLoop() {
       v.outerLevel = params_.ghostRegionOuter;
       v.departure = std::move(departure);
     }
+    const WheelClearances clearance = wheelClearances(
+        robot_, [&w](double x, double y) { return w.terrainHeight(x, y); }, r.base, shownPositions);
     {
       std::lock_guard lock(recordMutex_);
-      record_.shown(t, base->made, r.base, scale, sources);
+      record_.shown(t, base->made, r.base, scale, sources, clearance);
     }
     {
       std::lock_guard lock(statsMutex_);

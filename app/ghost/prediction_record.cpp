@@ -16,9 +16,10 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-void PredictionRecord::shown(double time, double made, const Pose& base, double scale, const ErrorSources& sources) {
+void PredictionRecord::shown(double time, double made, const Pose& base, double scale, const ErrorSources& sources,
+                             const WheelClearances& clearance) {
   while (!shown_.empty() && shown_.back().time >= time) shown_.pop_back();  // superseded
-  shown_.push_back({time, made, base, scale, sources});
+  shown_.push_back({time, made, base, scale, sources, clearance});
   while (shown_.front().time < time - kShownWindow) shown_.pop_front();
 }
 
@@ -38,6 +39,7 @@ std::optional<GhostError> PredictionRecord::compare(const RobotFrame& frame) {
   e.predicted.p = a.base.p + u * (b.base.p - a.base.p);
   e.scale = a.scale + u * (b.scale - a.scale);
   e.sources = u < 0.5 ? a.sources : b.sources;
+  for (size_t w = 0; w < e.clearance.size(); ++w) e.clearance[w] = a.clearance[w] + u * (b.clearance[w] - a.clearance[w]);
   e.position = std::hypot(e.predicted.p.x - frame.base.p.x, e.predicted.p.y - frame.base.p.y);
   e.heading = std::abs(std::remainder(heading(e.predicted.q) - heading(frame.base.q), 2 * kPi));
   errors_.push_back(e);

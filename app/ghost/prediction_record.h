@@ -28,7 +28,10 @@ struct GhostError {
   double scale = 0;     ///< [m]
   ErrorSources sources;  ///< what the scale was made of (the nearer shown state's)
   double inner = 0, outer = 0, limit = 0;  ///< [m] the inner, outer and departure regions
-  double vertical = 0;       ///< [m] the vertical pose's discrepancy (ghost_region.h verticalOf())
+  /// The twin's wheels' clearances over the map then (ghost_region.h
+  /// wheelClearances(); NaN where not shown).
+  WheelClearances clearance{kNoClearance, kNoClearance, kNoClearance, kNoClearance};
+  double vertical = 0;       ///< [m] the ground's discrepancy under the wheels (ghost_region.h groundDiscrepancy())
   double verticalLimit = 0;  ///< [m] its departure region
   /// +1: this frame announced a departure; -1: it cleared one; 0: neither.
   int departure = 0;
@@ -46,7 +49,9 @@ class PredictionRecord {
   /// telemetry of robot time `made`. A later prediction for the same or an
   /// earlier time supersedes what was shown from then on.
   /// `scale` [m]: its error scale (ghost_region.h; 0: none), made of `sources`.
-  void shown(double time, double made, const Pose& base, double scale = 0, const ErrorSources& sources = {});
+  /// `clearance`: the twin's wheels' (wheelClearances()).
+  void shown(double time, double made, const Pose& base, double scale = 0, const ErrorSources& sources = {},
+             const WheelClearances& clearance = {kNoClearance, kNoClearance, kNoClearance, kNoClearance});
   /// `frame` against what was shown for its time (interpolated between the
   /// two shown states around it), recorded; nullopt when nothing was shown
   /// within kMatchWindow of it.
@@ -65,6 +70,7 @@ class PredictionRecord {
     Pose base;
     double scale;
     ErrorSources sources;
+    WheelClearances clearance;
   };
   std::deque<Shown> shown_;
   std::deque<GhostError> errors_;

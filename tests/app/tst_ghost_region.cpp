@@ -1,7 +1,8 @@
 // How sure the ghost is (app/ghost/ghost_region.h), on synthetic residuals:
 // the conformal layer's arithmetic, its coverage before and after the robot
 // changes (with controls: the layer off, its adaptive step off), the
-// departure watch, and the error scale's sources.
+// departure watch, the error scale's sources, and the wheels' clearance over
+// the map (the ground's discrepancy departures are judged on).
 
 #include <QTest>
 
@@ -10,6 +11,8 @@
 
 #include "app/ghost/ghost_region.h"
 #include "app/ghost/in_flight.h"
+#include "sim/diagnostics.h"
+#include "sim/model_loader.h"
 
 using namespace sp;
 
@@ -177,6 +180,47 @@ class TestGhostRegion : public QObject {
 
   // A command's timing counts only when it takes effect within the
   // prediction's horizon; a drive before it sets the speed it changes.
+  // The wheels' clearance over the map, from the base's pose and the
+  // joints' positions: 0 on the ground, the step's height where the map
+  // has ground the wheel is not on; the discrepancy leaves out a wheel the
+  // twin lifted. Control: the same robot 4 cm higher reads 4 cm everywhere.
+  void wheelClearanceAndTheGroundsDiscrepancy() {
+    Diagnostics diag;
+    const std::optional<RobotModel> robot = loadRobot(SP_SOURCE_DIR "/robots/workpartner.xml", diag);
+    QVERIFY2(robot, diag.format().c_str());
+    const std::vector<double> joints(robot->joints.size(), 0.0);
+    const Pose base = robot->links[0].pose;  // the model's frame on the ground z = 0
+    const auto flat = [](double, double) { return 0.0; };
+    const WheelClearances standing = wheelClearances(*robot, flat, base, joints);
+    for (double c : standing) QVERIFY2(std::abs(c) < 1e-9, qPrintable(QString::number(c)));
+    // A map with a 6 cm block under the front-left wheel (x > 0, y > 0).
+    const auto block = [](double x, double y) { return x > 0.3 && y > 0.2 ? 0.06 : 0.0; };
+    const WheelClearances onBlock = wheelClearances(*robot, block, base, joints);
+    QVERIFY2(std::abs(onBlock[0] + 0.06) < 1e-9, qPrintable(QString::number(onBlock[0])));
+    for (size_t k = 1; k < 4; ++k) QVERIFY(std::abs(onBlock[k]) < 1e-9);
+    QVERIFY(std::abs(groundDiscrepancy(standing, onBlock) - 0.06) < 1e-9);
+    // Bent knees lower the hubs: the clearance follows the joints.
+    std::vector<double> bent = joints;
+    const int knee = robot->findJoint("knee_fl");
+    QVERIFY(knee >= 0);
+    bent[static_cast<size_t>(knee)] = 0.3;
+    const WheelClearances kneeling = wheelClearances(*robot, flat, base, bent);
+    QVERIFY2(std::abs(kneeling[0]) > 0.005, qPrintable(QString::number(kneeling[0])));
+    QVERIFY(std::abs(kneeling[1]) < 1e-9);
+    // A wheel the twin had lifted (a gait) is not compared.
+    WheelClearances lifted = standing;
+    lifted[0] = 0.08;
+    QCOMPARE(groundDiscrepancy(lifted, onBlock), 0.0);
+    const WheelClearances unknown{kNoClearance, kNoClearance, kNoClearance, kNoClearance};
+    QCOMPARE(groundDiscrepancy(standing, unknown), 0.0);
+    // Control: the whole robot 4 cm up.
+    Pose up = base;
+    up.p.z += 0.04;
+    const WheelClearances raised = wheelClearances(*robot, flat, up, joints);
+    for (double c : raised) QVERIFY(std::abs(c - 0.04) < 1e-9);
+    QVERIFY(std::abs(groundDiscrepancy(standing, raised) - 0.04) < 1e-9);
+  }
+
   void timingCountsCommandsWithinTheHorizon() {
     InFlightCommands in;
     in.add(DriveCmd{0.5, 0}, 1.0);
