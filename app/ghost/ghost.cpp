@@ -246,15 +246,27 @@ void Ghost::judge(GhostError& e, const RobotFrame& frame) {
       applyPatch(ground_.grid, groundEdits_.front().second);
     groundEdits_.pop_front();
   }
+  std::array<Vec3, 4> hubs{};
   const WheelClearances actual = wheelClearances(
-      robot_, [this](double x, double y) { return groundHeight(ground_, x, y); }, frame.base, frame.jointPositions);
-  e.vertical = groundDiscrepancy(e.clearance, actual);
+      robot_, [this](double x, double y) { return groundHeight(ground_, x, y); }, frame.base, frame.jointPositions,
+      &hubs);
+  // A wheel that carries nothing is off the ground, wherever the ground
+  // is (a bounce on rough ground): only wheels telemetry has loaded are
+  // judged, when it reports the loads at all.
+  WheelClearances loaded = actual;
+  if (std::any_of(frame.wheelNormal.begin(), frame.wheelNormal.end(), [](double n) { return n > 0; }))
+    for (size_t k = 0; k < loaded.size(); ++k)
+      if (frame.wheelNormal[k] < kLoadedWheel) loaded[k] = kNoClearance;
+  int wheel = -1;
+  e.vertical = groundDiscrepancy(e.clearance, loaded, &wheel);
+  const std::optional<Vec3> wheelAt =
+      wheel >= 0 ? std::optional<Vec3>(hubs[static_cast<size_t>(wheel)]) : std::nullopt;
   e.verticalLimit = vertical_.multiplier(0) * vscale;
   const double vscore = e.vertical / vscale;
   region_.judge(score);
   vertical_.judge(vscore);
   const DepartureWatch::Change change =
-      watch_.judge(frame.time, frame.base.p, e.position, e.limit, e.vertical, e.verticalLimit);
+      watch_.judge(frame.time, frame.base.p, e.position, e.limit, e.vertical, e.verticalLimit, wheelAt);
   if (change == DepartureWatch::Change::Began) {
     departures_.push_back(*watch_.last());
     e.departure = 1;

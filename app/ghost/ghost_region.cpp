@@ -65,7 +65,7 @@ double verticalScale(double horizontal, const ErrorModel& m) {
 }
 
 WheelClearances wheelClearances(const RobotModel& robot, const std::function<double(double, double)>& ground,
-                                const Pose& base, std::span<const double> jointPositions) {
+                                const Pose& base, std::span<const double> jointPositions, std::array<Vec3, 4>* hubs) {
   WheelClearances out{kNoClearance, kNoClearance, kNoClearance, kNoClearance};
   if (!robot.drive) return out;
   const std::vector<Pose> links = linkPoses(robot, base, jointPositions);
@@ -76,6 +76,7 @@ WheelClearances wheelClearances(const RobotModel& robot, const std::function<dou
     const int child = robot.joints[static_cast<size_t>(j)].child;
     if (child < 0 || child >= static_cast<int>(links.size())) continue;
     const Vec3 hub = links[static_cast<size_t>(child)].p;
+    if (hubs) (*hubs)[k] = hub;
     const double gx = (ground(hub.x + e, hub.y) - ground(hub.x - e, hub.y)) / (2 * e);
     const double gy = (ground(hub.x, hub.y + e) - ground(hub.x, hub.y - e)) / (2 * e);
     // The hub's height above the ground's tangent plane, along its normal.
@@ -84,12 +85,15 @@ WheelClearances wheelClearances(const RobotModel& robot, const std::function<dou
   return out;
 }
 
-double groundDiscrepancy(const WheelClearances& predicted, const WheelClearances& actual) {
-  double worst = 0;
+double groundDiscrepancy(const WheelClearances& predicted, const WheelClearances& actual, int* worst) {
+  double most = 0;
+  if (worst) *worst = -1;
   for (size_t k = 0; k < predicted.size(); ++k)
-    if (predicted[k] < kLiftedClearance && std::isfinite(actual[k]))
-      worst = std::max(worst, std::abs(actual[k] - predicted[k]));
-  return worst;
+    if (predicted[k] < kLiftedClearance && std::isfinite(actual[k]) && std::abs(actual[k] - predicted[k]) > most) {
+      most = std::abs(actual[k] - predicted[k]);
+      if (worst) *worst = static_cast<int>(k);
+    }
+  return most;
 }
 
 double gaussianMultiplier(double level) { return std::sqrt(-2 * std::log(1 - level)); }
@@ -197,9 +201,10 @@ std::string Departure::describe() const {
 }
 
 DepartureWatch::Change DepartureWatch::judge(double time, const Vec3& where, double error, double radius,
-                                             double vertical, double verticalLimit) {
-  const bool outside = (error > radius && error > options_.minimum) ||
-                       (vertical > verticalLimit && vertical > options_.minimumVertical);
+                                             double vertical, double verticalLimit, const std::optional<Vec3>& wheel) {
+  const bool away = error > radius && error > options_.minimum;
+  const bool off = vertical > verticalLimit && vertical > options_.minimumVertical;
+  const bool outside = away || off;
   if (departing()) {
     last_->error = std::max(last_->error, error);
     last_->vertical = std::max(last_->vertical, vertical);
@@ -220,7 +225,7 @@ DepartureWatch::Change DepartureWatch::judge(double time, const Vec3& where, dou
   }
   if (outsideSince_ < 0) {
     outsideSince_ = time;
-    outsideWhere_ = where;
+    outsideWhere_ = !away && wheel ? *wheel : where;
     outsideWorst_ = outsideVertical_ = 0;
   }
   outsideWorst_ = std::max(outsideWorst_, error);

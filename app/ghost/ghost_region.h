@@ -112,8 +112,10 @@ double verticalScale(double horizontal, const ErrorModel& model);
 /// groundHeight() of a TerrainSpec).
 using WheelClearances = std::array<double, 4>;
 constexpr double kNoClearance = std::numeric_limits<double>::quiet_NaN();
+/// `hubs`: where each wheel's hub is (when given).
 WheelClearances wheelClearances(const RobotModel& robot, const std::function<double(double, double)>& ground,
-                                const Pose& base, std::span<const double> jointPositions);
+                                const Pose& base, std::span<const double> jointPositions,
+                                std::array<Vec3, 4>* hubs = nullptr);
 
 /// [m] how far telemetry's ground is from the map's under the wheels: the
 /// largest |actual - predicted| clearance over the wheels the twin had on
@@ -121,8 +123,12 @@ WheelClearances wheelClearances(const RobotModel& robot, const std::function<dou
 /// gait does, is left out). The prediction's horizontal error hardly enters:
 /// both clearances are measured from the map where each robot stands. 0
 /// when no wheel can be compared.
-double groundDiscrepancy(const WheelClearances& predicted, const WheelClearances& actual);
+/// `worst`: the wheel it is of (-1: none).
+double groundDiscrepancy(const WheelClearances& predicted, const WheelClearances& actual, int* worst = nullptr);
 constexpr double kLiftedClearance = 0.02;  ///< [m]
+/// [N] a wheel telemetry reports carrying less is not on the ground (a
+/// WorkPartner wheel carries about 500 N standing).
+constexpr double kLoadedWheel = 50;
 
 /// The region's multiplier at `level` for a scale that is a 2-D Gaussian's
 /// per-axis deviation: sqrt(-2 ln(1 - level)) (Rayleigh). What the layer
@@ -200,7 +206,10 @@ class ConformalLayer {
 /// its own over groundDiscrepancy()'s scores).
 struct Departure {
   double time = 0;   ///< [s] robot time it began (the first frame outside)
-  Vec3 where;        ///< the robot's base then (as telemetry reported it)
+  /// Where: the robot's base then (as telemetry reported it), or for one
+  /// under the wheels (the position inside its region) the wheel that
+  /// stood off the map's ground: the place the ground differs.
+  Vec3 where;
   double error = 0;  ///< [m] the largest distance from the ghost's prediction while it lasts
   double vertical = 0;  ///< [m] the largest ground discrepancy under a wheel (groundDiscrepancy()) while it lasts
   double ended = -1; ///< [s] robot time it cleared (< 0: still on)
@@ -232,8 +241,10 @@ class DepartureWatch {
   /// A frame at robot time `time` at `where` was `error` from its
   /// prediction, whose departure region had radius `radius`, and
   /// `vertical` off in its vertical pose, whose region was `verticalLimit`.
+  /// `wheel`: where the wheel that stood furthest off the map was (a
+  /// departure under the wheels is placed there).
   Change judge(double time, const Vec3& where, double error, double radius, double vertical = 0,
-               double verticalLimit = 1e300);
+               double verticalLimit = 1e300, const std::optional<Vec3>& wheel = std::nullopt);
   /// The departure on now, or the last one (ended >= 0); nullopt before any.
   const std::optional<Departure>& last() const { return last_; }
   bool departing() const { return last_ && last_->ended < 0; }

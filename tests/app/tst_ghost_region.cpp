@@ -155,6 +155,17 @@ class TestGhostRegion : public QObject {
     QVERIFY(ended > back + 0.45 && ended < back + 0.55);
     QVERIFY(!watch.departing());
     QCOMPARE(watch.count(), 1);
+    // Under the wheels (the position inside its region): placed at the
+    // wheel, said in the ground's words; control: the position's departure
+    // above stayed at the base.
+    const Vec3 wheel{6.2, 0.6, 0.2};
+    const double under = t;
+    for (; t < under + 0.6; t += 0.02) watch.judge(t, here, 0.01, 0.05, 0.06, 0.01, wheel);
+    QVERIFY(watch.departing());
+    QCOMPARE(watch.count(), 2);
+    QCOMPARE(watch.last()->where.x, 6.2);
+    QVERIFY2(watch.last()->describe().find("a wheel stands 6 cm off the ground the map has there") != std::string::npos,
+             watch.last()->describe().c_str());
   }
 
   // The scale: the floor for a robot standing, growing with speed x horizon
