@@ -208,6 +208,7 @@ DepartureWatch::Change DepartureWatch::judge(double time, const Vec3& where, dou
   if (departing()) {
     last_->error = std::max(last_->error, error);
     last_->vertical = std::max(last_->vertical, vertical);
+    last_->ground |= off;
     if (outside) {
       insideSince_ = -1;
       return Change::None;
@@ -227,11 +228,13 @@ DepartureWatch::Change DepartureWatch::judge(double time, const Vec3& where, dou
     outsideSince_ = time;
     outsideWhere_ = !away && wheel ? *wheel : where;
     outsideWorst_ = outsideVertical_ = 0;
+    outsideGround_ = false;
   }
   outsideWorst_ = std::max(outsideWorst_, error);
   outsideVertical_ = std::max(outsideVertical_, vertical);
+  outsideGround_ |= off;
   if (time - outsideSince_ < options_.hold) return Change::None;
-  last_ = Departure{outsideSince_, outsideWhere_, outsideWorst_, outsideVertical_, -1};
+  last_ = Departure{outsideSince_, outsideWhere_, outsideWorst_, outsideVertical_, -1, outsideGround_};
   ++count_;
   insideSince_ = -1;
   return Change::Began;

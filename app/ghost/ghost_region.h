@@ -213,6 +213,10 @@ struct Departure {
   double error = 0;  ///< [m] the largest distance from the ghost's prediction while it lasts
   double vertical = 0;  ///< [m] the largest ground discrepancy under a wheel (groundDiscrepancy()) while it lasts
   double ended = -1; ///< [s] robot time it cleared (< 0: still on)
+  /// The ground under a wheel was off the map's in it: a place differs.
+  /// Without, the wheels stood on the map's ground and the base went
+  /// elsewhere than its twin: the robot differs (what calibration fits).
+  bool ground = false;
   /// For the operator: "the robot departs from its twin by 28 cm at
   /// (5.1, 0.2): the ground or the robot differ from the files there".
   std::string describe() const;
@@ -248,8 +252,8 @@ class DepartureWatch {
   /// The departure on now, or the last one (ended >= 0); nullopt before any.
   const std::optional<Departure>& last() const { return last_; }
   bool departing() const { return last_ && last_->ended < 0; }
-  /// A frame is outside, or the departure is on: the calibrator and the
-  /// conformal layer leave it out.
+  /// A frame is outside, or the departure is on: the conformal layer
+  /// leaves it out.
   bool suspect() const { return outsideSince_ >= 0 || departing(); }
   int count() const { return count_; }
   void clear();
@@ -259,6 +263,7 @@ class DepartureWatch {
   double outsideSince_ = -1;  // robot time of the first frame of a run outside
   Vec3 outsideWhere_;
   double outsideWorst_ = 0, outsideVertical_ = 0;
+  bool outsideGround_ = false;
   double insideSince_ = -1;   // while departing: the first frame of a run inside
   std::optional<Departure> last_;
   int count_ = 0;

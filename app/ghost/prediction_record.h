@@ -35,7 +35,9 @@ struct GhostError {
   double verticalLimit = 0;  ///< [m] its departure region
   /// +1: this frame announced a departure; -1: it cleared one; 0: neither.
   int departure = 0;
-  /// In a departure: not the files' world (the calibration leaves it out).
+  /// In a departure under the wheels (Departure::ground): not the files'
+  /// world there, so the calibration leaves it out. A departure of the base
+  /// alone is the robot, which the calibration is for: not suspect.
   bool suspect = false;
 };
 

@@ -155,6 +155,7 @@ class TestGhostRegion : public QObject {
     QVERIFY(ended > back + 0.45 && ended < back + 0.55);
     QVERIFY(!watch.departing());
     QCOMPARE(watch.count(), 1);
+    QVERIFY(!watch.last()->ground);  // the base alone: the robot differs, the calibration may fit it
     // Under the wheels (the position inside its region): placed at the
     // wheel, said in the ground's words; control: the position's departure
     // above stayed at the base.
@@ -166,6 +167,7 @@ class TestGhostRegion : public QObject {
     QCOMPARE(watch.last()->where.x, 6.2);
     QVERIFY2(watch.last()->describe().find("a wheel stands 6 cm off the ground the map has there") != std::string::npos,
              watch.last()->describe().c_str());
+    QVERIFY(watch.last()->ground);  // a place: the calibration leaves it out
   }
 
   // The scale: the floor for a robot standing, growing with speed x horizon
