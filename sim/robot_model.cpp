@@ -88,6 +88,12 @@ double groundHeight(const TerrainSpec& t, double x, double y) {
   return t.grid.heightAt(local.x, local.y) + t.pose.p.z;
 }
 
+bool onTerrain(const TerrainSpec& t, double x, double y) {
+  if (t.kind == TerrainSpec::Kind::Plane) return true;
+  const Vec3 local = transformPoint(inverse(t.pose), {x, y, 0});
+  return std::abs(local.x) <= t.grid.width / 2 && std::abs(local.y) <= t.grid.depth / 2;
+}
+
 double terrainUncertainty(const TerrainSpec& terrain) {
   if (terrain.heightUncertainty >= 0) return terrain.heightUncertainty;
   if (terrain.kind == TerrainSpec::Kind::Plane) return 0;

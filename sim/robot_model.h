@@ -195,6 +195,11 @@ double terrainUncertainty(const TerrainSpec& terrain);
 /// (its edge value outside it, as HeightGrid::heightAt does).
 double groundHeight(const TerrainSpec& terrain, double x, double y);
 
+/// Whether world (x, y) lies on `terrain`: always on a plane; inside its
+/// extent on a heightfield (beyond it the physics has no ground: a robot
+/// there falls).
+bool onTerrain(const TerrainSpec& terrain, double x, double y);
+
 /// A static or dynamic object of the world.
 struct ObjectSpec {
   std::string name;

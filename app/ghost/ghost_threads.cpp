@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <tuple>
 
 #include "app/ghost/ghost_impl.h"
@@ -22,6 +23,25 @@ namespace sp {
 namespace {
 
 constexpr double kTrailPeriod = 0.25; // [s] between trails while nothing changes
+
+// "" or, for `w` just diverged, that a link of its robot went past the
+// edge of the map (beyond it the physics has no ground: the twin falls),
+// in the operator's words rather than the solver's.
+std::string offTheMap(const World& w) {
+  const TerrainSpec& map = w.model().terrain;
+  for (int k = 0; k < static_cast<int>(w.robotModel(0).links.size()); ++k) {
+    const Vec3 p = w.linkPose(0, k).p;
+    if (std::isfinite(p.x) && std::isfinite(p.y) && !onTerrain(map, p.x, p.y)) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "the ghost's prediction leaves the map at (%.1f, %.1f): beyond its edge there is no ground to "
+                    "predict on",
+                    p.x, p.y);
+      return text;
+    }
+  }
+  return "";
+}
 
 // Seconds as the steady clock's duration (Ghost::now() counts from its epoch).
 std::chrono::steady_clock::duration steady(double seconds) {
@@ -174,10 +194,13 @@ void Ghost::anchorLoop() {
     base->made = frame.time;
     base->latched = latched;
     if (ok) base->snapshot = w.snapshot();
-    const std::string health = ok ? "" : w.health().message();
+    std::string why;
+    if (!ok) why = offTheMap(w);
+    if (!ok && why.empty())
+      why = "the ghost diverged predicting from " + std::to_string(frame.time) + " s: " + w.health().message();
     w.restore(run.anchored);
     if (!ok) {
-      setProblem("the ghost diverged predicting from " + std::to_string(frame.time) + " s: " + health);
+      setProblem(why);
       continue;
     }
     {
@@ -248,11 +271,12 @@ void Ghost::presentLoop() {
     size_t applied = 0;
     if (!advance(w, t, target, commands, applied, [this] { return stopping(); })) {
       if (stopping()) return;
-      const std::string health = w.health().message();
+      std::string why = offTheMap(w);
+      if (why.empty()) why = "the ghost diverged: " + w.health().message();
       w.restore(base->snapshot);
       t = base->time;
       next = base->nextSeq;
-      setProblem("the ghost diverged: " + health);
+      setProblem(why);
       continue;
     }
     if (applied > 0) next = commands[applied - 1].seq + 1;

@@ -257,6 +257,53 @@ class TestGhost : public QObject {
     QCOMPARE(v.jointPositions[elbow], bent.jointPositions[elbow]);
   }
 
+  // A prediction that runs past the map's edge (beyond it the physics has
+  // no ground: the twin falls) says so in words about the map, not the
+  // solver's "in the ground by 0.26 m" (bench_region once drove a robot
+  // there). The robot stands 2 m inside the bumpy field's edge, driving
+  // towards it with the ghost 2 s ahead; control: driving away from it.
+  void predictionOffTheMapSaysSo_data() {
+    QTest::addColumn<double>("speed");
+    QTest::addColumn<bool>("said");
+    QTest::newRow("towards the edge") << 0.6 << true;
+    QTest::newRow("control: away from it") << -0.6 << false;
+  }
+  void predictionOffTheMapSaysSo() {
+    QFETCH(double, speed);
+    QFETCH(bool, said);
+    Diagnostics diag;
+    auto world = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/bumpy.world.xml", diag);
+    QVERIFY2(world, diag.format().c_str());
+    world->robots[0].pose.p = {7.0, 0, 0.2};  // the front axle 2 m from x = 10 m; let down onto the ground below
+    auto robot = World::create(*world, SimParams{}, diag);
+    QVERIFY2(robot, diag.format().c_str());
+    for (int i = 0; i < 1500; ++i) QVERIFY(robot->step());
+    std::string error;
+    auto ghost = Ghost::create(*world, SimParams{}, error);
+    QVERIFY2(ghost, error.c_str());
+    const double roundTrip = 4;  // the ghost shows 2 s ahead
+    ghost->anchor(frameOf(*robot), roundTrip);
+    QTRY_VERIFY_WITH_TIMEOUT(ghost->viewVersion() > 0, 5000);
+    const Command drive = DriveCmd{speed, 0};
+    QCOMPARE(robot->submit(drive), std::string());
+    ghost->commandSent(drive);
+    std::string problem;
+    const auto start = std::chrono::steady_clock::now();
+    // Up to 3 s of the robot's driving, in real time: it stays on the map
+    // (its front axle, 1 m ahead of the base, short of x = 9.5 m).
+    while (robot->time() < 4.5 && problem.find("leaves the map") == std::string::npos) {
+      for (int i = 0; i < 20; ++i) QVERIFY(robot->step());
+      ghost->anchor(frameOf(*robot), roundTrip);
+      std::this_thread::sleep_until(start + std::chrono::duration<double>(robot->time() - 1.5));
+      problem = ghost->view().problem;
+    }
+    const double x = readRobot(*robot).base.p.x;
+    qInfo("robot at x = %.2f m at %.2f s; the ghost's problem: '%s'", x, robot->time(), problem.c_str());
+    QVERIFY(x + 1 < 9.5);
+    QCOMPARE(problem.find("the ghost's prediction leaves the map at (") == 0, said);
+    if (!said) QCOMPARE(problem, std::string());
+  }
+
   // The legs are held (ghost.hold) only while the robot keeps them still:
   // a crouch sent switches the ghost to the full robot, which bends its
   // knees a round trip before the robot does (a held ghost draws the knees

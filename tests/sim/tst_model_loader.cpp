@@ -55,6 +55,7 @@ class TestModelLoader : public QObject {
   void testRobotErrors_data();
   void testRobotErrors();
   void terrainUncertaintyStatedOrDerived();
+  void onTerrainIsTheMapsExtent();
   void testWorldErrors_data();
   void testWorldErrors();
   void testLinkWithoutGeomWarns();
@@ -415,6 +416,21 @@ void TestModelLoader::terrainUncertaintyStatedOrDerived() {
   qInfo("derived height uncertainty: bumpy %.2f mm, rough %.2f mm", b * 1000, r * 1000);
   QVERIFY(b > 0 && b < 0.001);
   QVERIFY(r > b);
+}
+
+// A plane is everywhere; a heightfield only over its extent (the bumpy
+// field: 20 m across, centred on the origin).
+void TestModelLoader::onTerrainIsTheMapsExtent() {
+  Diagnostics diag;
+  auto plane = parseWorld(R"(<world name="w"><terrain type="plane"/></world>)", "w.xml", "", diag);
+  QVERIFY2(plane, diag.format().c_str());
+  QVERIFY(onTerrain(plane->terrain, 1e4, -1e4));
+  const auto bumpy = loadWorld(std::string(SP_SOURCE_DIR) + "/terrains/bumpy.world.xml", diag);
+  QVERIFY2(bumpy, diag.format().c_str());
+  QVERIFY(onTerrain(bumpy->terrain, 9.9, -9.9));
+  QVERIFY(onTerrain(bumpy->terrain, 0, 0));
+  QVERIFY(!onTerrain(bumpy->terrain, 10.1, 0));
+  QVERIFY(!onTerrain(bumpy->terrain, 0, -10.1));
 }
 
 void TestModelLoader::testWorldErrors_data() {
