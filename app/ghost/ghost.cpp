@@ -286,7 +286,8 @@ void Ghost::judge(GhostError& e, const RobotFrame& frame) {
   // A lasting departure's frames teach the position's layer (the robot
   // differs: the region must widen to it), never the ground's: ground that
   // is not the map's stays a departure wherever the robot meets it.
-  const Judged judged{frame.time, e.position, e.vertical, e.sources, !watch_.departing()};
+  const Judged judged{frame.time, e.position, e.vertical, e.sources,
+                      !watch_.departing() && e.vertical <= kUnlearntGround};
   if (watch_.suspect() && !lasting) {
     pending_.push_back(judged);
     return;
