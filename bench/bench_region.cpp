@@ -148,8 +148,9 @@ Result runCase(const std::string& world, uint64_t seed, double seconds, bool unm
   const int64_t anchors0 = session.ghost() ? session.ghost()->stats().anchors : 0;
   const auto wall0 = std::chrono::steady_clock::now();
   // Until the last command has come back in telemetry.
+  const bool trace = std::getenv("SP_BENCH_TRACE") != nullptr;
   const std::vector<DrivePhase> drive = driveOf(world, seed, seconds);
-  if (std::getenv("SP_BENCH_TRACE"))
+  if (trace)
     for (const DrivePhase& p : drive) {
       if (const auto* d = std::get_if<DriveCmd>(&p.command))
         std::fprintf(stderr, "phase %.2f drive %.3f m/s %.1f deg\n", p.at, d->speed, radToDeg(d->articulation));
@@ -167,10 +168,11 @@ Result runCase(const std::string& world, uint64_t seed, double seconds, bool unm
         r.errors.push_back(e->position);
         r.radii.push_back(e->outer);
       }
-      if (std::getenv("SP_BENCH_TRACE") && e)
-        std::fprintf(stderr, "%.2f x %.2f y %.2f z %.3f err %.1f lim %.1f vert %.1f vlim %.1f scale %.1f dep %d sus %d\n", t.time,
-                     axlesX(t).first, t.pose.p.y, t.pose.p.z, e->position * 1000, e->limit * 1000, e->vertical * 1000, e->verticalLimit * 1000,
-                     e->scale * 1000, e->departure, e->suspect);
+      if (trace && e)
+        std::fprintf(stderr,
+                     "%.2f x %.2f y %.2f z %.3f err %.1f lim %.1f vert %.1f vlim %.1f scale %.1f dep %d sus %d\n",
+                     t.time, axlesX(t).first, t.pose.p.y, t.pose.p.z, e->position * 1000, e->limit * 1000,
+                     e->vertical * 1000, e->verticalLimit * 1000, e->scale * 1000, e->departure, e->suspect);
       if (unmapped) {
         // An axle coming onto a feature: the robot meets it (once per
         // crossing: the next needs both axles off first).
@@ -204,7 +206,7 @@ Result runCase(const std::string& world, uint64_t seed, double seconds, bool unm
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   if (session.ghost()) {
     r.anchorsPerSecond = static_cast<double>(session.ghost()->stats().anchors - anchors0) / wall;
-    if (std::getenv("SP_BENCH_TRACE")) {
+    if (trace) {
       std::fprintf(stderr, "end: ghost problem '%s', view time %.2f\n", session.ghost()->view().problem.c_str(),
                    session.ghost()->view().time);
       if (const LiveCalibrator* c = session.calibrator()) {
