@@ -143,6 +143,7 @@ struct Case {
   Vec3 comFit, comTrue;  // [m] forward, left of the files' (calibration.com_x, com_y)
   double rehearseFiles = 0, rehearseCal = 0, rehearseGhostValues = 0, rehearseOracle = 0, rehearseOwn = 0;  // [m] end position errors
   std::array<double, 4> torqueFit{}, torqueTrue{};  // each wheel motor's torque limit, factor
+  std::array<double, 4> torqueEstimate{}, torqueSigma{};  // the fused estimate before the significance gate; sigma 0: unobserved
   std::array<double, 4> tyreError{};                // |fitted / hidden - 1| per tyre (rolling radius)
   double checkMs = 0;
   double fitMsMax = 0, fitMsMedian = 0;
@@ -261,6 +262,8 @@ Case run(const std::string& name, const WorldModel& world, uint64_t seed) {
     const size_t i = static_cast<size_t>(CalParam::TorqueFL) + w;
     oracle[i] = c.torqueTrue[w] = p.torqueLimit * p.wheelTorque[w];
     c.torqueFit[w] = values[i];
+    c.torqueEstimate[w] = estimate.value[i];
+    c.torqueSigma[w] = estimate.observed[i] ? estimate.sigma[i] : 0;
   }
   {
     // Each tyre as the twins build it from the fitted mean and splits
@@ -416,6 +419,9 @@ int main(int argc, char** argv) {
                   c.torqueFit[0], c.torqueTrue[0], c.torqueFit[1], c.torqueTrue[1], c.torqueFit[2], c.torqueTrue[2],
                   c.torqueFit[3], c.torqueTrue[3], c.tyreError[0] * 100, c.tyreError[1] * 100, c.tyreError[2] * 100,
                   c.tyreError[3] * 100);
+      std::printf("       torque estimate FL %.3f+-%.3f FR %.3f+-%.3f RL %.3f+-%.3f RR %.3f+-%.3f (+-0: unobserved)\n",
+                  c.torqueEstimate[0], c.torqueSigma[0], c.torqueEstimate[1], c.torqueSigma[1], c.torqueEstimate[2],
+                  c.torqueSigma[2], c.torqueEstimate[3], c.torqueSigma[3]);
       std::fflush(stdout);
       cases[i] = std::move(c);
     }
