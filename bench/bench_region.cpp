@@ -26,6 +26,11 @@
 //
 // --control: the conformal layer off (its Gaussian multipliers on the
 // scale alone), to show that the coverage figures can fail.
+//
+// --change T: the stand-in changes T s into the drive (friction x 0.7,
+// delay + 100 ms: sim/perturbation.h SuddenChange); the 90 % region's
+// coverage is printed for each 10 s after 20 s, and whether every window
+// from 20 s after the change on holds 85-95 % (back within 30 s).
 
 #include <algorithm>
 #include <chrono>
@@ -99,6 +104,8 @@ std::vector<DrivePhase> driveOf(const std::string& world, uint64_t seed, double 
 
 struct Result {
   int judged = 0, inner = 0, outer = 0;
+  std::vector<std::pair<int, int>> windows;  // (judged, in 90 %) per 10 s of the drive
+  double changeIntoDrive = -1;               // [s] the sudden change, from the drive's start
   std::vector<double> errors, radii;
   int falseAlarms = 0;  // departures on mapped ground
   std::vector<double> latencies;  // [s] feature met to departure announced (departure runs)
@@ -121,7 +128,8 @@ std::pair<double, double> axlesX(const TelemetryMsg& t) {
   return {t.pose.p.x + 1.0 * c, t.pose.p.x - 0.1 * c};
 }
 
-Result runCase(const std::string& world, uint64_t seed, double seconds, bool unmapped, bool control) {
+Result runCase(const std::string& world, uint64_t seed, double seconds, bool unmapped, bool control,
+               double changeAt = -1) {
   Result r;
   ConsoleSessionOptions o;
   const std::string file = world == "track" ? "test_track" : world;
@@ -133,6 +141,7 @@ Result runCase(const std::string& world, uint64_t seed, double seconds, bool unm
   o.overrides = {"link.deadman=0.5"};
   if (seed != 0) o.perturbSeed = seed;
   if (control) o.ghostOptions.conformal = false;
+  if (changeAt >= 0) o.change = SuddenChange{changeAt, 0.7, 0.1};  // robot time: the drive starts within a second of 0
   ConsoleSession session(o);
   if (std::string e = session.start(); !e.empty()) {
     r.error = e;
@@ -159,7 +168,10 @@ Result runCase(const std::string& world, uint64_t seed, double seconds, bool unm
     }
   const std::string why = driveSession(session, kToken, drive, seconds + 2.5,
                                        [&](const TelemetryMsg& t, const std::optional<GhostError>& e) {
-      if (driveStart < 0) driveStart = t.time;
+      if (driveStart < 0) {
+        driveStart = t.time;
+        r.changeIntoDrive = changeAt - driveStart;
+      }
       const bool judged = t.time - driveStart >= 20 + 1.0 && e && e->scale > 0;
       if (judged) {
         ++r.judged;
@@ -167,6 +179,10 @@ Result runCase(const std::string& world, uint64_t seed, double seconds, bool unm
         r.outer += e->position <= e->outer;
         r.errors.push_back(e->position);
         r.radii.push_back(e->outer);
+        const auto w = static_cast<size_t>((t.time - driveStart) / 10);
+        if (r.windows.size() <= w) r.windows.resize(w + 1);
+        ++r.windows[w].first;
+        r.windows[w].second += e->position <= e->outer;
       }
       if (trace && e)
         std::fprintf(stderr,
@@ -234,6 +250,7 @@ std::pair<uint64_t, uint64_t> range(const char* text) {
 int main(int argc, char** argv) {
   std::pair<uint64_t, uint64_t> seeds{1, 20}, departures{0, 0};
   bool runDepartures = false, matched = false, control = false;
+  double changeAt = -1;
   std::string worlds = "rough,bumpy,track";
   double seconds = 60;
   for (int i = 1; i < argc; ++i) {
@@ -244,12 +261,13 @@ int main(int argc, char** argv) {
     else if (a == "--departures" && i + 1 < argc) {
       departures = range(argv[++i]);
       runDepartures = true;
-    } else if (a == "--matched") matched = true;
+    } else if (a == "--change" && i + 1 < argc) changeAt = std::atof(argv[++i]);
+    else if (a == "--matched") matched = true;
     else if (a == "--control") control = true;
     else {
       std::fprintf(stderr,
                    "usage: bench_region [--seeds A-B] [--worlds rough,bumpy,track] [--seconds S] [--departures A-B] "
-                   "[--matched] [--control]\n");
+                   "[--matched] [--control] [--change T]\n");
       return 2;
     }
   }
@@ -292,7 +310,7 @@ int main(int argc, char** argv) {
     if (matched) list.push_back(0);
     for (uint64_t s = seeds.first; s <= seeds.second && s > 0; ++s) list.push_back(s);
     for (uint64_t s : list) {
-      const Result r = runCase(w, s, seconds, false, control);
+      const Result r = runCase(w, s, seconds, false, control, changeAt);
       if (!r.error.empty()) {
         std::printf("%-6s %6llu error: %s\n", w.c_str(), static_cast<unsigned long long>(s), r.error.c_str());
         continue;
@@ -303,6 +321,26 @@ int main(int argc, char** argv) {
                   r.judged ? double(r.outer) / r.judged : NAN, em * 1000, rm * 1000, rm / em, r.falseAlarms,
                   r.anchorsPerSecond);
       std::fflush(stdout);
+      if (changeAt >= 0) {
+        // Each 10 s window's coverage; back when every window that starts
+        // 20 s or more after the change holds 85-95 %.
+        std::string line;
+        bool back = true;
+        int after = 0;
+        for (size_t k = 2; k < r.windows.size() && 10.0 * static_cast<double>(k + 1) <= seconds + 1e-9; ++k) {
+          if (r.windows[k].first == 0) continue;  // (the last, past the drive's end, holds the stop)
+          const double c = double(r.windows[k].second) / r.windows[k].first;
+          char b[40];
+          std::snprintf(b, sizeof b, " %zu-%zus %.3f", 10 * k, 10 * k + 10, c);
+          line += b;
+          if (10.0 * static_cast<double>(k) >= r.changeIntoDrive + 20 - 1e-9) {
+            ++after;
+            back = back && c >= 0.85 && c <= 0.95;
+          }
+        }
+        std::printf("       change at %.1f s of the drive; 90 %% coverage per 10 s:%s; back within 30 s: %s\n",
+                    r.changeIntoDrive, line.c_str(), after == 0 ? "not judged (drive too short)" : back ? "yes" : "no");
+      }
       judged += r.judged;
       inner += r.inner;
       outer += r.outer;

@@ -1,6 +1,9 @@
 #include "sim/perturbation.h"
 
+#include <array>
+#include <cmath>
 #include <cstdio>
+#include <optional>
 #include <tinyxml2.h>
 
 #include "sim/random.h"
@@ -159,6 +162,33 @@ std::optional<std::string> calibratedRobotText(const std::string& text, const Ro
   XMLPrinter printer;
   doc.Print(&printer);
   return std::string(printer.CStr(), static_cast<size_t>(printer.CStrSize() > 0 ? printer.CStrSize() - 1 : 0));
+}
+
+std::string SuddenChange::describe() const {
+  return "friction x" + shortestText(friction) + ", delay +" + shortestText(delay) + " s at " + shortestText(at) + " s";
+}
+
+std::string SuddenChange::check() const {
+  if (!std::isfinite(at) || at < 0) return "at " + shortestText(at) + " s: must be >= 0";
+  if (!std::isfinite(friction) || friction <= 0) return "friction factor " + shortestText(friction) + ": must be > 0";
+  if (!std::isfinite(delay) || delay < 0) return "delay " + shortestText(delay) + " s: must be >= 0";
+  return {};
+}
+
+std::string parseSuddenChange(const std::string& text, SuddenChange& c) {
+  std::array<std::optional<double>, 3> x;
+  size_t from = 0;
+  for (size_t k = 0; k < 3; ++k) {
+    const size_t comma = text.find(',', from);
+    if ((k < 2) == (comma == std::string::npos)) return "'" + text + "': a change is T,FRICTION,DELAY (30,0.7,0.1)";
+    x[k] = parseReal(std::string_view(text).substr(from, comma == std::string::npos ? std::string::npos : comma - from));
+    if (!x[k]) return "'" + text + "': a change is T,FRICTION,DELAY (30,0.7,0.1)";
+    from = comma + 1;
+  }
+  const SuddenChange parsed{*x[0], *x[1], *x[2]};
+  if (const std::string why = parsed.check(); !why.empty()) return "'" + text + "': " + why;
+  c = parsed;
+  return {};
 }
 
 std::string parseWeakMotor(const std::string& text, Perturbation& p) {

@@ -68,6 +68,23 @@ struct Perturbation {
   std::string report(const RobotModel& robot) const;
 };
 
+/// A robot that changes while it runs: at robot time `at` its contacts'
+/// friction is multiplied by `friction` and its commands' delay grows by
+/// `delay` (the ground turned wet, a motor's controller slowed). What the
+/// console's uncertainty must recover from (issue 61).
+struct SuddenChange {
+  double at = 0;        ///< [s] robot time
+  double friction = 1;  ///< factor on every contact's mu, > 0
+  double delay = 0;     ///< [s] added to the actuator delay, >= 0
+  /// "friction x0.7, delay +0.1 s at 30 s", for logs and reports.
+  std::string describe() const;
+  /// "" or what cannot be, naming the field ("friction factor 0: must be > 0").
+  std::string check() const;
+};
+/// Parses `T,FRICTION,DELAY` ("30,0.7,0.1") into `c`: "" or why not,
+/// naming the text; `c` is unchanged then.
+std::string parseSuddenChange(const std::string& text, SuddenChange& c);
+
 /// The deviations of `robot` drawn from `seed` within `ranges`.
 Perturbation drawPerturbation(uint64_t seed, const RobotModel& robot, const PerturbationRanges& ranges = {});
 

@@ -6,11 +6,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <mutex>
 
 #include "sim/command_check.h"
+#include "sim/text.h"
 #include "sim/world_impl.h"
 
 // ODE's quick stepper reorders constraints with dRandInt(), which draws from
@@ -192,6 +194,17 @@ Pose World::objectPose(int object) const {
   dBodyID b = impl_->objectBodies[object];
   if (!b) return impl_->staticObjectPoses[object];
   return bodyPose(b) * Pose{-impl_->objectComOffset[object], {}};
+}
+
+std::string World::scaleFriction(double factor) {
+  if (!std::isfinite(factor) || factor <= 0) return "friction factor " + shortestText(factor) + ": must be > 0";
+  for (dSurfaceParameters& s : impl_->surfaces) {
+    s.mu *= factor;
+    s.mu2 *= factor;
+  }
+  model_.defaultContact.mu *= factor;
+  for (ContactSpec& c : model_.contacts) c.mu *= factor;
+  return {};
 }
 
 const HeightGrid* World::terrainGrid() const {

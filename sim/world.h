@@ -159,6 +159,13 @@ class World {
   /// is queued then).
   std::string submit(const Command& command, int robot = 0);
 
+  /// Multiplies every contact's friction coefficient (each pair of
+  /// materials', and the model's) by `factor` (> 0, finite): the ground
+  /// turned wet under a robot. Takes effect at the next collision. Not a
+  /// command and not in snapshots: a stand-in's sudden change (issue 61),
+  /// which its log records as a note. Returns "" or why not (unchanged).
+  std::string scaleFriction(double factor);
+
   /// Advances one fixed step: applies queued commands, runs the actuators,
   /// collides, steps ODE, checks health, samples the sensors that are due.
   /// Returns false, and does nothing, once the twin has diverged (health()).

@@ -214,6 +214,7 @@ std::string ConsoleSession::startStandIn(const std::string& worldFile, const std
   o.logDir = options_.logDir;
   o.perturbSeed = options_.perturbSeed;
   o.wheelTorque = options_.wheelTorque;
+  o.change = options_.change;
   o.groundFile = options_.ground;
   o.emulation.delay = options_.delay;
   o.emulation.jitter = options_.jitter;

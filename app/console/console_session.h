@@ -31,6 +31,7 @@
 #include "net/message.h"
 #include "net/robot_client.h"
 #include "sim/params.h"
+#include "sim/perturbation.h"
 #include "sim/robot_model.h"
 
 namespace sp {
@@ -57,6 +58,8 @@ struct ConsoleSessionOptions {
   std::optional<uint64_t> perturbSeed;
   /// The stand-in's wheel motors' torque factors on top (StandInOptions::wheelTorque).
   std::array<double, 4> wheelTorque{1, 1, 1, 1};
+  /// The stand-in changes while it runs (StandInOptions::change).
+  std::optional<SuddenChange> change;
   /// The stand-in stands on this world's terrain instead of the drawn
   /// world's (StandInOptions::groundFile): ground the console's map lacks.
   std::string ground;

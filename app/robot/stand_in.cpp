@@ -72,7 +72,13 @@ std::unique_ptr<StandInRobot> StandInRobot::create(const StandInOptions& options
       return nullptr;
     }
   }
+  if (options.change)
+    if (const std::string why = options.change->check(); !why.empty()) {
+      diag.error("change", 0, why);
+      return nullptr;
+    }
   auto host = std::make_unique<TwinHost>(std::move(world), params->realTimeFactor);
+  if (options.change) host->scheduleChange(*options.change);
   if (perturbation || params->calDelay > 0)
     host->setDeviations((perturbation ? perturbation->delay : 0) + params->calDelay,
                         perturbation ? perturbation->rollBias : 0, perturbation ? perturbation->pitchBias : 0);
@@ -101,6 +107,7 @@ std::map<std::string, std::string> StandInRobot::logMeta() const {
     for (double f : options_.wheelTorque) text += (text.empty() ? "" : " ") + shortestText(f);
     meta["perturbation_wheel_torque"] = text;
   }
+  if (options_.change) meta["perturbation_change"] = options_.change->describe();
   return meta;
 }
 

@@ -32,6 +32,7 @@
 #include "net/link_emulator.h"
 #include "sim/diagnostics.h"
 #include "sim/params.h"
+#include "sim/perturbation.h"
 #include "sim/robot_model.h"
 #include "sim/world.h"
 
@@ -82,6 +83,11 @@ struct StandInOptions {
   /// perturbation: a weak motor (Perturbation::wheelTorque). The log records
   /// it (meta `perturbation_wheel_torque`) and re-simulation applies it.
   std::array<double, 4> wheelTorque{1, 1, 1, 1};
+  /// A robot that changes while it runs (sim/perturbation.h): its friction
+  /// and delay at a time. The log records it (meta `perturbation_change`
+  /// and a "note" event when it happens); re-simulation does not apply it,
+  /// so a replay's check says the twin diverged from there.
+  std::optional<SuddenChange> change;
   /// Further meta for the session log (`parent_log`, `parent_time`).
   std::map<std::string, std::string> logMeta;
   /// Lines for the operator (no newline): connections, refusals, lease

@@ -253,6 +253,19 @@ void TwinHost::submitDue(bool all) {
   }
 }
 
+void TwinHost::applyChange() {
+  const SuddenChange c = *change_;
+  change_.reset();
+  const std::string why = world_->scaleFriction(c.friction);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (why.empty()) delay_ += std::max(0.0, c.delay);
+  }
+  if (log_)
+    log_->writer().logEvent(world_->stepCount(), world_->time(), "note",
+                            why.empty() ? "the stand-in changed: " + c.describe() : "the stand-in's change refused: " + why);
+}
+
 void TwinHost::run() {
   Pacer pacer({world_->params().step, realTimeFactor_, 0.1, 50});
   pacer.start(monotonic());
@@ -264,6 +277,7 @@ void TwinHost::run() {
   runner_ = &runner;
   runner.setSubmitHook([this](const ScheduledCommand& c, const std::string& why) { sequenceCommand(c, why); });
   runner.setMonitor([&](const World& w) {
+    if (change_ && w.time() >= change_->at - 1e-9) applyChange();
     if (log_) log_->stepped(w);
     if (!delayed_.empty()) submitDue(false);  // a delayed command acts at its step
     if (w.stepCount() % publishEvery == 0) publish();

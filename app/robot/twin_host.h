@@ -21,6 +21,7 @@
 
 #include "app/log/session_recorder.h"
 #include "net/robot_server.h"
+#include "sim/perturbation.h"
 #include "sim/runner.h"
 #include "sim/world.h"
 
@@ -53,6 +54,10 @@ class TwinHost : public net::RobotPort {
     rollBias_ = rollBias;
     pitchBias_ = pitchBias;
   }
+  /// The robot changes at `change.at` (sim time): the World's friction is
+  /// scaled and the delay grows, on the physics thread at a step boundary,
+  /// logged as a "note" event. Before start().
+  void scheduleChange(const SuddenChange& change) { change_ = change; }
   bool acceptsTerrainEdits() const { return terrainEdits_; }
   /// Starts the physics thread. Once only.
   void start();
@@ -102,6 +107,8 @@ class TwinHost : public net::RobotPort {
   // Logs the queued events, then submits the queued commands and logs those
   // the World took. Physics thread.
   void takeCommands();
+  // The scheduled change, now. Physics thread.
+  void applyChange();
   /// Submits the delayed commands due by now (all of them when `all`).
   void submitDue(bool all);
   // The "health" event, once, when the World has diverged. Physics thread.
@@ -134,6 +141,7 @@ class TwinHost : public net::RobotPort {
   std::vector<Command> pending_;
   double delay_ = 0, rollBias_ = 0, pitchBias_ = 0;  // setDeviations()
   std::deque<std::pair<double, Command>> delayed_;    // (sim time due, command); physics thread
+  std::optional<SuddenChange> change_;                // scheduleChange(); physics thread once started
   std::vector<PendingEvent> events_;
   net::RobotState state_;
   net::LaserScanState laser_;

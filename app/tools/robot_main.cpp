@@ -55,6 +55,10 @@ constexpr const char* kUsage = R"(usage:
       --weak-motor WHEEL=F  that wheel motor's torque limit times F (fl, fr, rl
                         or rr; F in (0, 2]; repeatable): a weak motor, with or
                         without --perturb; the log records it
+      --change T,F,D    at robot time T s the contacts' friction times F and
+                        the actuator delay D s longer (30,0.7,0.1): a robot
+                        that changes while it runs; the log notes it, a
+                        replay does not re-apply it
       --perturb-report  print the deviations (with --perturb) and exit
   Prints `world PATH`, `logging to PATH`, then `listening on ADDRESS:PORT`
   when ready;
@@ -113,6 +117,14 @@ std::optional<int> parseArgs(const std::vector<std::string>& args, sp::StandInOp
         return 2;
       }
       options.perturbSeed = seed;
+    }
+    else if (a == "--change") {
+      sp::SuddenChange c;
+      if (const std::string why = sp::parseSuddenChange(v, c); !why.empty()) {
+        std::cerr << "<command line>: error: --change: " << why << "\n";
+        return 2;
+      }
+      options.change = c;
     }
     else if (a == "--weak-motor") {
       sp::Perturbation p;

@@ -422,6 +422,56 @@ class TestStandIn : public QObject {
     }
   }
 
+  // A robot that changes while it runs (issue 61): at the time asked its
+  // log notes the change and what it was; the meta says it for a replay.
+  // Before it (the control) no note. A change that cannot be is refused
+  // at create(), naming the field.
+  void suddenChangeIsLogged() {
+    QTemporaryDir dir;
+    const std::string path = dir.filePath("changed.splog").toStdString();
+    StandInOptions o = options(path);
+    o.change = SuddenChange{0.6, 0.7, 0.1};
+    Diagnostics diag;
+    auto robot = StandInRobot::create(o, diag);
+    QVERIFY2(robot, diag.format().c_str());
+    QCOMPARE(robot->start(), std::string());
+    std::this_thread::sleep_for(1200ms);
+    robot->stop();
+    std::string error;
+    auto reader = SessionLogReader::open(path, error);
+    QVERIFY2(reader, error.c_str());
+    QCOMPARE(reader->meta().at("perturbation_change"), std::string("friction x0.7, delay +0.1 s at 0.6 s"));
+    std::vector<LogEvent> notes;
+    for (const LogEvent& e : reader->events())
+      if (e.kind == "note" && e.text.rfind("the stand-in changed", 0) == 0) notes.push_back(e);
+    QCOMPARE(notes.size(), size_t{1});
+    QVERIFY2(notes[0].time >= 0.6 - 1e-9 && notes[0].time < 0.6 + 0.01, qPrintable(QString::number(notes[0].time)));
+    QCOMPARE(notes[0].text, std::string("the stand-in changed: friction x0.7, delay +0.1 s at 0.6 s"));
+
+    // The control: asked for later than the run lasted, nothing changed.
+    const std::string later = dir.filePath("later.splog").toStdString();
+    StandInOptions l = options(later);
+    l.change = SuddenChange{60, 0.7, 0.1};
+    auto unchanged = StandInRobot::create(l, diag);
+    QVERIFY2(unchanged, diag.format().c_str());
+    QCOMPARE(unchanged->start(), std::string());
+    std::this_thread::sleep_for(300ms);
+    unchanged->stop();
+    reader = SessionLogReader::open(later, error);
+    QVERIFY2(reader, error.c_str());
+    for (const LogEvent& e : reader->events()) QVERIFY2(e.text.find("changed") == std::string::npos, e.text.c_str());
+
+    for (const auto& [bad, expected] : {std::pair{SuddenChange{1, 0, 0}, "change: error: friction factor 0: must be > 0"},
+                                        std::pair{SuddenChange{1, 1, -0.1}, "change: error: delay -0.1 s: must be >= 0"},
+                                        std::pair{SuddenChange{NAN, 1, 0}, "change: error: at nan s: must be >= 0"}}) {
+      StandInOptions b = options("");
+      b.change = bad;
+      Diagnostics refused;
+      QVERIFY(!StandInRobot::create(b, refused));
+      QVERIFY2(refused.format().find(expected) != std::string::npos, refused.format().c_str());
+    }
+  }
+
   // start() refuses a log file that exists, and then runs nothing; create()
   // names what is wrong with the options.
   void refusals() {

@@ -136,6 +136,29 @@ class TestPerturbation : public QObject {
     }
   }
 
+  // A sudden change parsed from T,FRICTION,DELAY; what cannot be is
+  // refused naming the text and the field, and leaves the change alone.
+  void suddenChangeParsed() {
+    SuddenChange c;
+    QCOMPARE(parseSuddenChange("30,0.7,0.1", c), std::string());
+    QCOMPARE(c.at, 30.0);
+    QCOMPARE(c.friction, 0.7);
+    QCOMPARE(c.delay, 0.1);
+    QCOMPARE(c.describe(), std::string("friction x0.7, delay +0.1 s at 30 s"));
+    for (const auto& [bad, why] : {std::pair{"30,0,0.1", "friction factor 0: must be > 0"},
+                                   std::pair{"30,0.7,-1", "delay -1 s: must be >= 0"},
+                                   std::pair{"-1,0.7,0", "at -1 s: must be >= 0"},
+                                   std::pair{"30,0.7", "a change is T,FRICTION,DELAY"},
+                                   std::pair{"30,0.7,0.1,4", "a change is T,FRICTION,DELAY"},
+                                   std::pair{"30,x,0.1", "a change is T,FRICTION,DELAY"}}) {
+      SuddenChange d;
+      const std::string got = parseSuddenChange(bad, d);
+      QVERIFY2(got.find(std::string("'") + bad + "': ") == 0 && got.find(why) != std::string::npos, got.c_str());
+      QCOMPARE(d.at, 0.0);
+      QCOMPARE(d.friction, 1.0);
+    }
+  }
+
   // The robot feels it: its wheels turn (mean over 1-1.5 s) at gain x the commanded speed
   // (within 3 %: its torque limit is perturbed too); control: the twin of
   // the files turns them at the commanded speed within 1 %.

@@ -331,13 +331,17 @@ class TestWorld : public QObject {
 
   void slidingFriction_data() {
     QTest::addColumn<double>("mu");
-    QTest::newRow("slides, mu 0.1") << 0.1;
-    QTest::newRow("slides, mu 0.2") << 0.2;
-    QTest::newRow("sticks, mu 0.5") << 0.5;
+    QTest::addColumn<double>("scale");  // World::scaleFriction after the build
+    QTest::newRow("slides, mu 0.1") << 0.1 << 1.0;
+    QTest::newRow("slides, mu 0.2") << 0.2 << 1.0;
+    QTest::newRow("sticks, mu 0.5") << 0.5 << 1.0;
+    QTest::newRow("mu 0.5 scaled x 0.3: slides as 0.15") << 0.5 << 0.3;
+    QTest::newRow("mu 0.2 scaled x 0.5: slides as 0.1") << 0.2 << 0.5;
   }
   // A box on ground tilted 15 deg (by tilting gravity) slides with
   // a = g (sin 15 - mu cos 15) when mu < tan 15, and sticks otherwise.
   void slidingFriction() {
+    QFETCH(double, scale);
     QFETCH(double, mu);
     const double g = 9.81, theta = degToRad(15);
     const std::string gravity = QString("%1 0 %2").arg(g * std::sin(theta), 0, 'g', 17)
@@ -350,6 +354,13 @@ class TestWorld : public QObject {
       <object name="box" static="false" mass="1" xyz="0 0 0.1"><geom type="box" size="0.2 0.2 0.2" material="steel"/></object>
     </world>)").arg(QString::fromStdString(gravity)).arg(mu).toStdString());
     QVERIFY(world);
+    if (scale != 1) {
+      QCOMPARE(world->scaleFriction(scale), std::string());
+      QCOMPARE(world->model().contacts[0].mu, mu * scale);
+      mu *= scale;
+    }
+    QVERIFY(!world->scaleFriction(0).empty());
+    QVERIFY(!world->scaleFriction(std::nan("")).empty());
     stepFor(*world, 0.5);
     const double x0 = world->objectPose(0).p.x, t0 = world->time();
     stepFor(*world, 1.0);
