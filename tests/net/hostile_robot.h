@@ -122,9 +122,20 @@ class HostileRobot {
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit_);
     while (!finished_ && !stop_ && std::chrono::steady_clock::now() < end)
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (finished_ && !stop_) {
+      // Half-close, then read and drop what the client still sends until it
+      // closes (at most 2 s): closing with its heartbeats unread would send
+      // a reset, and the client's kernel would drop what it had not read of
+      // ours yet (a flood's last tens of thousands of frames).
+      play.join();
+      socket_.shutdown(asio::ip::tcp::socket::shutdown_send, ec);
+      const auto linger = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+      while (!stop_ && std::chrono::steady_clock::now() < linger && peer.drain())
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
     stop_ = true;
     socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ec);
-    play.join();
+    if (play.joinable()) play.join();
     socket_.close(ec);
   }
 
