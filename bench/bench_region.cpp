@@ -27,8 +27,9 @@
 // --control: the conformal layer off (its Gaussian multipliers on the
 // scale alone), to show that the coverage figures can fail.
 //
-// --change T: the stand-in changes T s into the drive (friction x 0.7,
-// delay + 100 ms: sim/perturbation.h SuddenChange); the 90 % region's
+// --change T: the stand-in changes at robot time T (friction x 0.7,
+// delay + 100 ms: sim/perturbation.h SuddenChange; the drive starts some
+// 4 s into robot time, and the line says where in the drive it fell); the 90 % region's
 // coverage is printed for each 10 s after 20 s, and whether every window
 // from 20 s after the change on holds 85-95 % (back within 30 s).
 
@@ -141,7 +142,7 @@ Result runCase(const std::string& world, uint64_t seed, double seconds, bool unm
   o.overrides = {"link.deadman=0.5"};
   if (seed != 0) o.perturbSeed = seed;
   if (control) o.ghostOptions.conformal = false;
-  if (changeAt >= 0) o.change = SuddenChange{changeAt, 0.7, 0.1};  // robot time: the drive starts within a second of 0
+  if (changeAt >= 0) o.change = SuddenChange{changeAt, 0.7, 0.1};  // robot time, not the drive's
   ConsoleSession session(o);
   if (std::string e = session.start(); !e.empty()) {
     r.error = e;
