@@ -273,16 +273,28 @@ std::array<double, 4> radiusValues(const std::array<double, 4>& factors);
 /// 0), which helps the ghost and moved a full-physics rehearsal's end from
 /// 0.2 to 9.4 cm. So each of kFullPhysicsChecked that `applied` moved from
 /// the files' is put back to the files' value unless the twin at `full`
-/// physics predicts the newest `window` seconds of telemetry better with it.
+/// physics predicts the newest `window` seconds of telemetry better with
+/// it: the splits on the motion (with the motors' limits at the files'),
+/// then the motors' limits on the wheels' forces (with the splits as
+/// judged), each at the value of kLimitSteps + 1 from the applied one to
+/// the files' that predicts the forces best. A limit fitted in the ghost's
+/// fits to the forces of wheels a spurious split made fight is refused
+/// there with the split.
 struct FullPhysicsCheck {
-  CalValues values{};       ///< `applied`, less what the full physics refused
-  double cost = 0;          ///< mean squared scaled residual with `applied`
+  CalValues values{};       ///< `applied`, less what the full physics refused (a limit may land between the two)
+  double cost = 0;          ///< the motion's mean squared scaled residual with `applied` (the limits at the files'); 0: no split checked
+  double forceCost = 0;     ///< the wheels' forces' with `values`' splits and `applied`'s limits; 0: no limit checked
   CalValues costWithout{};  ///< ... with each checked one at the files' (0: not tried)
   double wallMs = 0;
   std::string problem;      ///< "" or why nothing was checked (values = applied)
 };
 inline constexpr CalParam kFullPhysicsChecked[] = {CalParam::WheelRadiusSplit, CalParam::WheelRadiusSide,
-                                                   CalParam::WheelRadiusDiag};
+                                                   CalParam::WheelRadiusDiag,  CalParam::TorqueFL,
+                                                   CalParam::TorqueFR,         CalParam::TorqueRL,
+                                                   CalParam::TorqueRR};
+inline constexpr int kLimitSteps = 3;
+/// One of the wheel motors' torque limits (judged on the forces).
+constexpr bool isTorqueLimit(CalParam p) { return p >= CalParam::TorqueFL && p <= CalParam::TorqueRR; }
 FullPhysicsCheck fullPhysicsValues(const WorldModel& files, const SimParams& full, const std::vector<RobotFrame>& frames,
                                    const std::vector<TimedCommand>& commands, const CalValues& applied, double window,
                                    int threads = 1, const std::function<bool()>& abort = {});

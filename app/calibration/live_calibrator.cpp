@@ -97,6 +97,7 @@ void LiveCalibrator::updateFullPhysics() {
   for (CalParam p : kFullPhysicsChecked) {
     const size_t i = static_cast<size_t>(p);
     if (!state_.confirmed[i]) state_.fullPhysics[i] = calParams()[i].files;
+    else if (isTorqueLimit(p)) state_.fullPhysics[i] = state_.checkedValue[i];
   }
 }
 
@@ -251,8 +252,9 @@ void LiveCalibrator::check(const std::vector<RobotFrame>& frames, const std::vec
   for (CalParam p : kFullPhysicsChecked) {
     const size_t i = static_cast<size_t>(p);
     if (applied[i] == calParams()[i].files || state_.applied[i] == calParams()[i].files) continue;
-    state_.confirmed[i] = c.values[i] == applied[i];
+    state_.confirmed[i] = c.values[i] != calParams()[i].files;  // a split kept, or a limit found
     state_.refused[i] = !state_.confirmed[i];
+    state_.checkedValue[i] = c.values[i];
   }
   updateFullPhysics();
   ++state_.version;

@@ -42,10 +42,12 @@ struct CalibrationState {
   CalFlags observed{};      ///< some fit observed it (else the files' or the start's)
   /// What the full-physics twins (rehearsals, robustness runs, sweeps) use:
   /// `applied`, with each of kFullPhysicsChecked at the files' value until a
-  /// full-physics check confirmed it (calibration.h, fullPhysicsValues).
+  /// full-physics check confirmed it (calibration.h, fullPhysicsValues); a
+  /// confirmed motor's limit at the value that check found.
   CalValues fullPhysics{};
-  CalFlags confirmed{};     ///< the last full-physics check kept it
+  CalFlags confirmed{};     ///< the last full-physics check kept it (a limit: found one, at `checkedValue`)
   CalFlags refused{};       ///< ... put it back to the files' value
+  CalValues checkedValue{}; ///< the value the last check gave each of kFullPhysicsChecked
   double checkedAt = -1;    ///< [s] robot time of that check (< 0: none yet)
   bool frozen = false;
   int fits = 0, refusals = 0;
@@ -77,8 +79,8 @@ class LiveCalibrator {
     /// on the checker between those of a check), holding no lock (to prove
     /// the GUI thread never waits on a fit).
     std::function<void()> duringFit;
-    /// The console's own physics: when set, the radius splits the fits
-    /// applied are checked in it (fullPhysicsValues over the newest
+    /// The console's own physics: when set, the radius splits and motors'
+    /// torque limits the fits applied are checked in it (fullPhysicsValues over the newest
     /// `fit.window` s) before the full-physics twins are given them: after
     /// a fit that applied one no check judged, at most every `checkPeriod`
     /// s of robot time; the verdicts again every 4 `checkPeriod`.

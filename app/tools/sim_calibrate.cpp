@@ -67,8 +67,8 @@ int calibrate(const std::vector<std::string>& args) {
   }
   std::printf("%s: %d segments over %.1f - %.1f s, %d twin runs, %.0f ms; cost %.3g -> %.3g\n", log.c_str(),
               fit.segments, fit.from, fit.to, fit.twinRuns, fit.wallMs, fit.costBefore, fit.costAfter);
-  // Fitted in the ghost's profile: the radius splits are checked in the
-  // log's own physics before a file gets them, as the console does for its
+  // Fitted in the ghost's profile: the radius splits and the motors' limits
+  // are checked in the log's own physics before a file gets them, as the console does for its
   // rehearsals (calibration.h, fullPhysicsValues), over the newest 16 s.
   sp::CalibrationFit written = fit;
   if (profileName == "ghost") {
@@ -80,9 +80,11 @@ int calibrate(const std::vector<std::string>& args) {
       for (sp::CalParam q : sp::kFullPhysicsChecked) {
         const size_t i = static_cast<size_t>(q);
         if (check.values[i] == fit.value[i]) continue;
-        std::printf("full physics: %s %.5f put back to the files' %.5f (it predicts the robot better without it: cost %.4g "
+        const bool limit = sp::isTorqueLimit(q);
+        std::printf("full physics: %s %.5f put back to the files' %.5f (it predicts the robot%s better without it: cost %.4g "
                     "against %.4g)\n",
-                    sp::calParams()[i].key, fit.value[i], check.values[i], check.costWithout[i], check.cost);
+                    sp::calParams()[i].key, fit.value[i], check.values[i], limit ? "'s wheel forces" : "", check.costWithout[i],
+                    limit ? check.forceCost : check.cost);
         written.value[i] = check.values[i];
         written.observed[i] = false;
       }

@@ -344,6 +344,54 @@ class TestCalibration : public QObject {
       if (i != kDiag) QCOMPARE(c.values[i], values[i]);  // nothing else touched
   }
 
+  // The same check of the motors' torque limits, on the wheels' forces: a
+  // half-torque rear-left limit applied to a robot that has one is kept;
+  // applied to a robot that is its twin it is refused (the control); and the
+  // limits the fits took from a held spurious split (two weak motors where
+  // the split made the wheels fight) are refused with the split, which the
+  // motion judges with the limits at the files'.
+  void fullPhysicsConfirmsOnlyRealLimits_data() {
+    QTest::addColumn<double>("hiddenRearLeft");
+    QTest::addColumn<double>("appliedDiag");
+    QTest::addColumn<double>("appliedFrontRight");
+    QTest::addColumn<bool>("kept");
+    QTest::newRow("rear-left at half torque, applied 0.5") << 0.5 << 0.0 << 1.0 << true;
+    QTest::newRow("control: robot is its twin, applied 0.5") << 1.0 << 0.0 << 1.0 << false;
+    QTest::newRow("robot is its twin, a spurious split and two limits") << 1.0 << -0.015 << 0.65 << false;
+  }
+  void fullPhysicsConfirmsOnlyRealLimits() {
+    QFETCH(double, hiddenRearLeft);
+    QFETCH(double, appliedDiag);
+    QFETCH(double, appliedFrontRight);
+    QFETCH(bool, kept);
+    const WorldModel world = loadWorldFile("flat.world.xml");
+    Perturbation p = none(world);
+    p.wheelTorque = {1, 1, hiddenRearLeft, 1};
+    const char* const kDrive =  // brisk changes of speed: the wheels ask for their limits
+        "0.5 drive 0.5 0\n"
+        "4 drive 0.8 12\n"
+        "8 drive 0.4 -15\n"
+        "11 drive 0.8 0\n";
+    const RecordedDrive d = recordDrive(world, SimParams{}, p, commands(world, kDrive), 14.0);
+    QVERIFY2(d.problem.empty(), d.problem.c_str());
+    constexpr size_t kDiag = static_cast<size_t>(CalParam::WheelRadiusDiag);
+    constexpr size_t kFR = static_cast<size_t>(CalParam::TorqueFR), kRL = static_cast<size_t>(CalParam::TorqueRL);
+    CalValues values = filesCalValues();
+    values[kDiag] = appliedDiag;
+    values[kFR] = appliedFrontRight;
+    values[kRL] = 0.5;
+    const FullPhysicsCheck c = fullPhysicsValues(world, SimParams{}, d.frames, d.commands, values, 12, 2);
+    qInfo("forces' cost with the limits %.3f, without rear-left's %.3f; motion's with the split %.4f, without %.4f; %.0f ms",
+          c.forceCost, c.costWithout[kRL], c.cost, c.costWithout[kDiag], c.wallMs);
+    QVERIFY2(c.problem.empty(), c.problem.c_str());
+    QCOMPARE(c.values[kRL], kept ? 0.5 : 1.0);
+    QCOMPARE(c.values[kDiag], 0.0);
+    QCOMPARE(c.values[kFR], 1.0);
+    QVERIFY(c.costWithout[kRL] > 0);  // judged
+    for (size_t i = 0; i < kCalParams; ++i)
+      if (i != kDiag && i != kFR && i != kRL) QCOMPARE(c.values[i], values[i]);  // nothing else touched
+  }
+
   // What the twins get of a fused estimate: a value more than two
   // deviations from the files' (kSignificance), else the files' own.
   void significantValuesGateOnTwoDeviations() {
@@ -512,7 +560,10 @@ class TestCalibration : public QObject {
     // The full-physics twins get the same, but for a split no check confirmed.
     for (size_t i = 0; i < kCalParams; ++i) {
       const bool checked = std::count(std::begin(kFullPhysicsChecked), std::end(kFullPhysicsChecked), static_cast<CalParam>(i)) > 0;
-      QCOMPARE(s.fullPhysics[i], checked && !s.confirmed[i] ? calParams()[i].files : s.applied[i]);
+      const bool limit = isTorqueLimit(static_cast<CalParam>(i));
+      QCOMPARE(s.fullPhysics[i], checked && !s.confirmed[i] ? calParams()[i].files
+                                 : limit && s.confirmed[i] ? s.checkedValue[i]
+                                                           : s.applied[i]);
     }
     live.reset();
     QVERIFY(live.state().applied == filesCalValues());
