@@ -30,7 +30,11 @@
 //                 calibration: what starting the rehearsal from the
 //                 world's settled start instead of the robot's run, and
 //                 the joints held rigid, leave);
-//   fit cost      wall time of each online fit (on this thread).
+//   fit cost      wall time of each online fit (on this thread);
+//   motors        each wheel motor's torque limit: as the ghost gets it (the
+//                 fused estimate where significant), the estimate itself
+//                 +- its deviation, and as the rehearsals get it (after the
+//                 full physics' check, fullPhysicsValues).
 // Seed 0 is the control: the robot is its twin. --seed S runs seed S alone;
 // --window and --horizon measure a fit other than the console's (8 s, 2 s);
 // with SP_BENCH_VALUES set, each case's estimates, deviations and the hidden

@@ -221,9 +221,10 @@ DepartureWatch::Change DepartureWatch::judge(double time, const Vec3& where, dou
     return Change::Ended;
   }
   if (!outside) {
-    outsideSince_ = -1;
+    if (outsideSince_ >= 0 && time - outsideLast_ > options_.gap) outsideSince_ = -1;
     return Change::None;
   }
+  outsideLast_ = time;
   if (outsideSince_ < 0) {
     outsideSince_ = time;
     outsideWhere_ = !away && wheel ? *wheel : where;

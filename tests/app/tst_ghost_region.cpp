@@ -170,6 +170,31 @@ class TestGhostRegion : public QObject {
     QVERIFY(watch.last()->ground);  // a place: the calibration leaves it out
   }
 
+  // A run outside survives a frame inside (a wheel unloaded for a frame at
+  // a hollow's edge): 0.36 s out, one frame in, 0.3 s out is a departure,
+  // dated at the first run's start; control: 0.2 s inside between the two
+  // runs (beyond the 0.1 s gap) ends the first, and neither is one.
+  void departureSurvivesAFrameInside_data() {
+    QTest::addColumn<double>("inside");
+    QTest::addColumn<bool>("departs");
+    QTest::newRow("one frame inside") << 0.02 << true;
+    QTest::newRow("control: 0.2 s inside") << 0.2 << false;
+  }
+  void departureSurvivesAFrameInside() {
+    QFETCH(double, inside);
+    QFETCH(bool, departs);
+    DepartureWatch watch;
+    const Vec3 here{1, 0, 0}, wheel{1.5, 0.4, 0.2};
+    double t = 10;
+    for (; t < 10.36 - 1e-9; t += 0.02) watch.judge(t, here, 0.01, 0.05, 0.05, 0.02, wheel);
+    const double back = t;
+    for (; t < back + inside - 1e-9; t += 0.02) watch.judge(t, here, 0.01, 0.05, 0.004, 0.02, wheel);
+    const double again = t;
+    for (; t < again + 0.3 - 1e-9; t += 0.02) watch.judge(t, here, 0.01, 0.05, 0.05, 0.02, wheel);
+    QCOMPARE(watch.departing(), departs);
+    if (departs) QCOMPARE(watch.last()->time, 10.0);
+  }
+
   // The scale: the floor for a robot standing, growing with speed x horizon
   // along the path, with a change of speed whose arrival is uncertain, and
   // with the terrain's uncertainty.
